@@ -1,0 +1,28 @@
+# Quick start: `make demo` runs the main demo, `make test` runs the whole test suite.
+# Both create their own virtual environment in .venv on first use (needs only python3).
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed-stamp
+
+.PHONY: demo test bench clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/taut fk examples/sheet/example2_r2_r4_353mm.yaml --mass 1.0 --plot out/example2.png
+	@echo "figure written to out/example2.png"
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+bench: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[test,bench]'
+	$(BIN)/python bench/bench_fk.py
+
+clean:
+	rm -rf $(VENV) out .pytest_cache .hypothesis

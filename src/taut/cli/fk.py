@@ -1,0 +1,5 @@
+"""`taut fk` (placeholder filled below)."""
+import typer
+
+def register(app: typer.Typer) -> None:
+    pass
