@@ -13,7 +13,7 @@ import click
 import typer
 
 from ..errors import TautError
-from . import fk
+from . import cdpr, fk, motion
 
 app = typer.Typer(
     name="taut",
@@ -24,7 +24,7 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 
-for _module in (fk,):
+for _module in (fk, motion, cdpr):
     _module.register(app)
 
 EXIT_USAGE = 2

@@ -78,7 +78,8 @@ def _min_eig_family(frame: Frame, f: int, idx: np.ndarray) -> float:
     return float(np.linalg.eigvalsh(Hr)[0])
 
 
-def classify(frame: Frame, solved: Solved, taut: np.ndarray) -> Classified:
+def classify(frame: Frame, solved: Solved, taut: np.ndarray,
+             projection_checked: np.ndarray | None = None) -> Classified:
     """Turn candidate solutions (already feasible: pieces maximal, depth real, object
     above ground) into the final, de-duplicated, classified solution list.
 
@@ -86,6 +87,8 @@ def classify(frame: Frame, solved: Solved, taut: np.ndarray) -> Classified:
     *is* the taut set; apply the paper's projection test; compute weights (unique
     when the taut set is affinely independent, otherwise by LP/QP); status from the
     weights' signs and the reduced Hessian; sort by formation, taut-set size, taut set.
+    ``projection_checked`` (M,) marks rows that already passed the projection test on
+    their exact taut set.
     """
     N = taut.shape[1]
     tsize = taut.sum(axis=1)
@@ -104,7 +107,13 @@ def classify(frame: Frame, solved: Solved, taut: np.ndarray) -> Classified:
     tsize = tsize[pick]
     is_rare = is_rare[pick].astype(bool)
 
-    paper_ok = in_hull_2d(frame.R[sol.form], taut, sol.ro) & (tsize >= 3)
+    width = int(tsize.max())
+    cols, inside = taut_indices(taut, tsize, width)
+    pts = frame.R[sol.form[:, None], np.minimum(cols, N - 1)]
+    paper_ok = tsize >= 3
+    todo = paper_ok if projection_checked is None else paper_ok & ~projection_checked[pick]
+    if np.any(todo):
+        paper_ok[todo] = in_hull_2d(pts[todo], inside[todo], sol.ro[todo])
     sol = sol.take(paper_ok)
     taut, tsize, is_rare = taut[paper_ok], tsize[paper_ok], is_rare[paper_ok]
     K = len(tsize)
@@ -118,9 +127,7 @@ def classify(frame: Frame, solved: Solved, taut: np.ndarray) -> Classified:
         valid = cols >= 0
         weights[rows[valid], cols[valid]] = sol.w[common].ravel()[valid]
         min_w[common] = np.where(sol.subset[common] >= 0, sol.w[common], np.inf).min(axis=1)
-        for s in np.unique(sol.size[common]):
-            sel = common[sol.size[common] == s]
-            min_eig[sel] = reduced_hessian_min_eig(frame, sol.form[sel], sol.subset[sel, :s])
+        min_eig[common] = reduced_hessian_min_eig(frame, sol.form[common], sol.subset[common])
     for k in np.flatnonzero(is_rare):
         idx = np.flatnonzero(taut[k])
         w, t_star = _weights_family(frame, int(sol.form[k]), idx, sol.ro[k], sol.vo[k])
@@ -133,12 +140,25 @@ def classify(frame: Frame, solved: Solved, taut: np.ndarray) -> Classified:
 
     # Output order: formation, number of taut cables, taut set (lexicographic).
     width = int(tsize.max()) if K else 0
-    sorted_idx = np.sort(np.where(taut, np.arange(N), N), axis=1)[:, :width]
+    sorted_idx = taut_indices(taut, tsize, width)[0]
     order = np.lexsort(tuple(sorted_idx[:, c] for c in range(width - 1, -1, -1))
                        + (tsize, sol.form))
     sol = sol.take(order)
     return Classified(sol.form, taut[order], sol.ro, sol.vo,
                       np.sqrt(sol.depth2), weights[order], status[order])
+
+
+def taut_indices(taut: np.ndarray, tsize: np.ndarray, width: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Ascending indices of each row's True entries, padded to ``width`` with ``N``;
+    and the mask of real entries. ``taut`` (K, N) bool; O(number of True entries)."""
+    K, N = taut.shape
+    rows, cols = np.nonzero(taut)
+    starts = np.concatenate([[0], np.cumsum(tsize)[:-1]])
+    pos = np.arange(len(rows)) - starts[rows]
+    out = np.full((K, width), N, dtype=np.intp)
+    out[rows, pos] = cols
+    return out, out < N
 
 
 def _empty(N: int) -> Classified:

@@ -40,8 +40,12 @@ TAUT_TOL = 1e-9
 WEIGHT_TOL = 1e-9
 #: Reduced-Hessian eigenvalues above this count as positive (dimensionless).
 CURVATURE_TOL = 1e-9
-#: Relative determinant below which a candidate's Lagrange system counts as singular.
-SINGULAR_RTOL = 1e-11
+#: Relative determinant (|det K| / prod of row norms) below which a candidate's Lagrange
+#: system is checked for singularity by its condition number.
+SINGULAR_RTOL = 1e-10
+#: Condition number above which a Lagrange system counts as singular (affinely dependent
+#: lifted points give ~1e16; valid but ill-conditioned systems seen up to ~1e8).
+MAX_CONDITION = 1e12
 #: Angular slack (radians) of the paper's projection test.
 ANGLE_TOL = 1e-9
 
@@ -59,6 +63,8 @@ class Frame:
     ``R`` (B, N, 2) robots, ``V`` (N, 2) vertices, ``z`` hold height, all divided by
     ``scale``; ``r_centre`` (B, 2) and ``v_centre`` (2,) were subtracted before scaling.
     ``P`` (B, N, 5) are the lifted points :math:`(\\mathbf{a}_i, b_i)` and ``b`` (B, N).
+    ``gram`` (B, N, N) is :math:`G_{ij} = 2(\\mathbf{r}_i\\cdot\\mathbf{r}_j -
+    \\mathbf{v}_i\\cdot\\mathbf{v}_j)`.
     """
 
     R: np.ndarray
@@ -69,6 +75,7 @@ class Frame:
     scale: float
     b: np.ndarray
     P: np.ndarray
+    gram: np.ndarray
 
     @classmethod
     def build(cls, vertices: np.ndarray, formations: np.ndarray, hold_height: float,
@@ -83,7 +90,8 @@ class Frame:
         P[..., :2] = -2.0 * R
         P[..., 2:4] = 2.0 * V
         P[..., 4] = b
-        return cls(R, V, hold_height / scale, r_centre, v_centre, scale, b, P)
+        gram = 2.0 * (R @ R.transpose(0, 2, 1) - (V @ V.T)[None])
+        return cls(R, V, hold_height / scale, r_centre, v_centre, scale, b, P, gram)
 
 
 @dataclass
@@ -121,41 +129,59 @@ class Solved:
         return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.FIELDS))
 
 
-def solve_candidates(frame: Frame, groups: dict[int, tuple[np.ndarray, np.ndarray]]) -> Solved:
+def pad_groups(groups: dict[int, tuple[np.ndarray, np.ndarray]]
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Concatenate ``size -> (form, subset (M_s, size))`` groups (ascending size) into
+    ``form`` (M,) and ``subset`` (M, 5) padded with -1."""
+    forms, idxs = [], []
+    for s, (form, idx) in sorted(groups.items()):
+        pad = np.full((len(form), 5), -1, dtype=np.intp)
+        pad[:, :s] = idx
+        forms.append(form)
+        idxs.append(pad)
+    if not forms:
+        return np.zeros(0, np.intp), np.zeros((0, 5), np.intp)
+    return np.concatenate(forms), np.vstack(idxs)
+
+
+def solve_candidates(frame: Frame, form: np.ndarray, idx: np.ndarray, *,
+                     independent: bool = False) -> Solved:
     """Solve the Lagrange system for every candidate set, in one batched call.
 
     Parameters
     ----------
-    groups : dict
-        ``size -> (form (M_s,), subset (M_s, size))``; sizes 2..5. Each system is padded
-        to 6 x 6 (identity rows for unused slots) so that all sizes share one LAPACK call.
+    form : ndarray of int, shape (M,)
+        Formation index of each candidate.
+    idx : ndarray of int, shape (M, 5)
+        Robot indices of each candidate set (2..5 of them), padded with -1. Each system
+        is padded to 6 x 6 (identity rows for unused slots) so that all sizes share one
+        LAPACK call.
+    independent : bool
+        The caller guarantees that every candidate's lifted points are affinely
+        independent (faces of a non-degenerate triangulated hull). The determinant test is
+        then skipped; a system that is still singular (Lemma 1 failing) shows up as a
+        LAPACK error or a non-finite/huge solution and is dropped.
+
+    Returns
+    -------
+    Solved
+        ``source`` holds each solution's row in the input.
 
     Candidates whose system is singular (affinely dependent lifted points, or a degenerate
     reduced Hessian where the paper's Lemma 1 fails) are dropped: an affinely independent
     subset spanning the same face is always among the candidates as well.
     """
-    forms, idxs, sizes, sources = [], [], [], []
-    for s, (form, idx) in sorted(groups.items()):
-        if len(form) == 0:
-            continue
-        pad = np.full((len(form), 5), -1, dtype=np.intp)
-        pad[:, :s] = idx
-        forms.append(form)
-        idxs.append(pad)
-        sizes.append(np.full(len(form), s, dtype=np.intp))
-        sources.append(np.arange(len(form), dtype=np.intp))
-    if not forms:
+    if len(form) == 0:
         return Solved.concat([])
-    form = np.concatenate(forms)
-    idx = np.vstack(idxs)
-    size = np.concatenate(sizes)
-    source = np.concatenate(sources)
+    source = np.arange(len(form))
     valid = idx >= 0
+    size = valid.sum(axis=1)
     ii = np.where(valid, idx, 0)
     Rs = frame.R[form[:, None], ii] * valid[..., None]          # (M, 5, 2), 0 when unused
     Vs = frame.V[ii] * valid[..., None]
     K = np.zeros((len(form), 6, 6))
-    K[:, :5, :5] = 2.0 * (Rs @ Rs.transpose(0, 2, 1) - Vs @ Vs.transpose(0, 2, 1))
+    K[:, :5, :5] = frame.gram[form[:, None, None], ii[:, :, None], ii[:, None, :]]
+    K[:, :5, :5] *= valid[:, :, None] & valid[:, None, :]
     K[:, :5, 5] = valid
     K[:, 5, :5] = valid
     diag = np.arange(5)
@@ -163,12 +189,25 @@ def solve_candidates(frame: Frame, groups: dict[int, tuple[np.ndarray, np.ndarra
     rhs = np.zeros((len(form), 6))
     rhs[:, :5] = np.where(valid, frame.b[form[:, None], ii], 0.0)
     rhs[:, 5] = 1.0
-    det = np.linalg.det(K)
-    ok = np.abs(det) > SINGULAR_RTOL * np.prod(np.linalg.norm(K, axis=2), axis=1)
+    if independent:
+        try:
+            sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            independent = False
+        else:
+            ok = np.all(np.abs(sol) < 1e9, axis=1)
+    if not independent:
+        # Cheap screen by the determinant, then the condition number for the suspects.
+        det = np.linalg.det(K)
+        ok = np.abs(det) > SINGULAR_RTOL * np.prod(np.linalg.norm(K, axis=2), axis=1)
+        suspect = np.flatnonzero(~ok)
+        if len(suspect):
+            ok[suspect] = np.linalg.cond(K[suspect]) < MAX_CONDITION
+        sol = np.zeros((len(form), 6))
+        sol[ok] = np.linalg.solve(K[ok], rhs[ok][..., None])[..., 0]
     if not np.all(ok):
         form, idx, size, source = form[ok], idx[ok], size[ok], source[ok]
-        Rs, Vs, K, rhs = Rs[ok], Vs[ok], K[ok], rhs[ok]
-    sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+        Rs, Vs, sol = Rs[ok], Vs[ok], sol[ok]
     w = sol[:, :5]
     mu = sol[:, 5]
     ro = np.einsum("ms,msk->mk", w, Rs)
@@ -177,14 +216,14 @@ def solve_candidates(frame: Frame, groups: dict[int, tuple[np.ndarray, np.ndarra
     return Solved(form, idx, size, w, mu, ro, vo, depth2, source)
 
 
-def height_ok(frame: Frame, solved: Solved) -> np.ndarray:
+def height_ok(frame: Frame, depth2: np.ndarray | Solved) -> np.ndarray:
     """FK paper eq. 15 and its side conditions: :math:`f(x) < 0` (a real depth) and
-    :math:`0 < z_o < z_r` (the object above the ground)."""
-    d2 = solved.depth2
-    return (d2 > TAUT_TOL) & (np.sqrt(np.maximum(d2, 0.0)) < frame.z)
+    :math:`0 < z_o < z_r` (the object above the ground). ``depth2`` normalised (M,)."""
+    d2 = depth2.depth2 if isinstance(depth2, Solved) else depth2
+    return (d2 > TAUT_TOL) & (d2 < frame.z * frame.z)
 
 
-def taut_masks(frame: Frame, solved: Solved, chunk: int = 1 << 22) -> tuple[np.ndarray, np.ndarray]:
+def taut_masks(frame: Frame, solved: Solved, chunk: int = 1 << 24) -> tuple[np.ndarray, np.ndarray]:
     """Maximiser sets of the pieces at each solution.
 
     Returns
@@ -196,18 +235,30 @@ def taut_masks(frame: Frame, solved: Solved, chunk: int = 1 << 22) -> tuple[np.n
         Cables whose :math:`g_j` is within ``TAUT_TOL`` of the maximum (the exact taut set).
     """
     M = len(solved.form)
-    N = frame.R.shape[1]
+    B, N = frame.b.shape
     ok = np.zeros(M, dtype=bool)
     taut = np.zeros((M, N), dtype=bool)
-    step = max(1, chunk // max(N, 1))
-    for start in range(0, M, step):
-        sl = slice(start, min(M, start + step))
-        f = solved.form[sl]
-        g = (-2.0 * np.einsum("mnk,mk->mn", frame.R[f], solved.ro[sl])
-             + 2.0 * (solved.vo[sl] @ frame.V.T) + frame.b[f])
-        excess = g - solved.mu[sl, None]
-        ok[sl] = excess.max(axis=1) <= TAUT_TOL
-        taut[sl] = excess >= -TAUT_TOL
+    x = np.hstack([solved.ro, solved.vo])
+    if B > 1 and 4 * M * N <= chunk:
+        # Many small formations: gather each candidate's lifted points (one pass).
+        excess = (np.einsum("mnk,mk->mn", frame.P[solved.form, :, :4], x)
+                  + frame.b[solved.form] - solved.mu[:, None])
+        return excess.max(axis=1, initial=-np.inf) <= TAUT_TOL, excess >= -TAUT_TOL
+    if B == 1:
+        groups = [np.arange(M)]
+    else:
+        order = np.argsort(solved.form, kind="stable")
+        groups = np.split(order, np.flatnonzero(np.diff(solved.form[order])) + 1)
+    step = max(1, chunk // (8 * N))
+    for rows in groups:
+        if len(rows) == 0:
+            continue
+        Pf = frame.P[solved.form[rows[0]]]
+        for start in range(0, len(rows), step):
+            r = rows[start:start + step]
+            excess = x[r] @ Pf[:, :4].T + (Pf[:, 4] - solved.mu[r, None])
+            ok[r] = excess.max(axis=1, initial=-np.inf) <= TAUT_TOL
+            taut[r] = excess >= -TAUT_TOL
     return ok, taut
 
 
@@ -236,15 +287,24 @@ def reduced_hessian_min_eig(frame: Frame, form: np.ndarray, idx: np.ndarray) -> 
     """Smallest eigenvalue of the Hessian of ``q`` restricted to the face's tangent space.
 
     The tangent space is the null space of the differences :math:`\\mathbf{a}_i -
-    \\mathbf{a}_{i_1}` over the affinely independent set ``idx`` (M, s). For ``s = 5`` the
-    face is a vertex of the arrangement and the result is ``+inf`` (DESIGN.md Sec. 5).
+    \\mathbf{a}_{i_1}` over each affinely independent set ``idx`` (M, 5), padded with -1
+    (2..5 members). With 5 members the face is a vertex of the arrangement and the
+    result is ``+inf`` (DESIGN.md Sec. 5). The Hessian is scaled to ``diag(1,1,-1,-1)``.
     """
-    M, s = idx.shape
-    if s >= 5 or M == 0:
-        return np.full(M, np.inf)
-    A = frame.P[form[:, None], idx, :4]                  # (M, s, 4)
-    D = A[:, 1:, :] - A[:, :1, :]
-    _, _, vt = np.linalg.svd(D, full_matrices=True)
-    Z = vt[:, s - 1:, :]                                  # (M, 5-s, 4) orthonormal rows
-    Hr = np.einsum("mik,k,mjk->mij", Z, _H, Z)
-    return np.linalg.eigvalsh(Hr)[:, 0]
+    M = len(form)
+    out = np.full(M, np.inf)
+    size = (idx >= 0).sum(axis=1)
+    rows = np.flatnonzero(size < 5)
+    if len(rows) == 0:
+        return out
+    idx, size = idx[rows], size[rows]
+    A = frame.P[form[rows, None], np.maximum(idx, 0), :4]          # (m, 5, 4)
+    D = (A[:, 1:, :] - A[:, :1, :]) * (idx[:, 1:, None] >= 0)      # unused rows -> 0
+    _, _, vt = np.linalg.svd(D, full_matrices=True)                 # null space: last rows
+    # Restrict the Hessian to the last (5 - size) right singular vectors.
+    Hr = np.einsum("mik,k,mjk->mij", vt, _H, vt)                   # (m, 4, 4)
+    for s in np.unique(size):
+        sel = size == s
+        k = int(s) - 1
+        out[rows[sel]] = np.linalg.eigvalsh(Hr[sel][:, k:, k:])[:, 0]
+    return out

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ._candidates import combo_table
-from ._kernel import Frame, Solved, height_ok, solve_candidates, taut_masks
+from ._kernel import Frame, Solved, height_ok, pad_groups, solve_candidates, taut_masks
 from .results import Funnel
 
 #: Refuse exhaustive searches larger than this many taut-set combinations.
@@ -81,7 +81,7 @@ def exhaustive_search(frame: Frame) -> tuple[Solved, np.ndarray, dict[str, int]]
             rows = np.hstack([np.zeros((len(own), 1), np.intp),
                               1 + np.nonzero(take[own])[1].reshape(len(own), s - 1)])
             subsets = np.take_along_axis(combos[own], rows, axis=1)
-            sv = solve_candidates(frame, {int(s): (np.zeros(len(own), np.intp), subsets)})
+            sv = solve_candidates(frame, *pad_groups({int(s): (np.zeros(len(own), np.intp), subsets)}))
             own = own[sv.source]
             ok, taut = taut_masks(frame, sv)
             want = np.zeros((len(own), N), dtype=bool)

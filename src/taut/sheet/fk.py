@@ -27,9 +27,10 @@ import numpy as np
 
 from .._validate import as_array, as_positive
 from ..errors import InvalidInputError
-from ._candidates import all_small_subsets, hull_subsets
+from ._candidates import Stationary, all_small_subsets, hull_candidates
 from ._finalize import Classified, classify
-from ._kernel import STATUS_NAMES, Frame, height_ok, solve_candidates, taut_masks
+from ._kernel import (STATUS_NAMES, Frame, Solved, height_ok, in_hull_2d, pad_groups,
+                      solve_candidates, taut_masks)
 from .exhaustive import exhaustive_search, funnel_from
 from .model import Sheet, check_formation, check_formations, check_hold_height
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult
@@ -62,17 +63,33 @@ def _check_mass(mass: float | None) -> float | None:
     return None if mass is None else as_positive(mass, "mass")
 
 
-def _candidates(frame: Frame, sheet: Sheet, method: str):
+def _candidates(frame: Frame, sheet: Sheet, method: str
+                ) -> tuple[dict[int, tuple[np.ndarray, np.ndarray]], bool, Stationary | None]:
+    """Candidate taut sets of every formation: groups for the Lagrange solver (with its
+    ``independent`` flag) and hull-derived stationary points (generic formations)."""
     B, N = frame.b.shape
     pairs = sheet.has_collinear_vertices
     if method == "subsets" or N <= SMALL_TEAM:
-        return all_small_subsets(N, B, pairs)
+        return all_small_subsets(N, B, pairs), False, None
     per_size: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
+    independent = True
+    stationary: list[Stationary] = []
     for b in range(B):
-        for s, idx in hull_subsets(frame.P[b], pairs).items():
+        hc = hull_candidates(frame.P[b], pairs)
+        if hc.stationary is not None:
+            hc.stationary.form[:] = b
+            stationary.append(hc.stationary)
+        if hc.subsets:
+            independent &= hc.independent
+        for s, idx in hc.subsets.items():
             per_size.setdefault(s, []).append((np.full(len(idx), b, dtype=np.intp), idx))
-    return {s: (np.concatenate([f for f, _ in parts]), np.vstack([i for _, i in parts]))
-            for s, parts in per_size.items()}
+    groups = {s: (np.concatenate([f for f, _ in parts]), np.vstack([i for _, i in parts]))
+              for s, parts in per_size.items()}
+    merged = None
+    if stationary:
+        merged = Stationary(*(np.concatenate([getattr(p, f) for p in stationary])
+                              for f in ("form", "subset", "size", "x", "mu", "depth2")))
+    return groups, independent, merged
 
 
 def _solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
@@ -81,11 +98,37 @@ def _solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
     if method == "exhaustive":
         solved, taut, counts = exhaustive_search(frame)
         return frame, classify(frame, solved, taut), counts
-    solved = solve_candidates(frame, _candidates(frame, sheet, method))
-    solved = solved.take(height_ok(frame, solved))
-    ok, taut = taut_masks(frame, solved)
-    solved = solved.take(ok)
-    return frame, classify(frame, solved, taut[ok]), None
+    groups, independent, stationary = _candidates(frame, sheet, method)
+    parts: list[Solved] = []
+    tauts: list[np.ndarray] = []
+    checked: list[np.ndarray] = []
+    if groups:
+        solved = solve_candidates(frame, *pad_groups(groups), independent=independent)
+        solved = solved.take(height_ok(frame, solved))
+        ok, taut = taut_masks(frame, solved)
+        parts.append(solved.take(ok))
+        tauts.append(taut[ok])
+        checked.append(np.zeros(int(ok.sum()), dtype=bool))
+    if stationary is not None:
+        # Points already known: filter first, then solve only the survivors for weights.
+        # Generic hull: a face's exact taut set is its own vertex set, so the paper's
+        # projection test can run before the (costlier) maximiser scan.
+        st = stationary
+        valid = st.subset >= 0
+        keep = height_ok(frame, st.depth2)
+        keep[keep] = in_hull_2d(frame.R[st.form[keep, None], np.maximum(st.subset[keep], 0)],
+                                valid[keep], st.x[keep, :2])
+        pre = Solved(st.form[keep], st.subset[keep], st.size[keep], st.x[keep, :0],
+                     st.mu[keep], st.x[keep, :2], st.x[keep, 2:], st.depth2[keep], keep)
+        ok, taut = taut_masks(frame, pre)
+        sv = solve_candidates(frame, pre.form[ok], pre.subset[ok])
+        parts.append(sv)
+        tauts.append(taut[ok][sv.source])
+        checked.append(tauts[-1].sum(axis=1) == sv.size)
+    N = frame.R.shape[1]
+    solved = Solved.concat(parts)
+    taut = np.vstack(tauts) if tauts else np.zeros((0, N), dtype=bool)
+    return frame, classify(frame, solved, taut, np.concatenate(checked) if checked else None), None
 
 
 def _user_units(frame: Frame, sheet: Sheet, c: Classified, hold_height: float,
@@ -152,17 +195,14 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
     R = check_formation(sheet, formation)
     frame, c, counts = _solve(sheet, R[None], z, method)
     obj, vo, lengths, tensions = _user_units(frame, sheet, c, z, mass)
-    eqs = []
-    for k in range(len(c.form)):
-        idx = np.flatnonzero(c.taut[k])
-        eqs.append(Equilibrium(
-            taut=tuple(int(i) for i in idx),
-            object=obj[k], contact=vo[k],
-            weights=c.weights[k, idx],
-            tensions=None if tensions is None else tensions[k, idx],
-            cable_lengths=lengths[k, idx],
-            status=STATUS_NAMES[int(c.status[k])],  # type: ignore[arg-type]
-        ))
+    rows, cols = np.nonzero(c.taut)
+    cuts = np.searchsorted(rows, np.arange(1, len(c.form)))
+    w = np.split(c.weights[rows, cols], cuts)
+    ln = np.split(lengths[rows, cols], cuts)
+    tn = np.split(tensions[rows, cols], cuts) if tensions is not None else [None] * len(w)
+    eqs = [Equilibrium(tuple(idx.tolist()), obj[k], vo[k], w[k], tn[k], ln[k],
+                       STATUS_NAMES[st])  # type: ignore[arg-type]
+           for k, (idx, st) in enumerate(zip(np.split(cols, cuts), c.status.tolist()))]
     funnel = funnel_from(counts, len(eqs)) if counts is not None else None
     return FKResult(tuple(eqs), funnel, method, sheet, R, z, mass)
 

@@ -1,0 +1,97 @@
+"""Scenario files for sheet-carrying teams (YAML or JSON).
+
+Keys: ``hold_height`` (required, > 0), ``sheet`` (required, list of [x, y] vertices in robot
+order), ``formation`` (list of [x, y] robot positions; required by ``taut fk``), and the
+optional ``units`` (a label only), ``mass`` (kg, > 0) and ``name``. Unknown keys are errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from ..errors import ScenarioError, TautError
+from ..sheet.model import Sheet, check_formation, check_hold_height
+from .files import read_mapping, validate_mapping
+
+__all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"]
+
+Point = tuple[float, float]
+
+
+class _SheetScenarioFile(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=False)
+
+    name: str | None = None
+    units: str | None = None
+    hold_height: float = Field(allow_inf_nan=False)
+    mass: float | None = Field(default=None, allow_inf_nan=False)
+    sheet: list[Point]
+    formation: list[Point] | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class SheetScenario:
+    """A validated sheet scenario.
+
+    Attributes
+    ----------
+    sheet : Sheet
+    hold_height : float
+        :math:`z_r`, in ``units``.
+    formation : ndarray, shape (N, 2), or None
+    mass : float or None
+        Object mass, kg.
+    units : str or None
+        Length unit label (not interpreted).
+    name : str or None
+    """
+
+    sheet: Sheet
+    hold_height: float
+    formation: np.ndarray | None
+    mass: float | None
+    units: str | None
+    name: str | None
+
+
+def _rename(exc: TautError, field: str) -> ScenarioError:
+    tail = exc.field.split("[", 1)[1] if "[" in exc.field else None
+    return ScenarioError(f"{field}[{tail}" if tail else field, exc.problem)
+
+
+def sheet_scenario_from_mapping(data: dict) -> SheetScenario:
+    """Validate an already-parsed mapping (see module docstring for the keys)."""
+    raw = validate_mapping(_SheetScenarioFile, data)
+    try:
+        sheet = Sheet(np.array(raw.sheet, dtype=float))
+    except TautError as exc:
+        raise _rename(exc, "sheet") from None
+    try:
+        hold = check_hold_height(raw.hold_height)
+    except TautError as exc:
+        raise ScenarioError("hold_height", exc.problem) from None
+    if raw.mass is not None and not raw.mass > 0:
+        raise ScenarioError("mass", f"must be positive, got {raw.mass:g}")
+    formation = None
+    if raw.formation is not None:
+        try:
+            formation = check_formation(sheet, np.array(raw.formation, dtype=float))
+        except TautError as exc:
+            raise ScenarioError("formation", exc.problem) from None
+    return SheetScenario(sheet, hold, formation, raw.mass, raw.units, raw.name)
+
+
+def load_sheet_scenario(path: str | Path) -> SheetScenario:
+    """Read and validate a sheet scenario file.
+
+    Raises
+    ------
+    ScenarioError
+        Missing file, syntax error, unknown or missing keys, wrong types, an invalid
+        sheet, non-positive hold height or mass, an infeasible formation.
+    """
+    return sheet_scenario_from_mapping(read_mapping(path))

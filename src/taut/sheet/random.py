@@ -1,0 +1,54 @@
+"""Random feasible teams, for tests, benchmarks and sweeps (seeded, reproducible)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InvalidInputError
+from .model import Sheet
+
+__all__ = ["random_convex_polygon", "random_team"]
+
+
+def random_convex_polygon(n: int, rng: np.random.Generator, *, radius: float = 1.0
+                          ) -> np.ndarray:
+    """``n`` points in convex position, counter-clockwise, shape (n, 2).
+
+    Vertices on a random ellipse (semi-axes in ``[0.6, 1.0] * radius``, random tilt) at
+    jittered, evenly spread angles, so no two vertices nearly coincide.
+    """
+    if n < 3:
+        raise InvalidInputError("n", f"must be at least 3, got {n}")
+    base = 2 * np.pi * np.arange(n) / n
+    t = base + rng.uniform(-0.35, 0.35, n) * (2 * np.pi / n) + rng.uniform(0, 2 * np.pi)
+    a, b = radius * rng.uniform(0.6, 1.0, 2)
+    tilt = rng.uniform(0, np.pi)
+    c, s = np.cos(tilt), np.sin(tilt)
+    pts = np.column_stack([a * np.cos(t), b * np.sin(t)])
+    return pts @ np.array([[c, s], [-s, c]])
+
+
+def random_team(n: int, rng: np.random.Generator, *, slack: tuple[float, float] = (0.55, 0.95)
+                ) -> tuple[Sheet, np.ndarray]:
+    """A random sheet and a random feasible formation for it.
+
+    The formation is an independent random convex polygon (robot ``i`` near the
+    direction of vertex ``i``), scaled so that every pair of robots is closer than
+    its sheet vertices by a random factor in ``slack`` (FK paper's FormationFeasible),
+    then moved by a random offset. Generic: lifted points in general position.
+
+    Returns
+    -------
+    sheet : Sheet
+    formation : ndarray, shape (n, 2)
+    """
+    V = random_convex_polygon(n, rng)
+    R = random_convex_polygon(n, rng)
+    # Keep robot i roughly "behind" vertex i: rotate R's first vertex onto V's.
+    ang = np.arctan2(V[0, 1], V[0, 0]) - np.arctan2(R[0, 1], R[0, 0])
+    c, s = np.cos(ang), np.sin(ang)
+    R = R @ np.array([[c, s], [-s, c]])
+    iu, ju = np.triu_indices(n, 1)
+    ratio = np.linalg.norm(V[iu] - V[ju], axis=1) / np.linalg.norm(R[iu] - R[ju], axis=1)
+    R = R * ratio.min() * rng.uniform(*slack) + rng.normal(scale=0.3, size=2)
+    return Sheet(V), R
