@@ -31,8 +31,9 @@ def as_array(value: Any, field: str, *, ndim: int | None = None,
     if shape is not None:
         for axis, want_len in enumerate(shape):
             if want_len is not None and arr.shape[axis] != want_len:
-                raise InvalidInputError(
-                    field, f"axis {axis} must have length {want_len}, got {arr.shape[axis]}")
+                want = "x".join("N" if s is None else str(s) for s in shape)
+                raise InvalidInputError(field, f"must have shape {want}, got shape "
+                                               f"{'x'.join(map(str, arr.shape))}")
     if not np.all(np.isfinite(arr)):
         raise InvalidInputError(field, "contains NaN or infinite values")
     return arr

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import sys
 
-import click
 import typer
+from typer.exceptions import TyperException
 
 from ..errors import TautError
 from . import cdpr, fk, motion
@@ -24,6 +24,15 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 
+
+
+@app.callback()
+def _root() -> None:
+    """Carrying loads with cables and mobile robots: sheet-carrying robot teams (VVCM) and
+    cable-driven parallel robots on mobile bases. Every input error prints one line
+    ``taut: error: <field>: <problem>`` and exits with code 2."""
+
+
 for _module in (fk, motion, cdpr):
     _module.register(app)
 
@@ -35,24 +44,41 @@ def _fail(message: str) -> int:
     return EXIT_USAGE
 
 
+def _usage_line(exc: Exception) -> str:
+    """One line for a command-line usage error (typer's click exceptions)."""
+    option = getattr(exc, "option_name", None)
+    if option:
+        return f"{option}: no such option"
+    param = getattr(exc, "param", None)
+    name = None
+    if param is not None:
+        opts = getattr(param, "opts", None) or []
+        name = opts[0] if opts and opts[0].startswith("-") else getattr(param, "name", None)
+    message = getattr(exc, "message", None) or str(exc)
+    if type(exc).__name__ == "MissingParameter":
+        message = "missing"
+    message = " ".join(message.split())
+    return f"{name}: {message}" if name else message
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the process exit code (0 success, 2 bad input)."""
     try:
         result = app(args=argv, prog_name="taut", standalone_mode=False)
     except TautError as exc:
         return _fail(str(exc))
-    except click.exceptions.NoSuchOption as exc:
-        return _fail(f"{exc.option_name}: no such option")
-    except click.exceptions.BadParameter as exc:
-        name = exc.param.name if exc.param is not None else "argument"
-        return _fail(f"{name}: {exc.message}")
-    except click.exceptions.MissingParameter as exc:
-        name = exc.param.name if exc.param is not None else "argument"
-        return _fail(f"{name}: missing")
-    except click.exceptions.UsageError as exc:
-        return _fail(exc.format_message().splitlines()[0])
-    except click.exceptions.Abort:
+    except typer.Abort:
         return _fail("aborted")
+    except typer.Exit as exc:
+        return int(getattr(exc, "exit_code", 0) or 0)
+    except TyperException as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":
+            try:
+                print(exc.format_message() if hasattr(exc, "format_message") else exc)
+            except BrokenPipeError:
+                pass
+            return 0
+        return _fail(_usage_line(exc))
     except BrokenPipeError:
         return 0
     return int(result) if isinstance(result, int) else 0

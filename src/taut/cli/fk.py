@@ -1,5 +1,94 @@
-"""`taut fk` (placeholder filled below)."""
+"""`taut fk`: every rest state of the object for the formation in a scenario file."""
+
+from __future__ import annotations
+
+import json
+from enum import Enum
+from pathlib import Path
+from typing import Optional
+
 import typer
 
+from .._validate import as_positive
+from ..errors import ScenarioError
+from ..io.serialize import fk_result_to_dict
+from ..io.sheet_scenario import load_sheet_scenario
+from ..sheet import forward_kinematics
+from ..sheet.results import FKResult
+
+
+class FKMethod(str, Enum):
+    fast = "fast"
+    exhaustive = "exhaustive"
+    subsets = "subsets"
+
+
+def _fmt(values, digits: int = 4) -> str:
+    return ", ".join(f"{v:.{digits}g}" for v in values)
+
+
+def format_table(result: FKResult, *, name: str | None, units: str | None) -> str:
+    """Plain-text report, robots numbered 1..N as in the papers."""
+    u = f" {units}" if units else ""
+    lines = []
+    if name:
+        lines.append(name)
+    lines.append(f"N = {result.sheet.n} robots, hold height {result.hold_height:g}{u}, "
+                 f"method {result.method}: {len(result.equilibria)} solution(s), "
+                 f"{len(result.stable)} stable")
+    rows = [("#", "taut", f"x_o", "y_o", "z_o", "contact (u, v)", "status", "weights",
+             "tensions [N]")]
+    for k, e in enumerate(result.equilibria, 1):
+        rows.append((str(k), "{" + ",".join(str(i + 1) for i in e.taut) + "}",
+                     f"{e.object[0]:.2f}", f"{e.object[1]:.2f}", f"{e.object[2]:.2f}",
+                     f"({e.contact[0]:.2f}, {e.contact[1]:.2f})", e.status,
+                     _fmt(e.weights, 3), "-" if e.tensions is None else _fmt(e.tensions, 4)))
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    right = {0, 2, 3, 4}
+    for r in rows:
+        lines.append("  ".join(cell.rjust(w) if c in right else cell.ljust(w)
+                               for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+    f = result.funnel
+    if f is not None:
+        lines.append(f"Algorithm 1 funnel: {f.combinations} taut sets tried, {f.form_closure} "
+                     f"form closure, {f.cqp_feasible} CQP feasible, {f.height_feasible} "
+                     f"height feasible, {f.force_closure} force closure")
+    return "\n".join(lines)
+
+
 def register(app: typer.Typer) -> None:
-    pass
+    """Add ``taut fk``."""
+
+    @app.command("fk")
+    def fk_command(
+        scenario: Path = typer.Argument(..., help="Scenario file (YAML or JSON) with "
+                                        "hold_height, sheet, formation, optional mass/units/name."),
+        as_json: bool = typer.Option(False, "--json", help="Print machine-readable JSON "
+                                     "(0-based taut indices) instead of a table."),
+        method: FKMethod = typer.Option(FKMethod.fast, "--method", help="fast: convex-hull "
+                                        "enumeration; exhaustive: the paper's Algorithm 1 "
+                                        "with its step counts; subsets: all sets of <= 5 cables."),
+        mass: Optional[float] = typer.Option(None, "--mass", help="Object mass in kg "
+                                             "(overrides the scenario's); gives tensions in N."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a 3D figure of every "
+                                            "equilibrium to this file (.png, .pdf, .svg)."),
+    ) -> None:
+        """Forward kinematics: every place the object can rest, which are stable, and
+        each robot's cable tension."""
+        sc = load_sheet_scenario(scenario)
+        if sc.formation is None:
+            raise ScenarioError("formation", "required key is missing (taut fk needs the "
+                                "robots' positions)")
+        m = as_positive(mass, "--mass") if mass is not None else sc.mass
+        result = forward_kinematics(sc.sheet, sc.formation, sc.hold_height, mass=m,
+                                    method=method.value)
+        if as_json:
+            typer.echo(json.dumps(fk_result_to_dict(result), indent=2))
+        else:
+            typer.echo(format_table(result, name=sc.name, units=sc.units))
+        if plot is not None:
+            from ..viz.sheet import plot_fk
+
+            plot_fk(result, plot, units=sc.units, title=sc.name)
+            if not as_json:
+                typer.echo(f"figure written to {plot}")
