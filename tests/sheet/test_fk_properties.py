@@ -6,14 +6,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from taut.sheet import Sheet, forward_kinematics, forward_kinematics_batch
-from taut.sheet.random import random_team
+from taut.sheet.random import random_scattered_team, random_team
 
 SETTINGS = settings(max_examples=40, deadline=None)
 
 
 def team(seed, n, hold=None):
+    """Random feasible team; odd seeds scatter the robots (not in convex position)."""
     rng = np.random.default_rng(seed)
-    sheet, formation = random_team(n, rng)
+    sheet, formation = (random_scattered_team if seed % 2 else random_team)(n, rng)
     hold = rng.uniform(0.4, 1.5) if hold is None else hold
     return sheet, formation, hold
 

@@ -1,9 +1,153 @@
-"""`taut` subcommands for this family (filled in by its issue's work)."""
+"""`taut ik` (where must the robots stand?) and `taut simulate` (what does the object do
+while they move?)."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+from typing import Any, Optional, Tuple
+
+import numpy as np
 import typer
+
+from .._validate import as_positive
+from ..errors import InvalidInputError
+from ..io.sheet_scenario import load_sheet_scenario
+from ..io.trajectory import load_trajectory
+from ..sheet.ik import IKResult, inverse_kinematics
+from ..sheet.simulate import SimulationResult, simulate
+
+
+def _floats(a: Any) -> list[float] | None:
+    return None if a is None else [float(x) for x in np.asarray(a).ravel()]
+
+
+def ik_to_dict(r: IKResult) -> dict[str, Any]:
+    """JSON form of an IK result (robots in order, 0-based lists)."""
+    return {
+        "formation": [_floats(p) for p in r.formation],
+        "object": _floats(r.object),
+        "contact": _floats(r.contact),
+        "angles": _floats(r.angles),
+        "weights": _floats(r.weights),
+        "tensions": _floats(r.tensions),
+        "cable_lengths": _floats(r.cable_lengths),
+        "curvature": None if not np.isfinite(r.curvature) else float(r.curvature),
+        "spacing": float(r.spacing),
+        "construction": r.construction,
+    }
+
+
+def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
+    """JSON form of a simulation (NaN -> null; taut sets 0-based)."""
+    def clean(a: np.ndarray) -> list:
+        return [[None if not np.isfinite(v) else float(v) for v in row] for row in a]
+
+    return {
+        "time": _floats(time),
+        "object": clean(r.object),
+        "contact": clean(r.contact),
+        "taut": [list(s) for s in r.taut],
+        "tensions": None if r.tensions is None else clean(r.tensions),
+        "events": [{
+            "step": e.step, "fraction": e.fraction, "kind": e.kind,
+            "taut_before": list(e.taut_before), "taut_after": list(e.taut_after),
+            "object_before": clean(e.object_before[None])[0],
+            "object_after": clean(e.object_after[None])[0],
+            "drop": None if not np.isfinite(e.drop) else e.drop,
+        } for e in r.events],
+    }
+
+
+def _ik_table(r: IKResult, units: str | None) -> str:
+    u = f" {units}" if units else ""
+    p = r.object
+    lines = [f"object at ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}){u}, contact "
+             f"({r.contact[0]:.4g}, {r.contact[1]:.4g}); all {len(r.weights)} cables taut, "
+             f"stable ({r.construction})",
+             f"{'robot':>5}  {'x':>10}  {'y':>10}  {'angle[deg]':>10}  {'weight':>7}"
+             + ("  tension[N]" if r.tensions is not None else "")]
+    for i, (xy, th, w) in enumerate(zip(r.formation, r.angles, r.weights), 1):
+        row = f"{i:>5}  {xy[0]:>10.4f}  {xy[1]:>10.4f}  {np.degrees(th):>10.2f}  {w:>7.4f}"
+        if r.tensions is not None:
+            row += f"  {r.tensions[i - 1]:>10.4g}"
+        lines.append(row)
+    return "\n".join(lines)
+
+
+def _sim_table(r: SimulationResult, time: np.ndarray, units: str | None) -> str:
+    u = f" {units}" if units else ""
+    z = r.object[:, 2]
+    lines = [f"{len(r)} steps, {len(r.events)} event(s), {len(r.jumps)} jump(s); object "
+             f"height {np.nanmin(z):.4g}..{np.nanmax(z):.4g}{u}"]
+    for e in r.events:
+        k = min(e.step, len(time) - 1)
+        tk = time[k - 1] + e.fraction * (time[k] - time[k - 1]) if k else time[0]
+        before = "{" + ",".join(str(i + 1) for i in e.taut_before) + "}"
+        after = "{" + ",".join(str(i + 1) for i in e.taut_after) + "}"
+        extra = f", drop {e.drop:.4g}{u}" if e.kind == "jump" else ""
+        lines.append(f"  step {e.step} (t = {tk:.4g}): {e.kind.replace('_', ' ')} "
+                     f"{before} -> {after}{extra}")
+    last = r.object[-1]
+    lines.append(f"final object position ({last[0]:.4g}, {last[1]:.4g}, {last[2]:.4g}){u}")
+    return "\n".join(lines)
 
 
 def register(app: typer.Typer) -> None:
-    """Add this module's subcommands to the `taut` app."""
+    """Add ``taut ik`` and ``taut simulate``."""
+
+    @app.command("ik")
+    def ik_command(
+        scenario: Path = typer.Argument(..., help="Scenario file (YAML or JSON) with "
+                                        "hold_height and sheet (a formation is ignored)."),
+        object_position: Tuple[float, float, float] = typer.Option(
+            ..., "--object", help="Target object position X Y Z (scenario units)."),
+        contact: Optional[Tuple[float, float]] = typer.Option(
+            None, "--contact", help="Contact point U V on the sheet (sheet frame); default "
+            "the sheet's area centroid."),
+        heading: float = typer.Option(0.0, "--heading", help="Formation heading in "
+                                      "degrees (turn about the vertical)."),
+        mass: Optional[float] = typer.Option(None, "--mass", help="Object mass in kg "
+                                             "(overrides the scenario's); gives tensions."),
+        as_json: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
+    ) -> None:
+        """Inverse kinematics: where the robots must stand so that the object rests
+        stably at the target with every cable taut."""
+        sc = load_sheet_scenario(scenario)
+        m = as_positive(mass, "--mass") if mass is not None else sc.mass
+        r = inverse_kinematics(sc.sheet, object_position, sc.hold_height,
+                               contact=contact, heading=np.radians(heading), mass=m)
+        if as_json:
+            typer.echo(json.dumps(ik_to_dict(r), indent=2))
+        else:
+            typer.echo(_ik_table(r, sc.units))
+
+    @app.command("simulate")
+    def simulate_command(
+        scenario: Path = typer.Argument(..., help="Scenario file with hold_height and sheet."),
+        trajectory: Path = typer.Option(..., "--trajectory", help="CSV: time, then x, y of "
+                                        "each robot, one row per step."),
+        mass: Optional[float] = typer.Option(None, "--mass", help="Object mass in kg "
+                                             "(overrides the scenario's); gives tensions."),
+        as_json: bool = typer.Option(False, "--json", help="Print JSON instead of a summary."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a figure (object "
+                                            "height with events; top view of all paths)."),
+    ) -> None:
+        """Quasi-static simulation of the object while the robots follow a trajectory."""
+        sc = load_sheet_scenario(scenario)
+        traj = load_trajectory(trajectory)
+        if traj.n_robots != sc.sheet.n:
+            raise InvalidInputError(str(trajectory), f"has {traj.n_robots} robots but the "
+                                    f"sheet has {sc.sheet.n} vertices")
+        m = as_positive(mass, "--mass") if mass is not None else sc.mass
+        r = simulate(sc.sheet, traj.formations, sc.hold_height, mass=m)
+        if as_json:
+            typer.echo(json.dumps(simulation_to_dict(r, traj.time)))
+        else:
+            typer.echo(_sim_table(r, traj.time, sc.units))
+        if plot is not None:
+            from ..viz.motion import plot_simulation
+
+            plot_simulation(r, plot, time=traj.time, units=sc.units, title=sc.name)
+            if not as_json:
+                typer.echo(f"figure written to {plot}")

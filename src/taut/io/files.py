@@ -12,9 +12,21 @@ from pydantic import BaseModel, ValidationError
 
 from ..errors import ScenarioError
 
-__all__ = ["read_mapping", "validate_mapping", "write_json"]
+__all__ = ["read_text", "read_mapping", "validate_mapping", "write_json"]
 
 M = TypeVar("M", bound=BaseModel)
+
+
+def read_text(path: str | Path) -> str:
+    """The UTF-8 text of a file; a missing or unreadable file is a :class:`ScenarioError`
+    naming the path."""
+    p = Path(path)
+    if not p.is_file():
+        raise ScenarioError(str(path), "file not found")
+    try:
+        return p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(str(path), f"cannot read file ({exc.__class__.__name__})") from None
 
 
 def read_mapping(path: str | Path) -> dict[str, Any]:
@@ -26,12 +38,7 @@ def read_mapping(path: str | Path) -> dict[str, Any]:
         Missing or unreadable file, a syntax error, or a top level that is not a mapping.
     """
     p = Path(path)
-    if not p.is_file():
-        raise ScenarioError(str(path), "file not found")
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(str(path), f"cannot read file ({exc.__class__.__name__})") from None
+    text = read_text(p)
     try:
         if p.suffix.lower() == ".json":
             data = json.loads(text)

@@ -1,12 +1,24 @@
 """Robot teams holding a deformable sheet that carries an object (virtual variable cables
-model, VVCM): models, forward kinematics."""
+model, VVCM): model, forward and inverse kinematics, quasi-static simulation, formation
+geometry."""
 
 from .fk import METHODS, forward_kinematics, forward_kinematics_batch
+from .geometry import (FormationMetrics, formation_metrics, formation_size,
+                       max_obstacle_diameter, max_obstacle_height, min_robot_distance,
+                       minimum_enclosing_circle)
+from .ik import (IKConstraints, IKResult, contact_weights, formation_from_angles,
+                 ik_constraints, inverse_kinematics)
 from .model import Sheet, check_formation, check_formations
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult, Funnel
+from .simulate import SimulationEvent, SimulationResult, simulate
 
 __all__ = [
     "Sheet", "check_formation", "check_formations",
     "forward_kinematics", "forward_kinematics_batch", "METHODS",
     "FKResult", "BatchFKResult", "Equilibrium", "Funnel", "GRAVITY",
+    "inverse_kinematics", "IKResult", "IKConstraints", "formation_from_angles",
+    "ik_constraints", "contact_weights",
+    "simulate", "SimulationResult", "SimulationEvent",
+    "formation_metrics", "FormationMetrics", "minimum_enclosing_circle", "formation_size",
+    "max_obstacle_height", "min_robot_distance", "max_obstacle_diameter",
 ]

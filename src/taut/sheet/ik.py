@@ -517,7 +517,9 @@ def _polish(V: np.ndarray, rho: np.ndarray, w: np.ndarray, th: np.ndarray
     return th, w
 
 
-def _check_solution(V, rho, w, th, need_curv):
+def _check_solution(V: np.ndarray, rho: np.ndarray, w: np.ndarray, th: np.ndarray):
+    """Exact checks of a candidate (normalised units): ok, robots, spacing, curvature,
+    balance residual."""
     R = rho[:, None] * np.column_stack([np.cos(th), np.sin(th)])
     N = len(rho)
     iu, ju = np.triu_indices(N, 1)
@@ -592,13 +594,14 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
         phi = np.where(far, np.arctan2(ref_n[:, 1], ref_n[:, 0]), np.arctan2(V[:, 1], V[:, 0]))
     pvec = np.column_stack([np.cos(phi), np.sin(phi)])
     a = w * rho
-    best = None
+    best = closure = None
     u = _closure_directions(a, pvec) if a.max() < a.sum() - a.max() else None
     if u is not None:
         th = np.arctan2(u[:, 1], u[:, 0])
-        ok, *_ = _check_solution(V, rho, w, th, need_curv)
-        if ok and ref is None:
-            best = (th, w, "closure")
+        ok, *_ = _check_solution(V, rho, w, th)
+        if ok:
+            closure = (th, w, "closure")
+            best = closure if ref is None else None
     if best is None:
         th0 = np.arctan2(u[:, 1], u[:, 0]) if u is not None else phi.copy()
         starts = [th0]
@@ -608,16 +611,22 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
             out = _joint_optimise(V, rho, phi, w, th_start, ref_n, need_curv)
             if out is None:
                 continue
-            ok, *_ = _check_solution(V, rho, out[1], out[0], need_curv)
+            ok, *_ = _check_solution(V, rho, out[1], out[0])
             if ok:
                 best = (out[0], out[1], "optimised")
                 break
+    if ref_n is not None and closure is not None:
+        def motion(th: np.ndarray) -> float:
+            return float(np.sum((rho[:, None] * np.column_stack(
+                [np.cos(th), np.sin(th)]) - ref_n) ** 2))
+        if best is None or motion(closure[0]) < motion(best[0]):
+            best = closure
     if best is None:
-        why = _diagnose(V, rho, w, a, u, need_curv)
+        why = _diagnose(V, rho, w, a, u)
         raise UnreachableTargetError("object_position", f"no stable all-taut formation "
                                      f"found for this target and contact: {why}")
     th, w, how = best
-    ok, R, spacing, curv, _ = _check_solution(V, rho, w, th, need_curv)
+    ok, R, spacing, curv, _ = _check_solution(V, rho, w, th)
     formation = p[:2] + R * s
     tensions = None if mass is None else w * mass * GRAVITY * lengths / d
     formation.setflags(write=False)
@@ -625,15 +634,14 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
                     spacing * s, how)
 
 
-def _diagnose(V, rho, w, a, u, need_curv) -> str:
+def _diagnose(V, rho, w, a, u) -> str:
     if len(rho) == 3 and not a.max() < a.sum() - a.max():
         i = int(np.argmax(a))
         return (f"cable {i + 1} would pull sideways harder than the other two together "
                 "(horizontal forces cannot balance)")
     if u is None:
         return "the horizontal cable forces cannot be balanced"
-    ok, R, spacing, curv, _ = _check_solution(V, rho, w, np.arctan2(u[:, 1], u[:, 0]),
-                                              need_curv)
+    ok, R, spacing, curv, _ = _check_solution(V, rho, w, np.arctan2(u[:, 1], u[:, 0]))
     if spacing < SPACING_MARGIN:
         return "the balanced robots would stand farther apart than the sheet allows"
     if curv < MIN_CURVATURE:

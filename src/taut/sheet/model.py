@@ -170,16 +170,27 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
     limit = sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
     n = sheet.n
     iu, ju = np.triu_indices(n, 1)
-    dr = np.linalg.norm(r[:, iu, :] - r[:, ju, :], axis=2)
-    bad = dr > limit[iu, ju]
-    if np.any(bad):
+    lim2 = limit[iu, ju] ** 2
+    # Chunks keep the (chunk, pairs, 2) temporaries small (fresh large arrays are slow).
+    step = max(1, (1 << 18) // max(len(iu), 1))
+    bad = None
+    for start in range(0, r.shape[0], step):
+        chunk = r[start:start + step]
+        diff = chunk[:, iu, :] - chunk[:, ju, :]
+        d2 = np.einsum("bpk,bpk->bp", diff, diff)
+        if np.any(d2 > lim2):
+            bad = d2 > lim2
+            break
+    if bad is not None:
         b, p = np.argwhere(bad)[0]
         i, j = int(iu[p]), int(ju[p])
+        dr = np.sqrt(d2)
+        b += start
         step = int(b) if r.shape[0] > 1 else None
         where = f" at step {step}" if step is not None else ""
         raise InfeasibleFormationError(
             field,
-            f"robots {i + 1} and {j + 1} are {dr[b, p]:.6g} apart{where} but their sheet "
+            f"robots {i + 1} and {j + 1} are {dr[b - start, p]:.6g} apart{where} but their sheet "
             f"vertices only {limit[i, j] / (1 + GEOMETRY_RTOL):.6g} (the sheet would tear)",
             pair=(i, j), step=step)
     return r

@@ -7,7 +7,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from .model import Sheet
 
-__all__ = ["random_convex_polygon", "random_team"]
+__all__ = ["random_convex_polygon", "random_team", "random_scattered_team"]
 
 
 def random_convex_polygon(n: int, rng: np.random.Generator, *, radius: float = 1.0
@@ -48,6 +48,25 @@ def random_team(n: int, rng: np.random.Generator, *, slack: tuple[float, float] 
     ang = np.arctan2(V[0, 1], V[0, 0]) - np.arctan2(R[0, 1], R[0, 0])
     c, s = np.cos(ang), np.sin(ang)
     R = R @ np.array([[c, s], [-s, c]])
+    iu, ju = np.triu_indices(n, 1)
+    ratio = np.linalg.norm(V[iu] - V[ju], axis=1) / np.linalg.norm(R[iu] - R[ju], axis=1)
+    R = R * ratio.min() * rng.uniform(*slack) + rng.normal(scale=0.3, size=2)
+    return Sheet(V), R
+
+
+def random_scattered_team(n: int, rng: np.random.Generator,
+                          *, slack: tuple[float, float] = (0.55, 0.95)
+                          ) -> tuple[Sheet, np.ndarray]:
+    """A random sheet and robots scattered anywhere (not in convex position, in any order),
+    scaled to be feasible: the harder, less regular case for FK algorithms.
+
+    Returns
+    -------
+    sheet : Sheet
+    formation : ndarray, shape (n, 2)
+    """
+    V = random_convex_polygon(n, rng)
+    R = rng.normal(size=(n, 2))
     iu, ju = np.triu_indices(n, 1)
     ratio = np.linalg.norm(V[iu] - V[ju], axis=1) / np.linalg.norm(R[iu] - R[ju], axis=1)
     R = R * ratio.min() * rng.uniform(*slack) + rng.normal(scale=0.3, size=2)
