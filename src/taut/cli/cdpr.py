@@ -1,9 +1,290 @@
-"""`taut` subcommands for this family (filled in by its issue's work)."""
+"""`taut cdpr ...`: statics of cable-driven parallel robots on fixed frames and mobile bases
+(FASTKIT paper, §4): tension distribution, available wrench set, wrench-feasible workspace.
+
+MODEL is a preset name (``fastkit``, ``ipanema``) or a YAML/JSON model file. Poses are given
+as ``--pose X Y Z`` (m) and optionally ``--rpy ROLL PITCH YAW`` (rad).
+"""
 
 from __future__ import annotations
 
+import json
+import sys
+from enum import Enum
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
 import typer
+
+from ..cdpr import (available_wrench_set, axis_capacities, capacity_margin,
+                    distribute_tensions, disturbance_box, grid_points, with_stabilisers,
+                    wrench_feasible_workspace)
+from ..cdpr.model import CableRobot
+from ..errors import InvalidInputError
+from ..io.cdpr_model import load_cdpr_model
+
+__all__ = ["register"]
+
+
+class Method(str, Enum):
+    closed_form = "closed_form"
+    lp_min_sum = "lp_min_sum"
+    lp_min_max = "lp_min_max"
+    qp_min_norm = "qp_min_norm"
+
+
+_MODEL_HELP = "Preset name (fastkit, ipanema) or model file (YAML/JSON)."
+_POSE_HELP = "Platform position X Y Z in m."
+_RPY_HELP = "Platform orientation ROLL PITCH YAW in rad (Rz(yaw) Ry(pitch) Rx(roll))."
+
+
+# Options shared by the three commands (typer option metadata can be reused).
+_MODEL_ARG = typer.Argument(..., help=_MODEL_HELP)
+_POSE_OPT = typer.Option(..., "--pose", help=_POSE_HELP)
+_RPY_OPT = typer.Option((0.0, 0.0, 0.0), "--rpy", help=_RPY_HELP)
+_STAB_OPT = typer.Option(False, "--stabilisers", help="Deploy the stabilisers of mobile bases.")
+_JSON_OPT = typer.Option(False, "--json", help="Machine-readable output.")
+Vec3 = tuple[float, float, float]
+
+
+def _load(model: str, stabilisers: bool) -> CableRobot:
+    robot = load_cdpr_model(model)
+    return with_stabilisers(robot, True) if stabilisers else robot
+
+
+def _pose(pose: tuple[float, float, float], rpy: tuple[float, float, float]) -> np.ndarray:
+    return np.array([*pose, *rpy], dtype=float)
+
+
+def _r(x: float, d: int = 3) -> float:
+    return float(round(float(x), d))
+
+
+def _table(headers: list[str], rows: list[list[str]]) -> str:
+    widths = [max(len(h), *(len(r[k]) for r in rows)) if rows else len(h)
+              for k, h in enumerate(headers)]
+    line = "  ".join(h.rjust(w) for h, w in zip(headers, widths))
+    out = [line, "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in rows]
+    return "\n".join(out)
+
+
+def _echo_json(obj) -> None:
+    typer.echo(json.dumps(obj, indent=2))
+
+
+def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers: bool,
+              as_json: bool) -> None:
+    robot = _load(model, stabilisers)
+    P = _pose(pose, rpy)
+    res = distribute_tensions(robot, P, method.value, tipping=tipping)
+    t = res.tensions[0]
+    names = [c.name for c in robot.cables]
+    if as_json:
+        _echo_json({
+            "model": robot.name, "pose": P.tolist(), "method": method.value,
+            "tipping": res.tipping, "feasible": bool(res.feasible[0]),
+            "residual": None if not np.isfinite(res.residual[0]) else float(res.residual[0]),
+            "tensions": {n: (None if not np.isfinite(v) else float(v)) for n, v in zip(names, t)},
+            "tipping_moments": (None if not np.all(np.isfinite(res.tipping_moments[0])) else
+                                [float(x) for x in res.tipping_moments[0]]),
+            "tipping_edge_base": [robot.bases[k].name for k in robot.edge_base],
+        })
+        return
+    note = "" if not res.tipping else (
+        "  (tipping checked)" if method == Method.closed_form else "  (tipping imposed)")
+    typer.echo(f"{robot.name}: pose {P.round(4).tolist()}  method {method.value}{note}")
+    if not np.all(np.isfinite(t)):
+        typer.echo("no tension distribution found: the pose is not wrench-feasible")
+        return
+    rows = [[n, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if lo - 1e-6 <= v <= hi + 1e-6 else "!"]
+            for n, v, lo, hi in zip(names, t, robot.t_min, robot.t_max)]
+    typer.echo(_table(["cable", "tension [N]", "min", "max", ""], rows))
+    typer.echo(f"feasible: {'yes' if res.feasible[0] else 'no'}   "
+               f"residual max|W t + w_e| = {res.residual[0]:.2e}")
+    if robot.has_tipping:
+        M = res.tipping_moments[0]
+        for k, base in enumerate(robot.bases):
+            sel = robot.edge_base == k
+            if np.any(sel):
+                typer.echo(f"base {base.name}: largest edge moment {M[sel].max():.2f} N m "
+                           f"({'stable' if M[sel].max() <= 1e-6 else 'TIPS'})")
+
+
+def _wrench_set(model: str, pose, rpy, disturbance, stabilisers: bool, as_json: bool,
+                plot: Optional[Path] = None) -> None:
+    robot = _load(model, stabilisers)
+    P = _pose(pose, rpy)
+    D = None
+    if disturbance is not None:
+        hw = np.zeros(robot.dof)
+        vals = np.asarray(disturbance, dtype=float)
+        hw[:min(len(vals), robot.dof)] = vals[:robot.dof]
+        D = disturbance_box(robot, hw)
+    out = {"model": robot.name, "pose": P.tolist(), "dof": robot.dof}
+    modes = [False, True] if robot.has_tipping else [False]
+    caps = {}
+    for tip in modes:
+        key = "with_tipping" if tip else "tension_limits_only"
+        cap = axis_capacities(robot, P, tipping=tip)
+        aws = available_wrench_set(robot, P, tipping=tip)
+        H, h = aws.facets(0)
+        margin = float(capacity_margin(robot, P, D, tipping=tip)[0])
+        caps[key] = cap
+        out[key] = {
+            "capacity_positive": dict(zip(cap.labels, map(_r, cap.positive[0]))),
+            "capacity_negative": dict(zip(cap.labels, map(_r, cap.negative[0]))),
+            "capacity_margin": None if not np.isfinite(margin) else _r(margin, 4),
+            "gravity_feasible": bool(aws.contains(-aws.gravity_wrench)[0]),
+            "halfspaces": {"H": np.round(H, 9).tolist(), "h": np.round(h, 9).tolist()},
+        }
+    if plot is not None:
+        from ..viz.cdpr import plot_axis_capacities
+        import matplotlib.pyplot as plt
+        fig = plot_axis_capacities(caps["tension_limits_only"], caps.get("with_tipping"), plot,
+                                   title=f"{robot.name}: wrench capability at "
+                                         f"{np.round(P[:3], 3).tolist()} m")
+        plt.close(fig)
+        out["plot"] = str(plot)
+    if as_json:
+        _echo_json(out)
+        return
+    typer.echo(f"{robot.name}: available wrench set at pose {P.round(4).tolist()}")
+    typer.echo("largest extra external wrench on top of the platform and payload weight "
+               "(N, N m):")
+    rows = []
+    for lab_i, lab in enumerate(caps["tension_limits_only"].labels):
+        row = [lab]
+        for key in caps:
+            row += [f"{caps[key].positive[0, lab_i]:.2f}", f"{caps[key].negative[0, lab_i]:.2f}"]
+        rows.append(row)
+    head = ["axis", "+ (cables)", "- (cables)"]
+    if len(caps) == 2:
+        head += ["+ (tipping)", "- (tipping)"]
+    typer.echo(_table(head, rows))
+    for key in caps:
+        o = out[key]
+        typer.echo(f"{key.replace('_', ' ')}: weight held: "
+                   f"{'yes' if o['gravity_feasible'] else 'no'}; "
+                   f"{len(o['halfspaces']['h'])} half-spaces (some may be redundant); margin "
+                   f"{o['capacity_margin'] if o['capacity_margin'] is not None else '-inf'}")
+    if plot is not None:
+        typer.echo(f"figure written to {plot}")
+
+
+def _orientations(rpy, sweep: float) -> np.ndarray:
+    """The orientation ``rpy`` and, when ``sweep`` > 0, ``rpy`` +- sweep about each axis."""
+    base = np.array([rpy], dtype=float)
+    if not np.isfinite(sweep) or sweep < 0:
+        raise InvalidInputError("sweep", "must be a finite angle >= 0 (rad)")
+    if sweep == 0:
+        return base
+    steps = np.vstack([np.zeros(3), sweep * np.eye(3), -sweep * np.eye(3)])
+    return base + steps
+
+
+def _workspace(model: str, grid, box, rpy, plot: Optional[Path], stabilisers: bool,
+               as_json: bool, sweep: float = 0.0) -> None:
+    robot = _load(model, stabilisers)
+    if box is not None:
+        region = np.array(box, dtype=float).reshape(2, 3)
+    elif robot.desired_workspace is not None:
+        region = robot.desired_workspace
+    else:
+        region = robot.bounds
+    pts, shape = grid_points(region, grid)
+    ori = _orientations(rpy, sweep)
+    if not as_json and sys.stdout.isatty():
+        from rich.progress import Progress
+        with Progress(transient=True) as bar:
+            task = bar.add_task("wrench-feasible workspace", total=len(pts) * len(ori) * (
+                2 if robot.has_tipping else 1))
+            ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape,
+                                           chunk=2048,
+                                           progress=lambda d, t: bar.update(task, completed=d))
+    else:
+        ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape)
+    if plot is not None:
+        from ..viz.cdpr import plot_workspace
+        import matplotlib.pyplot as plt
+        fig = plot_workspace(ws, robot, plot)
+        plt.close(fig)
+    if as_json:
+        _echo_json({
+            "model": robot.name, "grid": list(shape), "box": region.tolist(),
+            "orientations": ori.tolist(), "points": len(pts),
+            "coverage": ws.coverage, "coverage_tipping": ws.coverage_tipping,
+            "feasible": ws.feasible.astype(int).tolist(),
+            "feasible_tipping": (None if ws.feasible_tipping is None else
+                                 ws.feasible_tipping.astype(int).tolist()),
+            "plot": None if plot is None else str(plot)})
+        return
+    typer.echo(f"{robot.name}: wrench-feasible workspace on a {'x'.join(map(str, shape))} grid "
+               f"over {region.round(3).tolist()} m"
+               + (f", feasible at all {len(ori)} orientations" if len(ori) > 1 else ""))
+    rows = [["tension limits", str(int(ws.feasible.sum())), f"{100 * ws.coverage:.1f} %"]]
+    if ws.feasible_tipping is not None:
+        rows.append(["+ tipping", str(int(ws.feasible_tipping.sum())),
+                     f"{100 * ws.coverage_tipping:.1f} %"])
+    typer.echo(_table(["constraints", f"feasible of {len(pts)}", "coverage"], rows))
+    if plot is not None:
+        typer.echo(f"figure written to {plot}")
 
 
 def register(app: typer.Typer) -> None:
-    """Add this module's subcommands to the `taut` app."""
+    """Add the ``cdpr`` sub-app to the `taut` app."""
+    sub = typer.Typer(help="Cable-driven parallel robots (fixed or on mobile bases): "
+                           "tensions, wrench sets, workspaces.", no_args_is_help=True)
+
+    @sub.command("tensions")
+    def tensions_cmd(
+        model: str = _MODEL_ARG,
+        pose: Vec3 = _POSE_OPT,
+        rpy: Vec3 = _RPY_OPT,
+        method: Method = typer.Option(Method.closed_form, "--method",
+                                      help="Tension distribution method."),
+        tipping: bool = typer.Option(False, "--tipping", help="Impose the tipping "
+                                     "constraints of the mobile bases (LP/QP methods)."),
+        stabilisers: bool = _STAB_OPT,
+        as_json: bool = _JSON_OPT,
+    ) -> None:
+        """Cable tensions holding platform and payload at a pose (FASTKIT eqs. 17-20)."""
+        _tensions(model, pose, rpy, method, tipping, stabilisers, as_json)
+
+    @sub.command("wrench-set")
+    def wrench_set_cmd(
+        model: str = _MODEL_ARG,
+        pose: Vec3 = _POSE_OPT,
+        rpy: Vec3 = _RPY_OPT,
+        disturbance: Optional[tuple[float, float, float, float, float, float]] = typer.Option(
+            None, "--disturbance", help="Half-widths FX FY FZ MX MY MZ (N, N m) of an extra "
+                                        "wrench box for the capacity margin."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a bar chart of the "
+                                            "axis capacities (like FASTKIT Fig. 14)."),
+        stabilisers: bool = _STAB_OPT,
+        as_json: bool = _JSON_OPT,
+    ) -> None:
+        """Available wrench set at a pose: axis capacities, margin, half-spaces (eq. 24)."""
+        if disturbance is not None and any(not np.isfinite(v) for v in disturbance):
+            raise InvalidInputError("disturbance", "contains NaN or infinite values")
+        _wrench_set(model, pose, rpy, disturbance, stabilisers, as_json, plot)
+
+    @sub.command("workspace")
+    def workspace_cmd(
+        model: str = _MODEL_ARG,
+        grid: tuple[int, int, int] = typer.Option((41, 1, 21), "--grid",
+                                                  help="Points per axis NX NY NZ."),
+        box: Optional[tuple[float, float, float, float, float, float]] = typer.Option(
+            None, "--box", help="XMIN YMIN ZMIN XMAX YMAX ZMAX in m (default: the model's "
+                                "desired workspace, else its frame)."),
+        rpy: Vec3 = _RPY_OPT,
+        sweep: float = typer.Option(0.0, "--sweep", help="Also require feasibility at the "
+                                    "orientation +- SWEEP rad about each axis (7 in all)."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a figure (PNG/PDF)."),
+        stabilisers: bool = _STAB_OPT,
+        as_json: bool = _JSON_OPT,
+    ) -> None:
+        """Wrench-feasible workspace with and without tipping; coverage of the desired one."""
+        _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep)
+
+    app.add_typer(sub, name="cdpr")

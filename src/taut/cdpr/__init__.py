@@ -1,0 +1,28 @@
+"""Cable-driven parallel robots on fixed frames and mobile bases (FASTKIT paper, §3-4):
+validated models, cable kinematics and the wrench matrix (eq. 18), tension distribution
+(eqs. 17, 20), tipping constraints of mobile bases (eqs. 21-23), the exact available wrench
+set (eq. 24) with axis capacities and capacity margins, and wrench-feasible workspaces.
+
+All quantities are SI (m, kg, N, rad), float64; batched functions take a leading axis of B
+poses ``(x, y, z, roll, pitch, yaw)``.
+"""
+
+from .kinematics import (CableState, as_poses, cable_state, gravity_wrench,
+                         rotation_matrices, tipping_matrix, wrench_matrix)
+from .model import Base, Cable, CableRobot, Payload, Platform, check_footprint, with_stabilisers
+from .tension import METHODS, TensionResult, distribute_tensions
+from .tipping import TippingResult, tipping_moments
+from .workspace import WorkspaceResult, grid_points, wrench_feasible_workspace
+from .wrench_set import (AXIS_LABELS, AvailableWrenchSet, AxisCapacities, available_wrench_set,
+                         axis_capacities, capacity_margin, disturbance_box, wrench_feasible)
+
+__all__ = [
+    "Base", "Cable", "CableRobot", "Payload", "Platform", "check_footprint", "with_stabilisers",
+    "CableState", "as_poses", "cable_state", "gravity_wrench", "rotation_matrices",
+    "tipping_matrix", "wrench_matrix",
+    "METHODS", "TensionResult", "distribute_tensions",
+    "TippingResult", "tipping_moments",
+    "WorkspaceResult", "grid_points", "wrench_feasible_workspace",
+    "AXIS_LABELS", "AvailableWrenchSet", "AxisCapacities", "available_wrench_set",
+    "axis_capacities", "capacity_margin", "disturbance_box", "wrench_feasible",
+]

@@ -1,0 +1,62 @@
+"""Shared linear-algebra pieces of the CDPR statics (private)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._validate import as_array
+from ..errors import InvalidInputError
+from .kinematics import CableState, gravity_wrench, tipping_matrix
+from .model import CableRobot
+
+RANK_TOL = 1e-9
+
+
+def svd_split(W: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pseudo-inverse ``W+`` (B, m, n), orthonormal null-space basis ``N`` (B, m, m-n) and a
+    full-rank flag (B,) of a batch of wrench matrices W (B, n, m)."""
+    B, n, m = W.shape
+    U, S, Vt = np.linalg.svd(W, full_matrices=True)
+    ok = S[:, -1] > RANK_TOL * S[:, 0]
+    inv = np.where(ok[:, None], 1.0 / np.where(S > 0, S, 1.0), 0.0)
+    pinv = np.einsum("bki,bk,bjk->bij", Vt[:, :n, :], inv, U)
+    N = np.swapaxes(Vt[:, n:, :], 1, 2)
+    return pinv, N, ok
+
+
+def required_wrench(robot: CableRobot, state: CableState, external: Any = None,
+                    field: str = "external_wrench") -> np.ndarray:
+    """The wrench the cables must apply, ``-(w_e + w_ext)`` (B, n) (FASTKIT eqs. 17, 19)."""
+    w = gravity_wrench(robot, state.R)
+    if external is not None:
+        ext = as_array(external, field)
+        if ext.shape[-1] != robot.dof or ext.ndim > 2:
+            raise InvalidInputError(field, f"must have {robot.dof} components (forces, N"
+                                           + (", then moments, N m)" if robot.dof == 6 else ")"))
+        w = w + ext
+    return -w
+
+
+def constraints(robot: CableRobot, state: CableState, tipping: bool
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Linear constraints ``A t <= b`` on tensions: the bounds of FASTKIT eq. 20 and, when
+    ``tipping``, the edge moments of eqs. 21-23. Returns A (B, K, m) and b (B, K)."""
+    B, m = state.lengths.shape
+    eye = np.eye(m)
+    rows = [eye, -eye]
+    rhs = [robot.t_max, -robot.t_min]
+    A = np.broadcast_to(np.concatenate(rows)[None], (B, 2 * m, m))
+    b = np.broadcast_to(np.concatenate(rhs)[None], (B, 2 * m))
+    if tipping and robot.has_tipping:
+        T = tipping_matrix(robot, state.unit)
+        A = np.concatenate([A, T], axis=1)
+        b = np.concatenate([b, np.broadcast_to(-robot.edge_weight_moment, (B, robot.n_edges))],
+                           axis=1)
+    return A, b
+
+
+def feas_tol(robot: CableRobot) -> float:
+    """Absolute tolerance on tensions and moments, scaled by the largest tension limit."""
+    return 1e-9 * float(np.max(robot.t_max))

@@ -1,0 +1,162 @@
+"""Cable kinematics and statics of a CDPR at a batch of platform poses.
+
+A pose is ``(x, y, z, roll, pitch, yaw)`` (m, rad); the platform rotation is
+``R = Rz(yaw) Ry(pitch) Rx(roll)``. A 3-vector ``(x, y, z)`` means zero orientation.
+Batched inputs carry a leading axis of B poses. Cable ``i`` pulls the platform along
+``u_i``, the unit vector from its attachment point to its exit point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._validate import as_array
+from ..errors import InfeasiblePoseError, InvalidInputError
+from .model import CableRobot
+
+__all__ = ["as_poses", "rotation_matrices", "CableState", "cable_state", "wrench_matrix",
+           "gravity_wrench", "tipping_matrix"]
+
+
+def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
+             check_bounds: bool = True) -> np.ndarray:
+    """Validate platform poses and return them as a float64 ``(B, 6)`` array.
+
+    Accepts shapes ``(3,)``, ``(6,)``, ``(B, 3)`` or ``(B, 6)``; a missing orientation is
+    zero. Raises :class:`InvalidInputError` on NaN/inf or a wrong shape, and
+    :class:`InfeasiblePoseError` when a position lies outside ``robot.bounds``.
+    """
+    arr = as_array(poses, field)
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] not in (3, 6):
+        raise InvalidInputError(field, "must be (x, y, z) or (x, y, z, roll, pitch, yaw), "
+                                       "optionally with a leading batch axis")
+    if arr.shape[1] == 3:
+        arr = np.hstack([arr, np.zeros((arr.shape[0], 3))])
+    if check_bounds:
+        lo, hi = robot.bounds
+        tol = 1e-9 * (1.0 + np.abs(robot.bounds).max())
+        bad = np.any((arr[:, :3] < lo - tol) | (arr[:, :3] > hi + tol), axis=1)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            where = f"{field}[{i}]" if arr.shape[0] > 1 else field
+            raise InfeasiblePoseError(where, "position {} lies outside the frame box "
+                                      "{} .. {} m".format(np.round(arr[i, :3], 4).tolist(),
+                                                          np.round(lo, 4).tolist(),
+                                                          np.round(hi, 4).tolist()))
+    return arr
+
+
+def rotation_matrices(rpy: np.ndarray) -> np.ndarray:
+    """``Rz(yaw) Ry(pitch) Rx(roll)`` for ``rpy`` of shape (B, 3) (rad) -> (B, 3, 3)."""
+    cr, cp, cy = np.cos(rpy.T)
+    sr, sp, sy = np.sin(rpy.T)
+    R = np.empty((rpy.shape[0], 3, 3))
+    R[:, 0, 0] = cy * cp
+    R[:, 0, 1] = cy * sp * sr - sy * cr
+    R[:, 0, 2] = cy * sp * cr + sy * sr
+    R[:, 1, 0] = sy * cp
+    R[:, 1, 1] = sy * sp * sr + cy * cr
+    R[:, 1, 2] = sy * sp * cr - cy * sr
+    R[:, 2, 0] = -sp
+    R[:, 2, 1] = cp * sr
+    R[:, 2, 2] = cp * cr
+    return R
+
+
+@dataclass(frozen=True)
+class CableState:
+    """Inverse kinematics of a batch of poses.
+
+    Attributes
+    ----------
+    poses : (B, 6)
+    lengths : (B, m)
+        Straight-line cable lengths, m.
+    unit : (B, m, 3)
+        Unit vectors ``u_i`` from attachment to exit point (direction of the cable force
+        on the platform).
+    r : (B, m, 3)
+        Vectors from the platform reference point P to the attachment points, world
+        frame, m (FASTKIT's ``r_i``).
+    W : (B, n, m)
+        Wrench matrix (FASTKIT eq. 18): columns ``[u_i; r_i x u_i]`` (n = 6), or ``u_i``
+        for a point-mass platform (n = 3).
+    R : (B, 3, 3)
+        Platform rotations.
+    """
+
+    poses: np.ndarray
+    lengths: np.ndarray
+    unit: np.ndarray
+    r: np.ndarray
+    W: np.ndarray
+    R: np.ndarray
+
+
+def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> CableState:
+    """Cable lengths, unit vectors and the wrench matrix W (FASTKIT eq. 18) at poses.
+
+    Parameters
+    ----------
+    robot : CableRobot
+    poses : array_like, (6,), (3,), (B, 6) or (B, 3)
+        Platform poses, m and rad.
+    validated : bool
+        Skip validation when ``poses`` is already a checked ``(B, 6)`` array.
+
+    Raises
+    ------
+    InfeasiblePoseError
+        A position outside the frame box, or an attachment point on its exit point
+        (zero cable length, direction undefined).
+    """
+    P = poses if validated else as_poses(robot, poses)
+    R = rotation_matrices(P[:, 3:])
+    r = np.einsum("bij,mj->bmi", R, robot.attach_local)
+    vec = robot.exits_world[None, :, :] - (P[:, None, :3] + r)
+    L = np.linalg.norm(vec, axis=2)
+    if np.any(L <= 1e-12 * (1.0 + np.abs(robot.exits_world).max())):
+        i = int(np.argmax(np.any(L <= 1e-12, axis=1)))
+        raise InfeasiblePoseError("pose", f"pose {i} puts an attachment point on its exit "
+                                          "point (zero cable length)")
+    u = vec / L[:, :, None]
+    if robot.dof == 3:
+        W = np.swapaxes(u, 1, 2).copy()
+    else:
+        W = np.concatenate([np.swapaxes(u, 1, 2), np.swapaxes(np.cross(r, u), 1, 2)], axis=1)
+    return CableState(P, L, u, r, W, R)
+
+
+def wrench_matrix(robot: CableRobot, poses: Any) -> np.ndarray:
+    """The wrench matrix W, shape (B, n, m) (FASTKIT eq. 18); see :func:`cable_state`."""
+    return cable_state(robot, poses).W
+
+
+def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
+    """External wrench ``w_e`` (FASTKIT eq. 19) of platform and payload weight, (B, n).
+
+    ``w_e = [f_e; m_e]`` with ``f_e = (m_p + m_l) g`` (N) and ``m_e`` the moment of both
+    weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3).
+    """
+    g = robot.gravity
+    f = np.broadcast_to(robot.total_mass * g, (R.shape[0], 3))
+    if robot.dof == 3:
+        return f.copy()
+    mc = robot.platform.mass * robot.platform.com + robot.payload.mass * robot.payload.com
+    m = np.cross(R @ mc, g)
+    return np.concatenate([f, m], axis=1)
+
+
+def tipping_matrix(robot: CableRobot, unit: np.ndarray) -> np.ndarray:
+    """Tipping coefficients ``T`` (B, E, m) so that the edge moments of FASTKIT eqs. 21-23
+    are ``m_C = T t + robot.edge_weight_moment`` (N m) for tensions ``t`` (N).
+
+    ``T[j, i] = u_Cj . ((c_j - b_i) x u_i)`` for a cable ``i`` leaving the base of edge
+    ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``.
+    """
+    return np.einsum("jik,bik->bji", robot._tip_V, unit)

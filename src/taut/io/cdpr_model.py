@@ -1,0 +1,169 @@
+"""Cable-robot model files (YAML or JSON) and the shipped presets.
+
+Top-level keys (unknown keys are errors; SI units):
+
+``name`` (str), ``gravity`` ([gx, gy, gz], m/s^2, default [0, 0, -9.81]),
+``bases`` (list; each: ``name``, ``mobile`` (bool), ``pose`` [x, y, theta],
+``exit_points`` {name: [x, y, z]} in the base frame, and for a mobile base ``mass``,
+``com`` [x, y, z], ``footprint`` [[x, y], ...], optional ``stabilisers``
+{``footprint``: [[x, y], ...], ``deployed``: bool}),
+``platform`` (``mass``, ``com``, ``inertia`` (3 numbers or 3x3), ``attachment_points``
+{name: [x, y, z]}), ``payload`` (``mass``, ``com``), ``cables`` (list; each ``name``,
+``exit`` "base.point", ``attachment``, ``t_min``, ``t_max``), optional ``bounds`` and
+``desired_workspace`` ({``min``: [x, y, z], ``max``: [x, y, z]}).
+
+:func:`load_cdpr_model` accepts a preset name (``fastkit``, ``ipanema``) or a file path.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from ..cdpr.model import Base, Cable, CableRobot, Payload, Platform
+from ..errors import InvalidModelError, ScenarioError, TautError
+from .files import read_mapping, validate_mapping
+
+__all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
+
+PRESETS = ("fastkit", "ipanema")
+
+Vec3 = tuple[float, float, float]
+Vec2 = tuple[float, float]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class _Stabilisers(_Strict):
+    footprint: list[Vec2]
+    deployed: bool = False
+
+
+class _Base(_Strict):
+    name: str
+    mobile: bool = False
+    pose: Vec3 = (0.0, 0.0, 0.0)
+    mass: float = 0.0
+    com: Vec3 = (0.0, 0.0, 0.0)
+    footprint: list[Vec2] | None = None
+    stabilisers: _Stabilisers | None = None
+    exit_points: dict[str, Vec3] = Field(min_length=1)
+
+
+class _Platform(_Strict):
+    mass: float = 0.0
+    com: Vec3 = (0.0, 0.0, 0.0)
+    inertia: Vec3 | tuple[Vec3, Vec3, Vec3] = (0.0, 0.0, 0.0)
+    attachment_points: dict[str, Vec3] = Field(min_length=1)
+
+
+class _Payload(_Strict):
+    mass: float = 0.0
+    com: Vec3 = (0.0, 0.0, 0.0)
+
+
+class _Cable(_Strict):
+    name: str
+    exit: str
+    attachment: str
+    t_min: float
+    t_max: float
+
+
+class _Box(_Strict):
+    min: Vec3
+    max: Vec3
+
+
+class _ModelFile(_Strict):
+    name: str = "cable robot"
+    gravity: Vec3 = (0.0, 0.0, -9.81)
+    bases: list[_Base] = Field(min_length=1)
+    platform: _Platform
+    payload: _Payload = _Payload()
+    cables: list[_Cable] = Field(min_length=1)
+    bounds: _Box | None = None
+    desired_workspace: _Box | None = None
+
+
+def _file_field(exc: TautError, raw: _ModelFile) -> str:
+    """Turn a model field such as ``bases[active].footprint`` into ``bases[0].footprint``."""
+    f = exc.field
+    if f.startswith("bases[") and "]" in f:
+        name, rest = f[6:].split("]", 1)
+        for i, b in enumerate(raw.bases):
+            if b.name == name:
+                return f"bases[{i}]{rest}"
+    return f
+
+
+def cdpr_model_from_mapping(data: dict[str, Any]) -> CableRobot:
+    """Validate a parsed mapping and build the :class:`CableRobot`.
+
+    Raises
+    ------
+    ScenarioError
+        Wrong types, unknown or missing keys, NaN/inf (field named by dotted path).
+    InvalidModelError
+        Inconsistent model: cable referencing a missing point, ``t_min > t_max``,
+        non-convex or degenerate footprint, base centre of mass outside its footprint.
+    """
+    raw = validate_mapping(_ModelFile, data)
+    try:
+        bases = []
+        for b in raw.bases:
+            st = b.stabilisers
+            bases.append(Base(name=b.name, exit_points=b.exit_points, pose=b.pose,
+                              mobile=b.mobile, mass=b.mass, com=b.com,
+                              footprint=b.footprint,
+                              stabilisers=None if st is None else st.footprint,
+                              stabilisers_deployed=bool(st is not None and st.deployed)))
+        cables = []
+        for i, c in enumerate(raw.cables):
+            if c.exit.count(".") != 1:
+                raise InvalidModelError(f"cables[{i}].exit",
+                                        "must be 'base.point', e.g. 'active.A1'")
+            base, point = c.exit.split(".")
+            cables.append(Cable(c.name, base, point, c.attachment, c.t_min, c.t_max))
+        p = raw.platform
+        robot = CableRobot(
+            bases=tuple(bases),
+            platform=Platform(attachment_points=p.attachment_points, mass=p.mass, com=p.com,
+                              inertia=p.inertia),
+            cables=tuple(cables),
+            payload=Payload(raw.payload.mass, raw.payload.com),
+            gravity=raw.gravity,
+            bounds=None if raw.bounds is None else (raw.bounds.min, raw.bounds.max),
+            desired_workspace=(None if raw.desired_workspace is None else
+                               (raw.desired_workspace.min, raw.desired_workspace.max)),
+            name=raw.name)
+    except InvalidModelError as exc:
+        raise InvalidModelError(_file_field(exc, raw), exc.problem) from None
+    except TautError as exc:
+        raise InvalidModelError(_file_field(exc, raw), exc.problem) from None
+    return robot
+
+
+def preset_path(name: str) -> Path:
+    """Path of a shipped preset file; raises :class:`ScenarioError` for an unknown name."""
+    if name not in PRESETS:
+        raise ScenarioError("model", f"unknown preset {name!r}; presets: "
+                                     + ", ".join(PRESETS) + " (or give a file path)")
+    return Path(str(resources.files("taut") / "data" / f"{name}.yaml"))
+
+
+def load_cdpr_model(source: str | Path) -> CableRobot:
+    """Load a cable-robot model from a preset name or a ``.yaml``/``.yml``/``.json`` path.
+
+    A bare word without a path separator or suffix is taken as a preset name.
+    """
+    s = str(source)
+    p = Path(s)
+    if not p.exists() and p.suffix == "" and "/" not in s and "\\" not in s:
+        p = preset_path(s)
+    return cdpr_model_from_mapping(read_mapping(p))

@@ -1,0 +1,174 @@
+"""Statics: equilibrium (FASTKIT eq. 17), tension distribution methods and their agreement,
+the hand-checkable symmetric point-mass robot, tipping moments (eqs. 21-23)."""
+
+import numpy as np
+import pytest
+
+from taut.cdpr import (Base, Cable, CableRobot, Platform, cable_state, distribute_tensions,
+                       gravity_wrench, tipping_moments, wrench_feasible)
+from taut.errors import InvalidInputError
+
+from cdpr_helpers import A, H, MASS, point_mass_robot, random_poses
+
+N_POSES = 2000
+G = 9.81
+
+
+@pytest.fixture(scope="module")
+def solved(fastkit, ipanema):
+    """All four methods on N_POSES random poses of each preset (computed once)."""
+    out = {}
+    for name, robot in (("fastkit", fastkit), ("ipanema", ipanema)):
+        P = random_poses(robot, N_POSES, seed=1 if name == "fastkit" else 2)
+        out[name] = (robot, P, {m: distribute_tensions(robot, P, m) for m in
+                                ("closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm")})
+    return out
+
+
+@pytest.mark.parametrize("name", ["fastkit", "ipanema"])
+def test_equilibrium_to_machine_precision(solved, name):
+    robot, P, res = solved[name]
+    st = cable_state(robot, P)
+    we = gravity_wrench(robot, st.R)
+    for method, r in res.items():
+        f = r.feasible
+        assert f.sum() > 100, (method, f.sum())
+        resid = np.einsum("bij,bj->bi", st.W[f], r.tensions[f]) + we[f]
+        # |W t + w_e| relative to the weight held: a few ulps of ~100 N.
+        assert np.abs(resid).max() <= 1e-12 * np.abs(we).max(), method
+        assert np.all(r.tensions[f] >= robot.t_min - 1e-9 * robot.t_max.max())
+        assert np.all(r.tensions[f] <= robot.t_max + 1e-9 * robot.t_max.max())
+
+
+@pytest.mark.parametrize("name", ["fastkit", "ipanema"])
+def test_methods_agree_on_feasibility(solved, name):
+    robot, P, res = solved[name]
+    lp = res["lp_min_sum"].feasible
+    np.testing.assert_array_equal(res["lp_min_max"].feasible, lp)
+    np.testing.assert_array_equal(res["qp_min_norm"].feasible, lp)
+    # Exact vectorised test (Helly/Farkas H-representation) agrees with the LPs.
+    np.testing.assert_array_equal(wrench_feasible(robot, P, tipping=False), lp)
+    cf = res["closed_form"].feasible
+    # Pott's closed form is conservative by design: closed-form feasible => LP feasible.
+    assert not np.any(cf & ~lp)
+    rate = (cf == lp).mean()
+    print(f"{name}: LP-feasible {lp.mean():.3f}, closed-form agreement {rate:.4f}")
+    assert 0.2 < lp.mean() < 0.95          # the sample is informative both ways
+    assert rate > 0.9
+
+
+@pytest.mark.parametrize("name", ["fastkit", "ipanema"])
+def test_optimality_of_each_method(solved, name):
+    robot, P, res = solved[name]
+    f = res["lp_min_sum"].feasible
+    sums = {m: r.tensions[f].sum(axis=1) for m, r in res.items()}
+    maxs = {m: r.tensions[f].max(axis=1) for m, r in res.items()}
+    norms = {m: np.linalg.norm(r.tensions[f], axis=1) for m, r in res.items()}
+    fc = res["closed_form"].feasible[f]
+    for m in res:
+        ok = fc if m == "closed_form" else np.ones_like(fc)
+        assert np.all(sums["lp_min_sum"][ok] <= sums[m][ok] + 1e-6)
+        assert np.all(maxs["lp_min_max"][ok] <= maxs[m][ok] + 1e-6)
+        assert np.all(norms["qp_min_norm"][ok] <= norms[m][ok] + 1e-6)
+
+
+def test_qp_enumeration_matches_scipy(fastkit):
+    P = random_poses(fastkit, 400, seed=5)
+    f = distribute_tensions(fastkit, P, "lp_min_sum").feasible
+    P = P[f][:25]
+    for tip in (False, True):
+        a = distribute_tensions(fastkit, P, "qp_min_norm", tipping=tip)
+        b = distribute_tensions(fastkit, P, "qp_min_norm", tipping=tip, qp_solver="scipy")
+        np.testing.assert_array_equal(a.feasible, b.feasible)
+        np.testing.assert_allclose(a.tensions[a.feasible], b.tensions[a.feasible], atol=1e-4)
+
+
+def test_tipping_constrained_methods_agree(fastkit):
+    P = random_poses(fastkit, 800, seed=7)
+    lp = distribute_tensions(fastkit, P, "lp_min_sum", tipping=True)
+    qp = distribute_tensions(fastkit, P, "qp_min_norm", tipping=True)
+    free = distribute_tensions(fastkit, P, "lp_min_sum", tipping=False)
+    np.testing.assert_array_equal(lp.feasible, qp.feasible)
+    np.testing.assert_array_equal(wrench_feasible(fastkit, P, tipping=True), lp.feasible)
+    assert not np.any(lp.feasible & ~free.feasible)          # tipping only removes poses
+    assert np.any(free.feasible & ~lp.feasible)               # ...and here it does
+    assert np.all(lp.tipping_moments[lp.feasible] <= 1e-6)
+    cf = distribute_tensions(fastkit, P, "closed_form", tipping=True)
+    assert not np.any(cf.feasible & ~lp.feasible)
+
+
+def test_unequal_limits_closed_form(fastkit):
+    """Per-cable mean tensions and limits (the known pitfall with unequal limits)."""
+    from dataclasses import replace
+    cables = tuple(replace(c, t_min=1.0 + i, t_max=30.0 + 5 * i)
+                   for i, c in enumerate(fastkit.cables))
+    robot = replace(fastkit, cables=cables)
+    P = random_poses(robot, 600, seed=11)
+    cf = distribute_tensions(robot, P, "closed_form")
+    lp = distribute_tensions(robot, P, "lp_min_sum")
+    assert cf.feasible.sum() > 50
+    assert not np.any(cf.feasible & ~lp.feasible)
+    t = cf.tensions[cf.feasible]
+    assert np.all(t >= robot.t_min - 1e-8) and np.all(t <= robot.t_max + 1e-8)
+
+
+# --- hand-checkable symmetric point-mass robot --------------------------------------------
+
+@pytest.mark.parametrize("z0", [0.5, 1.5, 2.5])
+@pytest.mark.parametrize("method", ["closed_form", "lp_min_max", "qp_min_norm"])
+def test_point_mass_equal_tensions(point_mass, z0, method):
+    dh = H - z0
+    L = np.sqrt(2 * A * A + dh * dh)
+    r = distribute_tensions(point_mass, [0.0, 0.0, z0], method)
+    assert r.feasible[0]
+    np.testing.assert_allclose(r.tensions[0], MASS * G * L / (4 * dh), rtol=1e-12)
+
+
+def test_point_mass_infeasible_when_limits_too_low():
+    robot = point_mass_robot(t_min=1.0, t_max=5.0)      # 4 x 5 N < 39 N weight
+    for m in ("closed_form", "lp_min_sum", "qp_min_norm"):
+        assert not distribute_tensions(robot, [0, 0, 1.0], m).feasible[0]
+
+
+def test_bad_method(point_mass):
+    with pytest.raises(InvalidInputError) as e:
+        distribute_tensions(point_mass, [0, 0, 1], "magic")
+    assert e.value.field == "method"
+
+
+# --- tipping moments by hand --------------------------------------------------------------
+
+def tipping_cart(mass=50.0, height=1.0):
+    """A 1 m square cart (COM at its centre, 0.4 m up) with one exit point on its front edge
+    line at ``height``, plus a fixed frame; point-mass platform level with the exit."""
+    cart = Base("cart", {"E": (0.5, 0.0, height)}, mobile=True, mass=mass,
+                com=(0.0, 0.0, 0.4),
+                footprint=[(0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5), (0.5, -0.5)])   # clockwise
+    frame = Base("frame", {"F1": (4.0, 1.0, 3.0), "F2": (4.0, -1.0, 3.0),
+                           "F3": (4.0, 0.0, 0.0)})
+    cables = (Cable("c0", "cart", "E", "P", 0.0, 1000.0),
+              Cable("c1", "frame", "F1", "P", 0.0, 1000.0),
+              Cable("c2", "frame", "F2", "P", 0.0, 1000.0),
+              Cable("c3", "frame", "F3", "P", 0.0, 1000.0))
+    return CableRobot((cart, frame), Platform({"P": (0, 0, 0)}, mass=1.0), cables)
+
+
+def test_tipping_moment_about_front_edge_by_hand():
+    M, h = 50.0, 1.0
+    robot = tipping_cart(M, h)
+    # Weight moments: -M g * 0.5 about every edge of the 1 m square (COM at the centre).
+    np.testing.assert_allclose(robot.edge_weight_moment, -M * G * 0.5)
+    t = np.array([100.0, 0.0, 0.0, 0.0])
+    res = tipping_moments(robot, [2.0, 0.0, h], t)
+    # Cable pulls the cart towards +x, horizontally, at height h, from the front edge line:
+    # moment about the front edge = -M g 0.5 + t h; about the back edge the arm is the same
+    # height (the pull is horizontal), so -M g 0.5 - t h; side edges: no moment.
+    front = np.argmax(robot.edge_points[:, 0] + np.roll(robot.edge_points[:, 0], -1))
+    assert res.moments.shape == (1, 4)
+    np.testing.assert_allclose(res.moments[0, front], -M * G * 0.5 + 100.0 * h, atol=1e-9)
+    np.testing.assert_allclose(np.sort(res.moments[0]),
+                               np.sort([-M * G * 0.5 + 100 * h, -M * G * 0.5 - 100 * h,
+                                        -M * G * 0.5, -M * G * 0.5]), atol=1e-9)
+    assert res.stable[0]
+    tip = tipping_moments(robot, [2.0, 0.0, h], [M * G * 0.5 / h + 1.0, 0, 0, 0])
+    assert not tip.stable[0] and tip.worst_edge[0] == front
