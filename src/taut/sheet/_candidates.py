@@ -47,14 +47,25 @@ def sizes_for(N: int, pairs: bool) -> range:
     return range(2 if pairs else 3, min(5, N) + 1)
 
 
-def all_small_subsets(N: int, B: int, pairs: bool) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """Every subset of size 2/3..5 for each of ``B`` formations (complete for any N; used
-    where it is cheaper than the hull, i.e. small N, and as the fast method's cross-check)."""
-    groups = {}
-    for s in sizes_for(N, pairs):
-        table = combo_table(N, s)
-        groups[s] = (np.repeat(np.arange(B), len(table)), np.tile(table, (B, 1)))
-    return groups
+_PADDED: dict[tuple[int, bool], np.ndarray] = {}
+
+
+def padded_small_subsets(N: int, pairs: bool) -> np.ndarray:
+    """Every subset of size 2/3..5 of ``range(N)``, ascending size, padded with -1 to
+    shape (M, 5) (cached; read-only). Complete for any N: the candidates of small teams,
+    where it is cheaper than the hull, and of the fast method's cross-check."""
+    key = (N, pairs)
+    if key not in _PADDED:
+        parts = []
+        for s in sizes_for(N, pairs):
+            table = combo_table(N, s)
+            pad = np.full((len(table), 5), -1, dtype=np.intp)
+            pad[:, :s] = table
+            parts.append(pad)
+        table = np.vstack(parts) if parts else np.zeros((0, 5), np.intp)
+        table.flags.writeable = False
+        _PADDED[key] = table
+    return _PADDED[key]
 
 
 def _unique_sorted_rows(rows: np.ndarray, N: int) -> np.ndarray:
@@ -89,7 +100,9 @@ class Stationary:
 
     ``subset`` (M, 5) padded with -1, ``size`` (M,), ``x`` (M, 4) the point
     :math:`(\\mathbf{r}_o, \\mathbf{v}_o)`, ``mu`` (M,) the common piece value, ``depth2``
-    (M,), all normalised; ``form`` (M,) the formation index.
+    (M,), all normalised; ``form`` (M,) the formation index; ``curvature`` (M,) the
+    smallest eigenvalue of the reduced Hessian on the face (as
+    :func:`~taut.sheet._kernel.reduced_hessian_min_eig`, ``+inf`` for facets).
     """
 
     form: np.ndarray
@@ -98,6 +111,9 @@ class Stationary:
     x: np.ndarray
     mu: np.ndarray
     depth2: np.ndarray
+    curvature: np.ndarray
+
+    FIELDS = ("form", "subset", "size", "x", "mu", "depth2", "curvature")
 
 
 @dataclass
@@ -112,19 +128,16 @@ class HullCandidates:
 
 
 _J = np.array([1.0, 1.0, -1.0, -1.0])
+#: Faces whose spanning directions have a relative size or mutual sine below this are
+#: solved by the Lagrange kernel rather than in closed form from the facet normals.
+FALLBACK_SIN = 1e-3
+_ONES = np.ones(4)
 _PROBE = np.array([0.6180339887, 0.7071067812, 0.5772156649, 0.3183098862, 0.2718281828,
                    0.1414213562])
 
 
-def _key(rows: np.ndarray, N: int) -> np.ndarray:
-    key = rows[:, 0].astype(np.int64)
-    for c in range(1, rows.shape[1]):
-        key = key * N + rows[:, c]
-    return key
-
-
 def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
-                             ) -> Stationary | None:
+                             ) -> tuple[Stationary, dict[int, np.ndarray]] | None:
     """Stationary points of every upper face of a simplicial, full-dimensional hull.
 
     For a face ``S`` the points ``x`` at which exactly the pieces of ``S`` are maximal
@@ -136,15 +149,17 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     1x1 or 2x2 system (closed form). This replaces the paper's Lagrange solve (eq. 14)
     for every candidate; the exact maximiser test still decides which are valid.
 
-    Returns None for hulls where this shortcut does not apply (coplanar or merged
-    facets), which then go through the general solver.
+    Returns the stationary points, and the faces (``size -> subsets``) whose directions
+    are too ill-conditioned for the closed form (nearly coplanar neighbouring facets),
+    which go through the general solver; or None for hulls where the shortcut does not
+    apply at all (coplanar points or merged facets).
     """
     if len(hull.coplanar):
         return None
     eq = hull.equations
     # Qt gives every simplex of a merged (non-simplicial) facet that facet's hyperplane.
-    probe = eq @ _PROBE
-    if len(np.unique(probe)) < len(probe):
+    probe = np.sort(eq @ _PROBE)
+    if np.any(probe[1:] == probe[:-1]):
         return None
     nP = eq[:, :5] @ basis.T                             # outward normals in lifted coords
     upper = nP[:, 4] > 1e-12
@@ -152,61 +167,114 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     simp = np.sort(hull.simplices, axis=1)
     nf = len(simp)
     uf = np.flatnonzero(upper)
-    subsets, xs = [], []
     # Facets: the stationary point is the facet's own vertex of the arrangement.
-    subsets.append(simp[uf])
-    xs.append(nP[uf, :4] / nP[uf, 4:5])
+    subsets = [simp[uf]]
+    xs = [nP[uf, :4] / nP[uf, 4:5]]
+    sizes = [np.full(len(uf), 5, dtype=np.intp)]
+    curvs = [np.full(len(uf), np.inf)]
     # Ridges: facet f minus its vertex j, shared with neighbour g = neighbors[f, j]
     # (Qhull orders neighbours opposite the unsorted simplex's vertices).
-    f, j = np.nonzero(upper[:, None] & np.ones((1, 5), bool))
-    g = hull.neighbors[f, j]
-    keep = ~upper[g] | (f < g)
-    f, j, g = f[keep], j[keep], g[keep]
-    ridge = np.sort(np.where(np.arange(5) == j[:, None], -1, hull.simplices[f]), axis=1)[:, 1:]
+    nbr = hull.neighbors[uf]
+    fi, j = np.nonzero(~upper[nbr] | (uf[:, None] < nbr))
+    f, g = uf[fi], nbr[fi, j]
+    rows = simp[f]
+    ridge = np.full((len(f), 5), -1, dtype=np.intp)
+    ridge[:, :4] = rows[rows != hull.simplices[f, j][:, None]].reshape(-1, 4)
     faces = [(ridge, f, g[:, None])]
     # 2-faces: group the 3-subsets of all simplices; each is shared by >= 3 facets.
-    tab = combo_table(5, 3)
-    sub = simp[:, tab].reshape(-1, 3)
-    fid = np.repeat(np.arange(nf), len(tab))
-    key = _key(sub, N) * 2 + (~upper[fid])               # upper facets first within a face
+    sub = simp[:, combo_table(5, 3)].reshape(-1, 3)
+    fid = np.repeat(np.arange(nf), 10)
+    key = (sub @ np.array([2 * N * N, 2 * N, 2])) + (~upper[fid])   # upper facets first
     order = np.argsort(key)
-    key, sub, fid = key[order] // 2, sub[order], fid[order]
-    start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    count = np.diff(np.r_[start, len(key)])
+    key, fid = key[order] // 2, fid[order]
+    start = np.flatnonzero(np.diff(key, prepend=-1))
+    count = np.diff(start, append=len(key))
     first = fid[start]
     if np.any(count[upper[first]] < 3):
         return None
-    keep = upper[first]
-    start = start[keep]
-    faces.append((sub[start], fid[start], fid[start[:, None] + np.arange(1, 3)]))
+    start, count = start[upper[first]], count[upper[first]]
+    face = np.full((len(start), 5), -1, dtype=np.intp)
+    face[:, :3] = sub[order[start]]
+    # Of the facets around each 2-face pick the two whose directions u_g (see below) are
+    # best conditioned: nearly coplanar neighbours give nearly parallel directions.
+    f2 = fid[start]
+    width = int(count.max()) if len(count) else 1
+    member = np.minimum(start[:, None] + np.arange(1, width), len(fid) - 1)
+    present = np.arange(1, width) < count[:, None]
+    g_all = np.where(present, fid[member], f2[:, None])
+    n_all = nP[g_all]                                             # (G, K, 5)
+    x2 = nP[f2, :4] / nP[f2, 4:5]
+    u_all = n_all[..., :4] - n_all[..., 4:5] * x2[:, None, :]
+    u_all /= np.linalg.norm(n_all, axis=2)[..., None]
+    len1 = np.linalg.norm(u_all, axis=2)
+    k1 = np.argmax(len1, axis=1)
+    rows2 = np.arange(len(f2))
+    e1 = u_all[rows2, k1] / np.maximum(len1[rows2, k1], 1e-300)[:, None]
+    perp = u_all - (u_all @ e1[:, :, None]) * e1[:, None, :]
+    k2 = np.argmax(np.linalg.norm(perp, axis=2), axis=1)
+    faces.append((face, f2, np.column_stack([g_all[rows2, k1], g_all[rows2, k2]])))
+    fallback: dict[int, list[np.ndarray]] = {}
     for face, f, g in faces:
+        # Stationary point of q + g_i on x_f + span(u_g): a 1x1 or 2x2 system in closed
+        # form (A = U J U', U the rows u_g; row sums by products with _ONES). Also the
+        # reduced Hessian's smallest eigenvalue on span(u_g), in an orthonormal basis.
         xf = nP[f, :4] / nP[f, 4:5]
-        m = g.shape[1]
-        U = nP[g, :4] - nP[g, 4:5] * xf[:, None, :]            # (M, m, 4)
-        A = np.einsum("mik,k,mjk->mij", U, _J, U)
-        rhs = -np.einsum("mik,mk->mi", U, _J * xf + 0.5 * P[face[:, 0], :4])
-        scale = np.einsum("mik,mik->m", U, U)
-        if m == 1:
-            det = A[:, 0, 0]
-            ok = np.abs(det) > 1e-12 * scale
-            t = rhs[ok] / det[ok, None]
+        c = _J * xf + 0.5 * P[face[:, 0], :4]             # gradient terms at x_f (any i)
+        u = nP[g[:, 0], :4] - nP[g[:, 0], 4:5] * xf
+        uu = u * u
+        a11, n1 = uu @ _J, uu @ _ONES
+        r1 = -((u * c) @ _ONES)
+        # Directions nearly lost to cancellation (nearly coplanar neighbouring facets) are
+        # solved by the general Lagrange kernel instead.
+        size_u = np.sqrt(n1) / np.linalg.norm(nP[g[:, 0]], axis=1)
+        if g.shape[1] == 1:
+            ok = (np.abs(a11) > 1e-12 * n1) & (size_u > FALLBACK_SIN)
+            x = xf[ok] + (r1[ok] / a11[ok])[:, None] * u[ok]
+            curvs.append(a11[ok] / n1[ok])
         else:
-            det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
-            ok = np.abs(det) > 1e-12 * scale ** 2
-            A, rhs, det = A[ok], rhs[ok], det[ok]
-            t = np.column_stack([A[:, 1, 1] * rhs[:, 0] - A[:, 0, 1] * rhs[:, 1],
-                                 A[:, 0, 0] * rhs[:, 1] - A[:, 1, 0] * rhs[:, 0]]) / det[:, None]
-        xs.append(xf[ok] + np.einsum("mi,mik->mk", t, U[ok]))
-        pad = np.full((int(ok.sum()), 5), -1, dtype=np.intp)
-        pad[:, :face.shape[1]] = face[ok]
-        subsets.append(pad)
+            v = nP[g[:, 1], :4] - nP[g[:, 1], 4:5] * xf
+            vv = v * v
+            a12, a22 = (u * v) @ _J, vv @ _J
+            r2 = -((v * c) @ _ONES)
+            det = a11 * a22 - a12 * a12
+            m2, g12 = vv @ _ONES, (u * v) @ _ONES
+            n2 = n1 + m2
+            size_v = np.sqrt(m2) / np.linalg.norm(nP[g[:, 1]], axis=1)
+            sin_uv = np.sqrt(np.maximum(m2 - g12 * g12 / np.maximum(n1, 1e-300), 0.0) /
+                             np.maximum(m2, 1e-300))
+            ok = ((np.abs(det) > 1e-12 * n2 * n2) & (size_u > FALLBACK_SIN)
+                  & (size_v > FALLBACK_SIN) & (sin_uv > FALLBACK_SIN))
+            t1 = (a22 * r1 - a12 * r2)[ok] / det[ok]
+            t2 = (a11 * r2 - a12 * r1)[ok] / det[ok]
+            x = xf[ok] + t1[:, None] * u[ok] + t2[:, None] * v[ok]
+            # Orthonormal basis (Gram-Schmidt) e1 = u / |u|, e2 ~ v - (v.e1) e1; closed-form
+            # 2 x 2 eigenvalue. Nearly parallel u, v lose digits: leave those (NaN) to the
+            # SVD-based reduced_hessian_min_eig.
+            n1, m2, g12, a11, a12, a22 = n1[ok], m2[ok], g12[ok], a11[ok], a12[ok], a22[ok]
+            s1 = g12 / n1                                    # n1 > 0 where ok
+            w2 = m2 - s1 * g12                               # |v - s1 u|^2
+            good = w2 > 1e-2 * m2
+            w2 = np.where(good, w2, 1.0)
+            h11 = a11 / n1
+            h12 = (a12 - s1 * a11) / np.sqrt(n1 * w2)
+            h22 = (a22 - 2.0 * s1 * a12 + s1 * s1 * a11) / w2
+            half = 0.5 * (h11 - h22)
+            curv = 0.5 * (h11 + h22) - np.sqrt(half * half + h12 * h12)
+            curvs.append(np.where(good, curv, np.nan))
+        if not np.all(ok):
+            s_face = 5 - g.shape[1]
+            fallback.setdefault(s_face, []).append(face[~ok, :s_face])
+        xs.append(x)
+        subsets.append(face[ok])
+        sizes.append(np.full(len(x), 5 - g.shape[1], dtype=np.intp))
     subset = np.vstack(subsets)
     x = np.vstack(xs)
-    size = (subset >= 0).sum(axis=1)
     first = P[subset[:, 0]]
-    mu = np.einsum("mk,mk->m", first[:, :4], x) + first[:, 4]
-    depth2 = -(np.einsum("mk,k,mk->m", x, _J, x) + mu)
-    return Stationary(np.zeros(len(x), np.intp), subset, size, x, mu, depth2)
+    mu = (first[:, :4] * x) @ _ONES + first[:, 4]
+    sq = x * x
+    depth2 = -((sq[:, 0] + sq[:, 1]) - (sq[:, 2] + sq[:, 3]) + mu)
+    return Stationary(np.zeros(len(x), np.intp), subset, np.concatenate(sizes), x, mu, depth2,
+                      np.concatenate(curvs)), {s: np.vstack(v) for s, v in fallback.items()}
 
 
 def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
@@ -245,9 +313,10 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
         except QhullError:                             # pragma: no cover - last resort
             return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
     if d == 5 and not pairs:
-        stationary = _stationary_from_normals(P, hull, basis)
-        if stationary is not None:
-            return HullCandidates({}, True, stationary)
+        found = _stationary_from_normals(P, hull, basis)
+        if found is not None:
+            stationary, fallback = found
+            return HullCandidates(fallback, True, stationary)
     simplices = hull.simplices
     if up_in_hull:
         upper = hull.equations[:, :d] @ up > -1e-12

@@ -12,6 +12,10 @@ from ._kernel import (CURVATURE_TOL, STATUS_NOT_EQUILIBRIUM, STATUS_SADDLE, STAT
                       WEIGHT_TOL, Frame, Solved, in_hull_2d, reduced_hessian_min_eig)
 
 
+#: Candidates whose weights all exceed this pass the paper's projection test unchecked.
+INSIDE_WEIGHT = 1e-6
+
+
 @dataclass
 class Classified:
     """Final solutions, flat over formations, in output order.
@@ -29,11 +33,32 @@ class Classified:
     status: np.ndarray
 
 
-def _row_keys(form: np.ndarray, taut: np.ndarray) -> np.ndarray:
-    packed = np.packbits(taut, axis=1)
-    keys = np.ascontiguousarray(np.concatenate(
-        [form.astype(">i8").view(np.uint8).reshape(-1, 8), packed], axis=1))
-    return keys.view(np.dtype((np.void, keys.shape[1]))).ravel()
+def _output_order(form: np.ndarray, taut: np.ndarray, tsize: np.ndarray,
+                  prefer: np.ndarray) -> np.ndarray:
+    """One row per (formation, taut set), in output order.
+
+    Rows are sorted by formation, number of taut cables, then taut set (ascending index
+    lists compare like the bit strings of ``~taut``, most significant bit first). Among
+    rows with the same key the first one with ``prefer`` set wins, else the first one.
+    Returns the chosen row indices, in output order.
+    """
+    first = np.argsort(~prefer, kind="stable")
+    M, N = taut.shape
+    if N <= 40 and (int(form.max()) + 1) * (N + 1) < 1 << (62 - N):
+        # Small teams: the same key packed into one integer; stable sort, first of each run.
+        code = (~taut[first]) @ (1 << np.arange(N - 1, -1, -1, dtype=np.int64))
+        key = (form[first] * (N + 1) + tsize[first]) << N | code
+        order = np.argsort(key, kind="stable")
+        key = key[order]
+        head = np.ones(M, dtype=bool)
+        np.not_equal(key[1:], key[:-1], out=head[1:])
+        return first[order[head]]
+    keys = np.concatenate([form[first].astype(">i8").view(np.uint8).reshape(M, 8),
+                           tsize[first].astype(">i4").view(np.uint8).reshape(M, 4),
+                           np.packbits(~taut[first], axis=1)], axis=1)
+    keys = np.ascontiguousarray(keys).view(np.dtype((np.void, keys.shape[1]))).ravel()
+    _, pick = np.unique(keys, return_index=True)       # stable: first occurrence wins
+    return first[pick]
 
 
 def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: np.ndarray
@@ -79,73 +104,69 @@ def _min_eig_family(frame: Frame, f: int, idx: np.ndarray) -> float:
 
 
 def classify(frame: Frame, solved: Solved, taut: np.ndarray,
-             projection_checked: np.ndarray | None = None) -> Classified:
+             projection_checked: np.ndarray | None = None,
+             curvature: np.ndarray | None = None) -> Classified:
     """Turn candidate solutions (already feasible: pieces maximal, depth real, object
     above ground) into the final, de-duplicated, classified solution list.
 
     Steps: keep one solution per (formation, taut set), preferring one whose candidate
-    *is* the taut set; apply the paper's projection test; compute weights (unique
+    *is* the taut set, in output order; apply the paper's projection test; compute weights (unique
     when the taut set is affinely independent, otherwise by LP/QP); status from the
     weights' signs and the reduced Hessian; sort by formation, taut-set size, taut set.
     ``projection_checked`` (M,) marks rows that already passed the projection test on
-    their exact taut set.
+    their exact taut set; ``curvature`` (M,) holds rows' reduced-Hessian eigenvalues
+    already known (NaN where not).
     """
     N = taut.shape[1]
-    tsize = taut.sum(axis=1)
-    if len(tsize) == 0:
+    if len(taut) == 0:
         return _empty(N)
-    keys = _row_keys(solved.form, taut)
-    _, inverse = np.unique(keys, return_inverse=True)
-    inverse = inverse.ravel()
-    is_rare = (tsize != solved.size).astype(np.int8)
-    order = np.lexsort((is_rare, inverse))
-    first_mask = np.ones(len(order), dtype=bool)
-    first_mask[1:] = inverse[order][1:] != inverse[order][:-1]
-    pick = order[first_mask]
-    sol = solved.take(pick)
-    taut = taut[pick]
-    tsize = tsize[pick]
-    is_rare = is_rare[pick].astype(bool)
-
-    width = int(tsize.max())
-    cols, inside = taut_indices(taut, tsize, width)
-    pts = frame.R[sol.form[:, None], np.minimum(cols, N - 1)]
+    tsize = taut.sum(axis=1)
+    pick = _output_order(solved.form, taut, tsize, tsize == solved.size)
+    taut, tsize = taut[pick], tsize[pick]
+    form, subset = solved.form[pick], solved.subset[pick]
+    is_rare = tsize != solved.size[pick]
+    ro = solved.x[pick, :2]
+    w = solved.w[pick]
+    members = subset >= 0
+    min_w = np.where(members, w, np.inf).min(axis=1, initial=np.inf)
     paper_ok = tsize >= 3
     todo = paper_ok if projection_checked is None else paper_ok & ~projection_checked[pick]
+    # r_o = sum w_i r_i over the candidate's robots (a subset of the taut ones): with
+    # every weight clearly positive it lies inside their polygon, the test can only pass.
+    todo = todo & ~(min_w > INSIDE_WEIGHT)
     if np.any(todo):
-        paper_ok[todo] = in_hull_2d(pts[todo], inside[todo], sol.ro[todo])
-    sol = sol.take(paper_ok)
-    taut, tsize, is_rare = taut[paper_ok], tsize[paper_ok], is_rare[paper_ok]
+        todo = np.flatnonzero(todo)
+        if np.any(is_rare[todo]):
+            cols, inside = taut_indices(taut[todo], tsize[todo], int(tsize[todo].max()))
+        else:                                     # the candidates are the taut sets
+            cols, inside = subset[todo], members[todo]
+        paper_ok[todo] = in_hull_2d(frame.R[form[todo, None], np.clip(cols, 0, N - 1)],
+                                    inside, ro[todo])
+    if not paper_ok.all():
+        pick, taut, tsize, is_rare = pick[paper_ok], taut[paper_ok], tsize[paper_ok], is_rare[paper_ok]
+        form, subset, members = form[paper_ok], subset[paper_ok], members[paper_ok]
+        w, min_w = w[paper_ok], min_w[paper_ok]
+    x = solved.x[pick]
     K = len(tsize)
     weights = np.zeros((K, N))
-    min_w = np.empty(K)
-    min_eig = np.empty(K)
-    common = np.flatnonzero(~is_rare)
-    if len(common):
-        rows = np.repeat(common, 5)
-        cols = sol.subset[common].ravel()
-        valid = cols >= 0
-        weights[rows[valid], cols[valid]] = sol.w[common].ravel()[valid]
-        min_w[common] = np.where(sol.subset[common] >= 0, sol.w[common], np.inf).min(axis=1)
-        min_eig[common] = reduced_hessian_min_eig(frame, sol.form[common], sol.subset[common])
+    rows = np.nonzero(members)[0]
+    weights[rows, subset[members]] = w[members]
+    # Curvature decides stable vs saddle only: not needed where a weight is negative
+    # (not an equilibrium) nor for rare rows (their own computation below).
+    min_eig = np.full(K, np.nan) if curvature is None else curvature[pick]
+    unknown = np.flatnonzero(np.isnan(min_eig) & (min_w >= -WEIGHT_TOL) & ~is_rare)
+    if len(unknown):
+        min_eig[unknown] = reduced_hessian_min_eig(frame, form[unknown], subset[unknown])
     for k in np.flatnonzero(is_rare):
         idx = np.flatnonzero(taut[k])
-        w, t_star = _weights_family(frame, int(sol.form[k]), idx, sol.ro[k], sol.vo[k])
-        weights[k, idx] = w
-        min_w[k] = t_star
-        min_eig[k] = _min_eig_family(frame, int(sol.form[k]), idx)
+        weights[k] = 0.0
+        weights[k, idx], min_w[k] = _weights_family(frame, int(form[k]), idx, x[k, :2], x[k, 2:])
+        min_eig[k] = _min_eig_family(frame, int(form[k]), idx)
     status = np.where(min_w < -WEIGHT_TOL, STATUS_NOT_EQUILIBRIUM,
                       np.where(min_eig > CURVATURE_TOL, STATUS_STABLE, STATUS_SADDLE)
                       ).astype(np.int8)
-
-    # Output order: formation, number of taut cables, taut set (lexicographic).
-    width = int(tsize.max()) if K else 0
-    sorted_idx = taut_indices(taut, tsize, width)[0]
-    order = np.lexsort(tuple(sorted_idx[:, c] for c in range(width - 1, -1, -1))
-                       + (tsize, sol.form))
-    sol = sol.take(order)
-    return Classified(sol.form, taut[order], sol.ro, sol.vo,
-                      np.sqrt(sol.depth2), weights[order], status[order])
+    return Classified(form, taut, x[:, :2], x[:, 2:], np.sqrt(solved.depth2[pick]), weights,
+                      status)
 
 
 def taut_indices(taut: np.ndarray, tsize: np.ndarray, width: int

@@ -36,8 +36,10 @@ import numpy as np
 
 #: Cable ``j`` counts as taut when :math:`L_j^2 - l_j^2 \\ge -` this (in sheet-size^2 units).
 TAUT_TOL = 1e-9
-#: Weights above ``-WEIGHT_TOL`` count as non-negative (weights are dimensionless, sum 1).
-WEIGHT_TOL = 1e-9
+#: Weights above ``-WEIGHT_TOL`` count as non-negative (weights are dimensionless shares of
+#: the load, sum 1). Ten times ``TAUT_TOL``: where the taut set changes, a cable that is
+#: taut only within ``TAUT_TOL`` carries a weight of that order and either sign.
+WEIGHT_TOL = 1e-8
 #: Reduced-Hessian eigenvalues above this count as positive (dimensionless).
 CURVATURE_TOL = 1e-9
 #: Relative determinant (|det K| / prod of row norms) below which a candidate's Lagrange
@@ -54,6 +56,12 @@ STATUS_NAMES = ("stable", "saddle", "not_equilibrium")
 
 # Reduced Hessian of q, up to the factor 2 (does not change signs).
 _H = np.array([1.0, 1.0, -1.0, -1.0])
+# Columns and signs of the 3 x 3 minors giving the null vector of a 3 x 4 matrix.
+_MINOR_COLS = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+_MINOR_SIGN = np.array([1.0, -1.0, 1.0, -1.0])
+_ONES4 = np.ones(4)
+# Offset (from N) of the augmented-table row standing for an unused slot 2, 3 or 4.
+_UNUSED_SLOT = np.arange(5) - 2
 
 
 @dataclass(frozen=True)
@@ -63,8 +71,14 @@ class Frame:
     ``R`` (B, N, 2) robots, ``V`` (N, 2) vertices, ``z`` hold height, all divided by
     ``scale``; ``r_centre`` (B, 2) and ``v_centre`` (2,) were subtracted before scaling.
     ``P`` (B, N, 5) are the lifted points :math:`(\\mathbf{a}_i, b_i)` and ``b`` (B, N).
-    ``gram`` (B, N, N) is :math:`G_{ij} = 2(\\mathbf{r}_i\\cdot\\mathbf{r}_j -
-    \\mathbf{v}_i\\cdot\\mathbf{v}_j)`.
+
+    Two augmented tables let :func:`solve_candidates` assemble every padded 6 x 6 Lagrange
+    system with a single gather: ``kaug`` (B, N + 4, N + 4) holds the Gram matrix
+    :math:`G_{ij} = 2(\\mathbf{r}_i\\cdot\\mathbf{r}_j - \\mathbf{v}_i\\cdot\\mathbf{v}_j)`
+    bordered by indices ``N .. N + 2`` (up to three unused slots: identity rows and
+    columns) and index ``N + 3`` (the constraint :math:`\\sum w_i = 1`: ones against
+    real indices); ``baug`` (B, N + 4) the matching right-hand side (``b``, 0, 0, 0, 1).
+    ``X`` (B, N + 3, 4) holds :math:`(\\mathbf{r}_i, \\mathbf{v}_i)` and three zero rows.
     """
 
     R: np.ndarray
@@ -75,23 +89,42 @@ class Frame:
     scale: float
     b: np.ndarray
     P: np.ndarray
-    gram: np.ndarray
+    kaug: np.ndarray
+    baug: np.ndarray
+    X: np.ndarray
+
+    @property
+    def gram(self) -> np.ndarray:
+        """(B, N, N) Gram matrix :math:`G` (a view of ``kaug``)."""
+        N = self.b.shape[1]
+        return self.kaug[:, :N, :N]
 
     @classmethod
     def build(cls, vertices: np.ndarray, formations: np.ndarray, hold_height: float,
               scale: float) -> "Frame":
         v_centre = vertices.mean(axis=0)
         r_centre = formations.mean(axis=1)
-        V = (vertices - v_centre) / scale
-        R = (formations - r_centre[:, None, :]) / scale
-        b = np.einsum("bnk,bnk->bn", R, R) - np.einsum("nk,nk->n", V, V)[None, :]
-        B, N = b.shape
+        B, N = formations.shape[:2]
+        X = np.zeros((B, N + 3, 4))
+        X[:, :N, :2] = formations - r_centre[:, None, :]
+        X[:, :N, 2:] = vertices - v_centre
+        X[:, :N] /= scale
+        R, V = X[:, :N, :2], X[0, :N, 2:]
+        sq = X * X
+        b = (sq[:, :N, 0] + sq[:, :N, 1]) - (sq[:, :N, 2] + sq[:, :N, 3])
         P = np.empty((B, N, 5))
-        P[..., :2] = -2.0 * R
-        P[..., 2:4] = 2.0 * V
+        P[..., :4] = X[:, :N] * np.array([-2.0, -2.0, 2.0, 2.0])
         P[..., 4] = b
-        gram = 2.0 * (R @ R.transpose(0, 2, 1) - (V @ V.T)[None])
-        return cls(R, V, hold_height / scale, r_centre, v_centre, scale, b, P, gram)
+        kaug = np.zeros((B, N + 4, N + 4))
+        kaug[:, :N, :N] = 2.0 * (R @ R.transpose(0, 2, 1) - (V @ V.T)[None])
+        unused = np.arange(N, N + 3)
+        kaug[:, unused, unused] = 1.0
+        kaug[:, :N, N + 3] = 1.0
+        kaug[:, N + 3, :N] = 1.0
+        baug = np.zeros((B, N + 4))
+        baug[:, :N] = b
+        baug[:, N + 3] = 1.0
+        return cls(R, V, hold_height / scale, r_centre, v_centre, scale, b, P, kaug, baug, X)
 
 
 @dataclass
@@ -99,9 +132,9 @@ class Solved:
     """Stationary points of candidate sets (flat over all candidates of all sizes).
 
     ``form`` (M,) formation index; ``subset`` (M, 5) robot indices padded with -1;
-    ``size`` (M,); ``w`` (M, 5) weights padded with 0; ``mu`` (M,); ``ro``, ``vo`` (M, 2);
-    ``depth2`` (M,) normalised :math:`d^2`; ``source`` (M,) position of the candidate in
-    its size group's input.
+    ``size`` (M,); ``w`` (M, 5) weights padded with 0; ``mu`` (M,); ``x`` (M, 4) the point
+    :math:`(\\mathbf{r}_o, \\mathbf{v}_o)` (``ro``, ``vo`` are views of it); ``depth2``
+    (M,) normalised :math:`d^2`; ``source`` (M,) position of the candidate in its input.
     """
 
     form: np.ndarray
@@ -109,22 +142,30 @@ class Solved:
     size: np.ndarray
     w: np.ndarray
     mu: np.ndarray
-    ro: np.ndarray
-    vo: np.ndarray
+    x: np.ndarray
     depth2: np.ndarray
     source: np.ndarray
 
-    FIELDS = ("form", "subset", "size", "w", "mu", "ro", "vo", "depth2", "source")
+    FIELDS = ("form", "subset", "size", "w", "mu", "x", "depth2", "source")
+
+    @property
+    def ro(self) -> np.ndarray:
+        return self.x[:, :2]
+
+    @property
+    def vo(self) -> np.ndarray:
+        return self.x[:, 2:]
 
     def take(self, keep: np.ndarray) -> "Solved":
         return Solved(*(getattr(self, f)[keep] for f in self.FIELDS))
 
     @classmethod
     def concat(cls, parts: list["Solved"]) -> "Solved":
+        if len(parts) == 1:
+            return parts[0]
         if not parts:
-            z2 = np.zeros((0, 2))
             return cls(np.zeros(0, np.intp), np.zeros((0, 5), np.intp), np.zeros(0, np.intp),
-                       np.zeros((0, 5)), np.zeros(0), z2, z2.copy(), np.zeros(0),
+                       np.zeros((0, 5)), np.zeros(0), np.zeros((0, 4)), np.zeros(0),
                        np.zeros(0, np.intp))
         return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.FIELDS))
 
@@ -171,24 +212,83 @@ def solve_candidates(frame: Frame, form: np.ndarray, idx: np.ndarray, *,
     reduced Hessian where the paper's Lemma 1 fails) are dropped: an affinely independent
     subset spanning the same face is always among the candidates as well.
     """
-    if len(form) == 0:
+    M = len(form)
+    if M == 0:
         return Solved.concat([])
-    source = np.arange(len(form))
-    valid = idx >= 0
-    size = valid.sum(axis=1)
-    ii = np.where(valid, idx, 0)
-    Rs = frame.R[form[:, None], ii] * valid[..., None]          # (M, 5, 2), 0 when unused
-    Vs = frame.V[ii] * valid[..., None]
-    K = np.zeros((len(form), 6, 6))
-    K[:, :5, :5] = frame.gram[form[:, None, None], ii[:, :, None], ii[:, None, :]]
-    K[:, :5, :5] *= valid[:, :, None] & valid[:, None, :]
-    K[:, :5, 5] = valid
-    K[:, 5, :5] = valid
-    diag = np.arange(5)
-    K[:, diag, diag] += ~valid
-    rhs = np.zeros((len(form), 6))
-    rhs[:, :5] = np.where(valid, frame.b[form[:, None], ii], 0.0)
-    rhs[:, 5] = 1.0
+    B, N = frame.b.shape
+    n2 = N + 4
+    J = _slots(idx, N)
+    if B > 1:
+        J += (form * n2)[:, None]
+    K = frame.kaug.reshape(-1)[(J * n2)[:, :, None] + (J % n2)[:, None, :]]
+    rhs = frame.baug.reshape(-1)[J]
+    # Unused slots gather zero rows of X.
+    XJ = frame.X.reshape(-1, 4)[J[:, :5] - (J[:, :5] // n2)] if B > 1 else frame.X[0][J[:, :5]]
+    ok, sol = _screen_and_solve(K, rhs, independent)
+    return _stationary_points(ok, sol, XJ, form, idx)
+
+
+def solve_table(frame: Frame, table: np.ndarray, forms: slice = slice(None), *,
+                independent: bool = False) -> Solved:
+    """:func:`solve_candidates` for the same candidate ``table`` (C, 5) in each formation
+    of the range ``forms`` (rows formation-major). The systems are gathered by
+    broadcasting the small table over the formations, without (B * C, 6, 6) index arrays.
+    Large blocks are solved per set size ``s`` at their own size ``s + 1`` (the padding
+    changes neither the determinant nor the row norms of the screen; suspects get their
+    condition number from the padded 6 x 6 form, as in :func:`solve_candidates`)."""
+    first, stop, _ = forms.indices(frame.b.shape[0])
+    B, N, C = stop - first, frame.b.shape[1], len(table)
+    if B * C <= 0:
+        return Solved.concat([])
+    J = _slots(table, N)
+    XJ = frame.X[first:stop, J[:, :5]].reshape(B * C, 5, 4)
+    if B == 1:
+        form, idx = np.full(C, first, dtype=np.intp), table
+    else:
+        form = np.repeat(np.arange(first, stop), C)
+        idx = np.broadcast_to(table, (B, C, 5)).reshape(B * C, 5)
+    if independent or B * C < PER_SIZE_MIN:
+        K = frame.kaug[first:stop, J[:, :, None], J[:, None, :]].reshape(B * C, 6, 6)
+        rhs = frame.baug[first:stop, J].reshape(B * C, 6)
+        ok, sol = _screen_and_solve(K, rhs, independent)
+        return _stationary_points(ok, sol, XJ, form, idx)
+    sizes = (table >= 0).sum(axis=1)
+    ok = np.empty((B, C), dtype=bool)
+    sol = np.zeros((B, C, 6))
+    for size in np.unique(sizes):
+        cols = np.flatnonzero(sizes == size)            # contiguous: rows sorted by size
+        a, e, n = cols[0], cols[-1] + 1, size + 1
+        Js = np.concatenate([J[a:e, :size], J[a:e, 5:]], axis=1)
+        K = frame.kaug[first:stop, Js[:, :, None], Js[:, None, :]].reshape(-1, n, n)
+        rhs = frame.baug[first:stop, Js].reshape(-1, n)
+        ok_s, sol_s = _screen_and_solve(K, rhs, False)
+        ok[:, a:e] = ok_s.reshape(B, e - a)
+        sol[:, a:e, :size] = sol_s[:, :size].reshape(B, e - a, size)
+        sol[:, a:e, 5] = sol_s[:, size].reshape(B, e - a)
+    return _stationary_points(ok.reshape(-1), sol.reshape(-1, 6), XJ, form, idx)
+
+
+#: solve_table solves per set size from this many systems on (fewer LAPACK flops; more
+#: calls).
+PER_SIZE_MIN = 4096
+
+
+def _slots(idx: np.ndarray, N: int) -> np.ndarray:
+    """Rows of the augmented tables (see Frame) for each candidate's 6 slots: member
+    ``i`` -> ``i``, an unused slot ``j`` (always j >= 2) -> ``N + j - 2``, the last slot
+    -> the constraint row ``N + 3``."""
+    J = np.empty((len(idx), 6), dtype=np.intp)
+    J[:, :5] = np.where(idx >= 0, idx, _UNUSED_SLOT + N)
+    J[:, 5] = N + 3
+    return J
+
+
+def _screen_and_solve(K: np.ndarray, rhs: np.ndarray, independent: bool
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Solve the systems ``K`` (M, n, n) ``[w, mu] = rhs`` (M, n) (n <= 6: a candidate's
+    members and its constraint row, possibly padded to 6) and flag the non-singular ones
+    (policy of :func:`solve_candidates`). ``K`` is overwritten where singular."""
+    ok = None
     if independent:
         try:
             sol = np.linalg.solve(K, rhs[..., None])[..., 0]
@@ -197,23 +297,42 @@ def solve_candidates(frame: Frame, form: np.ndarray, idx: np.ndarray, *,
         else:
             ok = np.all(np.abs(sol) < 1e9, axis=1)
     if not independent:
-        # Cheap screen by the determinant, then the condition number for the suspects.
+        # Cheap screen by the determinant, then the condition number for the suspects
+        # (of the 6 x 6 padded form: identity rows and columns for unused slots).
         det = np.linalg.det(K)
-        ok = np.abs(det) > SINGULAR_RTOL * np.prod(np.linalg.norm(K, axis=2), axis=1)
+        ok = np.abs(det) > SINGULAR_RTOL * np.prod(np.sqrt(np.einsum("mij,mij->mi", K, K)),
+                                                   axis=1)
         suspect = np.flatnonzero(~ok)
         if len(suspect):
-            ok[suspect] = np.linalg.cond(K[suspect]) < MAX_CONDITION
-        sol = np.zeros((len(form), 6))
-        sol[ok] = np.linalg.solve(K[ok], rhs[ok][..., None])[..., 0]
-    if not np.all(ok):
-        form, idx, size, source = form[ok], idx[ok], size[ok], source[ok]
-        Rs, Vs, sol = Rs[ok], Vs[ok], sol[ok]
+            n = K.shape[1]
+            padded = np.zeros((len(suspect), 6, 6))
+            padded[:, n:, n:] = np.eye(6 - n)
+            padded[:, :n, :n] = K[suspect]
+            ok[suspect] = np.linalg.cond(padded) < MAX_CONDITION
+        if not ok.all():
+            K[~ok] = np.eye(K.shape[1])        # singular: solved harmlessly, dropped later
+        sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+    return ok, sol
+
+
+def _stationary_points(ok: np.ndarray, sol: np.ndarray, XJ: np.ndarray, form: np.ndarray,
+                       idx: np.ndarray) -> Solved:
+    """Keep the solved candidates flagged ``ok`` and form their stationary points from
+    the padded solutions ``sol`` (M, 6) = (w, mu) and the members' ``(r_i, v_i)`` rows
+    ``XJ`` (M, 5, 4) (zero rows for unused slots)."""
+    M = len(sol)
+    source = None
+    if not ok.all():
+        source = np.flatnonzero(ok)
+        form, idx, XJ, sol = form[source], idx[source], XJ[source], sol[source]
     w = sol[:, :5]
     mu = sol[:, 5]
-    ro = np.einsum("ms,msk->mk", w, Rs)
-    vo = np.einsum("ms,msk->mk", w, Vs)
-    depth2 = -(np.einsum("mk,mk->m", ro, ro) - np.einsum("mk,mk->m", vo, vo) + mu)
-    return Solved(form, idx, size, w, mu, ro, vo, depth2, source)
+    x = np.matmul(w[:, None, :], XJ)[:, 0]                      # sum_j w_j (r_j, v_j)
+    sq = x * x
+    depth2 = -((sq[:, 0] + sq[:, 1]) - (sq[:, 2] + sq[:, 3]) + mu)
+    size = (idx >= 0).sum(axis=1)
+    return Solved(form, idx, size, w, mu, x, depth2,
+                  np.arange(M) if source is None else source)
 
 
 def height_ok(frame: Frame, depth2: np.ndarray | Solved) -> np.ndarray:
@@ -224,7 +343,14 @@ def height_ok(frame: Frame, depth2: np.ndarray | Solved) -> np.ndarray:
 
 
 def taut_masks(frame: Frame, solved: Solved, chunk: int = 1 << 24) -> tuple[np.ndarray, np.ndarray]:
-    """Maximiser sets of the pieces at each solution.
+    """Maximiser sets of the pieces at each solution (see :func:`maximiser_masks`)."""
+    return maximiser_masks(frame, solved.form, solved.x, solved.mu, chunk)
+
+
+def maximiser_masks(frame: Frame, form: np.ndarray, x: np.ndarray, mu: np.ndarray,
+                    chunk: int = 1 << 24) -> tuple[np.ndarray, np.ndarray]:
+    """Maximiser sets of the pieces at points ``x`` (M, 4) of formations ``form`` (M,)
+    where the candidate's pieces take the value ``mu`` (M,).
 
     Returns
     -------
@@ -234,29 +360,32 @@ def taut_masks(frame: Frame, solved: Solved, chunk: int = 1 << 24) -> tuple[np.n
     taut : ndarray of bool, shape (M, N)
         Cables whose :math:`g_j` is within ``TAUT_TOL`` of the maximum (the exact taut set).
     """
-    M = len(solved.form)
+    M = len(form)
     B, N = frame.b.shape
+    if B == 1 and M * N <= chunk // 8:
+        P = frame.P[0]
+        excess = x @ P[:, :4].T + (P[:, 4] - mu[:, None])
+        return excess.max(axis=1, initial=-np.inf) <= TAUT_TOL, excess >= -TAUT_TOL
     ok = np.zeros(M, dtype=bool)
     taut = np.zeros((M, N), dtype=bool)
-    x = np.hstack([solved.ro, solved.vo])
     if B > 1 and 4 * M * N <= chunk:
         # Many small formations: gather each candidate's lifted points (one pass).
-        excess = (np.einsum("mnk,mk->mn", frame.P[solved.form, :, :4], x)
-                  + frame.b[solved.form] - solved.mu[:, None])
+        excess = np.matmul(frame.P[form, :, :4], x[:, :, None])[..., 0]
+        excess += frame.b[form] - mu[:, None]
         return excess.max(axis=1, initial=-np.inf) <= TAUT_TOL, excess >= -TAUT_TOL
     if B == 1:
         groups = [np.arange(M)]
     else:
-        order = np.argsort(solved.form, kind="stable")
-        groups = np.split(order, np.flatnonzero(np.diff(solved.form[order])) + 1)
+        order = np.argsort(form, kind="stable")
+        groups = np.split(order, np.flatnonzero(np.diff(form[order])) + 1)
     step = max(1, chunk // (8 * N))
     for rows in groups:
         if len(rows) == 0:
             continue
-        Pf = frame.P[solved.form[rows[0]]]
+        Pf = frame.P[form[rows[0]]]
         for start in range(0, len(rows), step):
             r = rows[start:start + step]
-            excess = x[r] @ Pf[:, :4].T + (Pf[:, 4] - solved.mu[r, None])
+            excess = x[r] @ Pf[:, :4].T + (Pf[:, 4] - mu[r, None])
             ok[r] = excess.max(axis=1, initial=-np.inf) <= TAUT_TOL
             taut[r] = excess >= -TAUT_TOL
     return ok, taut
@@ -270,17 +399,16 @@ def in_hull_2d(points: np.ndarray, valid: np.ndarray, p: np.ndarray) -> np.ndarr
     (Sec. III-A.3: the projection :math:`\\mathbf{r}_o` inside the taut robots' polygon).
     """
     d = points - p[:, None, :]
-    dist = np.linalg.norm(d, axis=2)
-    scale = np.max(np.where(valid, dist, 0.0), axis=1, initial=0.0)
-    coincide = np.any(valid & (dist <= 1e-12 * np.maximum(scale, 1.0)[:, None]), axis=1)
+    dist2 = d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]
+    scale2 = np.max(dist2, axis=1, where=valid, initial=1.0)     # max(scale, 1) squared
+    coincide = np.any(valid & (dist2 <= 1e-24 * scale2[:, None]), axis=1)
     ang = np.arctan2(d[..., 1], d[..., 0])
-    first = np.argmax(valid, axis=1)
-    ang = np.where(valid, ang, ang[np.arange(len(p)), first][:, None])
-    ang = np.sort(ang, axis=1)
-    gaps = np.diff(ang, axis=1)
-    wrap = 2 * np.pi - (ang[:, -1] - ang[:, 0])
-    max_gap = np.maximum(gaps.max(axis=1, initial=0.0), wrap)
-    return coincide | (max_gap <= np.pi + ANGLE_TOL)
+    # Unused slots repeat the row's first valid direction (no new gap); the last column
+    # closes the circle.
+    first = ang[np.arange(len(p)), np.argmax(valid, axis=1)]
+    ang = np.sort(np.where(valid, ang, first[:, None]), axis=1)
+    gaps = np.diff(ang, axis=1, append=ang[:, :1] + 2 * np.pi)
+    return coincide | (gaps.max(axis=1) <= np.pi + ANGLE_TOL)
 
 
 def reduced_hessian_min_eig(frame: Frame, form: np.ndarray, idx: np.ndarray) -> np.ndarray:
@@ -300,9 +428,25 @@ def reduced_hessian_min_eig(frame: Frame, form: np.ndarray, idx: np.ndarray) -> 
     idx, size = idx[rows], size[rows]
     A = frame.P[form[rows, None], np.maximum(idx, 0), :4]          # (m, 5, 4)
     D = (A[:, 1:, :] - A[:, :1, :]) * (idx[:, 1:, None] >= 0)      # unused rows -> 0
+    if size.min() == 4:
+        # One-dimensional tangent space: its direction n is the generalised cross
+        # product of the three differences (signed 3 x 3 minors); result n'Hn / n'n.
+        n = np.linalg.det(D[:, :3, _MINOR_COLS].transpose(0, 2, 1, 3)) * _MINOR_SIGN
+        nn = n * n
+        out[rows] = (nn @ _H) / (nn @ _ONES4)
+        return out
     _, _, vt = np.linalg.svd(D, full_matrices=True)                 # null space: last rows
+    if size.min() >= 3:
+        # Tangent space of dimension 1 or 2: the last two right singular vectors z1, z2;
+        # closed-form eigenvalues of the 2 x 2 restriction (or z2' H z2 alone).
+        Z = vt[:, 2:, :]
+        h = np.matmul(Z * _H, Z.transpose(0, 2, 1))                 # (m, 2, 2)
+        a, c, b = h[:, 0, 0], h[:, 1, 1], h[:, 0, 1]
+        half = 0.5 * (a - c)
+        out[rows] = np.where(size == 4, c, 0.5 * (a + c) - np.sqrt(half * half + b * b))
+        return out
     # Restrict the Hessian to the last (5 - size) right singular vectors.
-    Hr = np.einsum("mik,k,mjk->mij", vt, _H, vt)                   # (m, 4, 4)
+    Hr = np.matmul(vt * _H, vt.transpose(0, 2, 1))                  # (m, 4, 4)
     for s in np.unique(size):
         sel = size == s
         k = int(s) - 1

@@ -8,8 +8,11 @@ stable, saddle or not an equilibrium, and give each taut cable's share of the lo
 Methods (one interface, chosen by ``method``):
 
 ``"fast"`` (default)
-    Candidate taut sets from the upper convex hull of the lifted points (Qhull), solved
-    in one batch (DESIGN.md Sec. 2). Same solutions as Algorithm 1; O(N^2) candidates.
+    Candidate taut sets from the upper convex hull of the lifted points (Qhull), their
+    stationary points read off the facet normals (DESIGN.md Sec. 2). Same solutions as
+    Algorithm 1; O(N^2) candidates. Teams of at most ``SMALL_TEAM`` robots take every
+    small subset instead (as ``"subsets"``), one cached table solved for all formations
+    at once, which is cheaper there.
 ``"exhaustive"``
     Algorithm 1 as published: all :math:`\\sum_{k\\ge3}\\binom{N}{k}` taut sets, the rank
     test (eq. 5), the Lagrange solution (eqs. 10-15), the slack and height checks and the
@@ -21,18 +24,19 @@ Methods (one interface, chosen by ``method``):
 
 from __future__ import annotations
 
+import weakref
 from typing import Literal
 
 import numpy as np
 
 from .._validate import as_array, as_positive
 from ..errors import InvalidInputError
-from ._candidates import Stationary, all_small_subsets, hull_candidates
+from ._candidates import Stationary, hull_candidates, padded_small_subsets
 from ._finalize import Classified, classify
-from ._kernel import (STATUS_NAMES, Frame, Solved, height_ok, in_hull_2d, pad_groups,
-                      solve_candidates, taut_masks)
+from ._kernel import (STATUS_NAMES, STATUS_NOT_EQUILIBRIUM, Frame, Solved, height_ok,
+                      in_hull_2d, maximiser_masks, pad_groups, solve_candidates, solve_table)
 from .exhaustive import exhaustive_search, funnel_from
-from .model import Sheet, check_formation, check_formations, check_hold_height
+from .model import Sheet, check_formations, check_hold_height
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult
 
 __all__ = ["forward_kinematics", "forward_kinematics_batch", "Method", "METHODS"]
@@ -40,8 +44,14 @@ __all__ = ["forward_kinematics", "forward_kinematics_batch", "Method", "METHODS"
 Method = Literal["fast", "exhaustive", "subsets"]
 METHODS: tuple[str, ...] = ("fast", "exhaustive", "subsets")
 
-#: Up to this many robots every small subset is cheaper than a convex hull.
-SMALL_TEAM = 6
+#: Up to this many robots every small subset (N = 8: 182 candidates) is cheaper than a
+#: convex hull, for one formation and for batches alike (measured).
+SMALL_TEAM = 8
+#: Candidate systems solved per block when every formation shares one candidate table.
+TABLE_BLOCK = 65_536
+#: Hull candidates: run the maximiser scan before the projection test when it touches at
+#: most this many (candidate, cable) pairs (it is then cheaper than the projection test).
+SCAN_FIRST = 20_000
 
 
 def _check_sheet(sheet: Sheet) -> Sheet:
@@ -63,14 +73,37 @@ def _check_mass(mass: float | None) -> float | None:
     return None if mass is None else as_positive(mass, "mass")
 
 
+#: Squared sheet side lengths, shrunk by a relative 1e-12, per sheet (see _formations).
+_SIDES2: "weakref.WeakKeyDictionary[Sheet, np.ndarray]" = weakref.WeakKeyDictionary()
+
+
+def _formations(sheet: Sheet, formations: np.ndarray, field: str, single: bool) -> np.ndarray:
+    """``check_formation(s)`` with a fast path: formations whose robots are all clearly
+    closer than their sheet vertices (squared distances below the cached squared side
+    lengths) are accepted at once; anything else gets the full check, which decides
+    borderline cases and raises the usual errors. Returns shape (B, N, 2)."""
+    r = as_array(formations, field, ndim=2 if single else 3)
+    rb = r[None] if single else r
+    if rb.shape[1:] == (sheet.n, 2):
+        sides2 = _SIDES2.get(sheet)
+        if sides2 is None:
+            sides2 = _SIDES2[sheet] = sheet.side_lengths() ** 2 * (1.0 - 1e-12)
+        d = rb[:, :, None, :] - rb[:, None, :, :]
+        if np.all(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] <= sides2):
+            return rb
+    return check_formations(sheet, rb, field)
+
+
 def _candidates(frame: Frame, sheet: Sheet, method: str
-                ) -> tuple[dict[int, tuple[np.ndarray, np.ndarray]], bool, Stationary | None]:
-    """Candidate taut sets of every formation: groups for the Lagrange solver (with its
-    ``independent`` flag) and hull-derived stationary points (generic formations)."""
+                ) -> tuple[tuple[np.ndarray, np.ndarray] | np.ndarray | None, bool,
+                           Stationary | None]:
+    """Candidate taut sets of every formation for the Lagrange solver (with its
+    ``independent`` flag): ``(form, subset)``, or one ``subset`` table shared by every
+    formation; and hull-derived stationary points (generic formations)."""
     B, N = frame.b.shape
     pairs = sheet.has_collinear_vertices
     if method == "subsets" or N <= SMALL_TEAM:
-        return all_small_subsets(N, B, pairs), False, None
+        return padded_small_subsets(N, pairs), False, None
     per_size: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
     independent = True
     stationary: list[Stationary] = []
@@ -86,10 +119,12 @@ def _candidates(frame: Frame, sheet: Sheet, method: str
     groups = {s: (np.concatenate([f for f, _ in parts]), np.vstack([i for _, i in parts]))
               for s, parts in per_size.items()}
     merged = None
-    if stationary:
+    if len(stationary) == 1:
+        merged = stationary[0]
+    elif stationary:
         merged = Stationary(*(np.concatenate([getattr(p, f) for p in stationary])
-                              for f in ("form", "subset", "size", "x", "mu", "depth2")))
-    return groups, independent, merged
+                              for f in Stationary.FIELDS))
+    return (pad_groups(groups) if groups else None), independent, merged
 
 
 def _solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
@@ -99,36 +134,57 @@ def _solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
         solved, taut, counts = exhaustive_search(frame)
         return frame, classify(frame, solved, taut), counts
     groups, independent, stationary = _candidates(frame, sheet, method)
+    # Rows from the Lagrange solver first, then (hull path) those from the normals, which
+    # carry projection-test and curvature results (``None``: nothing known yet).
     parts: list[Solved] = []
     tauts: list[np.ndarray] = []
-    checked: list[np.ndarray] = []
-    if groups:
-        solved = solve_candidates(frame, *pad_groups(groups), independent=independent)
-        solved = solved.take(height_ok(frame, solved))
-        ok, taut = taut_masks(frame, solved)
-        parts.append(solved.take(ok))
-        tauts.append(taut[ok])
-        checked.append(np.zeros(int(ok.sum()), dtype=bool))
+    N = frame.R.shape[1]
+    if groups is not None:
+        if isinstance(groups, tuple):
+            chunks = [solve_candidates(frame, *groups, independent=independent)]
+        else:
+            # One table for all formations: solve in cache-sized blocks of formations.
+            step = max(1, TABLE_BLOCK // len(groups))
+            chunks = (solve_table(frame, groups, slice(b, b + step), independent=independent)
+                      for b in range(0, frame.b.shape[0], step))
+        for solved in chunks:
+            keep = np.flatnonzero(height_ok(frame, solved.depth2))
+            ok, taut = maximiser_masks(frame, solved.form[keep], solved.x[keep],
+                                       solved.mu[keep])
+            parts.append(solved.take(keep[ok]))
+            tauts.append(taut[ok])
+    done = curv = None
     if stationary is not None:
         # Points already known: filter first, then solve only the survivors for weights.
         # Generic hull: a face's exact taut set is its own vertex set, so the paper's
-        # projection test can run before the (costlier) maximiser scan.
+        # projection test on the face is final for most rows. Cheapest test first: the
+        # maximiser scan costs O(N) per row, the projection test O(1) but more calls.
         st = stationary
-        valid = st.subset >= 0
-        keep = height_ok(frame, st.depth2)
-        keep[keep] = in_hull_2d(frame.R[st.form[keep, None], np.maximum(st.subset[keep], 0)],
-                                valid[keep], st.x[keep, :2])
-        pre = Solved(st.form[keep], st.subset[keep], st.size[keep], st.x[keep, :0],
-                     st.mu[keep], st.x[keep, :2], st.x[keep, 2:], st.depth2[keep], keep)
-        ok, taut = taut_masks(frame, pre)
-        sv = solve_candidates(frame, pre.form[ok], pre.subset[ok])
+        keep = np.flatnonzero(height_ok(frame, st.depth2))
+        scan_first = len(keep) * N <= SCAN_FIRST
+        if scan_first:
+            ok, taut = maximiser_masks(frame, st.form[keep], st.x[keep], st.mu[keep])
+            keep, taut = keep[ok], taut[ok]
+        sub = st.subset[keep]
+        inside = in_hull_2d(frame.R[st.form[keep, None], np.maximum(sub, 0)], sub >= 0,
+                            st.x[keep, :2])
+        keep = keep[inside]
+        if scan_first:
+            taut = taut[inside]
+        else:
+            ok, taut = maximiser_masks(frame, st.form[keep], st.x[keep], st.mu[keep])
+            keep, taut = keep[ok], taut[ok]
+        sv = solve_candidates(frame, st.form[keep], st.subset[keep])
+        taut = taut[sv.source]
+        before = sum(len(t) for t in tauts)
+        done = np.concatenate([np.zeros(before, dtype=bool), taut.sum(axis=1) == sv.size])
+        curv = np.concatenate([np.full(before, np.nan), st.curvature[keep[sv.source]]])
         parts.append(sv)
-        tauts.append(taut[ok][sv.source])
-        checked.append(tauts[-1].sum(axis=1) == sv.size)
-    N = frame.R.shape[1]
+        tauts.append(taut)
     solved = Solved.concat(parts)
-    taut = np.vstack(tauts) if tauts else np.zeros((0, N), dtype=bool)
-    return frame, classify(frame, solved, taut, np.concatenate(checked) if checked else None), None
+    taut = tauts[0] if len(tauts) == 1 else (
+        np.vstack(tauts) if tauts else np.zeros((0, N), dtype=bool))
+    return frame, classify(frame, solved, taut, done, curv), None
 
 
 def _user_units(frame: Frame, sheet: Sheet, c: Classified, hold_height: float,
@@ -136,13 +192,17 @@ def _user_units(frame: Frame, sheet: Sheet, c: Classified, hold_height: float,
     """Positions in the caller's frame and units, tensions in N."""
     ro = c.ro * frame.scale + frame.r_centre[c.form]
     vo = c.vo * frame.scale + frame.v_centre
-    zo = hold_height - c.depth * frame.scale
-    obj = np.column_stack([ro, zo])
-    lengths = np.linalg.norm(frame.V[None, :, :] - c.vo[:, None, :], axis=2)   # normalised
+    obj = np.empty((len(ro), 3))
+    obj[:, :2] = ro
+    obj[:, 2] = hold_height - c.depth * frame.scale
+    d = frame.V[None, :, :] - c.vo[:, None, :]
+    lengths = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1])       # normalised
     tensions = None
     if mass is not None:
+        # Only equilibria have tensions: elsewhere the "tension" would be negative (a push).
         tensions = c.weights * (mass * GRAVITY) * lengths / c.depth[:, None]
-        tensions = np.where(c.taut, tensions, 0.0)
+        held = c.taut & (c.status != STATUS_NOT_EQUILIBRIUM)[:, None]
+        tensions = np.where(held, tensions, np.where(c.taut, np.nan, 0.0))
     return obj, vo, lengths * frame.scale, tensions
 
 
@@ -160,9 +220,9 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
     hold_height : float
         Height :math:`z_r` of all holding points above the ground (> 0), same unit.
     mass : float, optional
-        Object mass in kg; when given, cable tensions are reported in N (g = 9.81 m/s^2;
-        lengths must then be in metres only if you want tensions for a real sheet -- the
-        tension formula :math:`F_i = w_i m g L_i / d` is unit-free in length).
+        Object mass in kg; when given, each equilibrium's cable tensions are reported in
+        N (g = 9.81 m/s^2). The formula :math:`F_i = w_i m g L_i / d` (FK paper eq. 16
+        solved with the weights) uses only a ratio of lengths, so any length unit works.
     method : {"fast", "exhaustive", "subsets"}
         Algorithm (see module docstring). All return the same equilibria.
 
@@ -192,17 +252,22 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
     method = _check_method(method)
     mass = _check_mass(mass)
     z = check_hold_height(hold_height)
-    R = check_formation(sheet, formation)
-    frame, c, counts = _solve(sheet, R[None], z, method)
+    Rb = _formations(sheet, formation, "formation", single=True)
+    R = Rb[0]
+    frame, c, counts = _solve(sheet, Rb, z, method)
     obj, vo, lengths, tensions = _user_units(frame, sheet, c, z, mass)
+    # Per-equilibrium slices of the flat taut entries (row-major order of c.taut).
     rows, cols = np.nonzero(c.taut)
-    cuts = np.searchsorted(rows, np.arange(1, len(c.form)))
-    w = np.split(c.weights[rows, cols], cuts)
-    ln = np.split(lengths[rows, cols], cuts)
-    tn = np.split(tensions[rows, cols], cuts) if tensions is not None else [None] * len(w)
-    eqs = [Equilibrium(tuple(idx.tolist()), obj[k], vo[k], w[k], tn[k], ln[k],
-                       STATUS_NAMES[st])  # type: ignore[arg-type]
-           for k, (idx, st) in enumerate(zip(np.split(cols, cuts), c.status.tolist()))]
+    w = c.weights[rows, cols]
+    ln = lengths[rows, cols]
+    tn = tensions[rows, cols] if tensions is not None else None
+    ends = np.cumsum(c.taut.sum(axis=1)).tolist()
+    starts = [0] + ends[:-1]
+    idx = cols.tolist()
+    eqs = [Equilibrium(tuple(idx[a:e]), obj[k], vo[k], w[a:e],
+                       None if tn is None or st == STATUS_NOT_EQUILIBRIUM else tn[a:e],
+                       ln[a:e], STATUS_NAMES[st])  # type: ignore[arg-type]
+           for k, (a, e, st) in enumerate(zip(starts, ends, c.status.tolist()))]
     funnel = funnel_from(counts, len(eqs)) if counts is not None else None
     return FKResult(tuple(eqs), funnel, method, sheet, R, z, mass)
 
@@ -234,7 +299,7 @@ def forward_kinematics_batch(sheet: Sheet, formations: np.ndarray, hold_height: 
         raise InvalidInputError("method", "the batched form supports 'fast' and 'subsets'")
     mass = _check_mass(mass)
     z = check_hold_height(hold_height)
-    R = check_formations(sheet, as_array(formations, "formations", ndim=3))
+    R = _formations(sheet, formations, "formations", single=False)
     B, N = R.shape[:2]
     frame, c, _ = _solve(sheet, R, z, method)
     obj, vo, _, tensions = _user_units(frame, sheet, c, z, mass)

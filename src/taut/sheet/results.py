@@ -36,7 +36,8 @@ class Equilibrium:
         not an equilibrium of the model. Where more cables are taut than the state
         determines (e.g. Lemma 2), the minimum-norm non-negative weights are reported.
     tensions : ndarray, shape (k,), or None
-        Cable tensions :math:`F_i = w_i m g L_i / d` in newtons when a mass was given.
+        Cable tensions :math:`F_i = w_i m g L_i / d` in newtons when a mass was given and
+        the state is an equilibrium (None otherwise: no tensions can hold it there).
     cable_lengths : ndarray, shape (k,)
         Lengths :math:`l_i = |\\mathbf{v}_i - \\mathbf{v}_o|` of the taut cables.
     status : {"stable", "saddle", "not_equilibrium"}
@@ -152,7 +153,8 @@ class BatchFKResult:
     weights : ndarray, shape (B, K, N)
         Weight of each cable (0 for slack cables).
     tensions : ndarray, shape (B, K, N), or None
-        Tensions in N (0 for slack cables) when a mass was given.
+        Tensions in N (0 for slack cables, NaN for the taut cables of non-equilibria)
+        when a mass was given.
     status : ndarray of int8, shape (B, K)
         0 stable, 1 saddle, 2 not_equilibrium, -1 padding.
     """
@@ -191,7 +193,8 @@ class BatchFKResult:
                 object=self.object[b, k].copy(),
                 contact=self.contact[b, k].copy(),
                 weights=self.weights[b, k, idx].copy(),
-                tensions=None if self.tensions is None else self.tensions[b, k, idx].copy(),
+                tensions=(None if self.tensions is None or self.status[b, k] == 2
+                          else self.tensions[b, k, idx].copy()),
                 cable_lengths=np.linalg.norm(self.sheet.vertices[idx] - self.contact[b, k], axis=1),
                 status=STATUS_NAMES[int(self.status[b, k])],  # type: ignore[arg-type]
             ))
