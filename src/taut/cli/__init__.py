@@ -13,7 +13,7 @@ import typer
 from typer.exceptions import TyperException
 
 from ..errors import TautError
-from . import cdpr, fk, motion
+from . import cdpr, fk, motion, plan
 
 app = typer.Typer(
     name="taut",
@@ -33,7 +33,7 @@ def _root() -> None:
     ``taut: error: <field>: <problem>`` and exits with code 2."""
 
 
-for _module in (fk, motion, cdpr):
+for _module in (fk, motion, plan, cdpr):
     _module.register(app)
 
 EXIT_USAGE = 2

@@ -1,0 +1,170 @@
+"""Planning scenario files (YAML or JSON) for ``taut plan``.
+
+Schema (lengths in m, times in s, angles in rad; unknown keys are errors)::
+
+    name: paper corridor            # optional
+    free_space: [[0, -1], [6, -1], [6, 1], [0, 1]]   # simple polygon, the walls
+    obstacles:                      # optional list
+      - {id: "1", center: [2, 0], radius: 0.1, height: 0.1}     # cylinder
+      - {id: box, polygon: [[3, -.2], [3.3, -.2], [3.3, .1]], height: 0.4}
+    start: [0.8, 0]                 # object projection (x, y)
+    goal: [5.2, 0]
+    team:
+      sheet: [[x, y], ...]          # or: regular: {n: 3, circumradius: 0.577}
+      hold_height: 0.5
+      robot_radius: 0.15
+      height_safety: 0.05           # object above obstacles beneath and the ground
+      lateral_safety: 0.05          # robot footprint to walls and obstacles
+      speed: 0.1                    # m/s
+      rotation_speed: 0.3           # rad/s
+      mass: 0.17                    # optional, kg
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from ..errors import ScenarioError, TautError
+from ..plan.world import Obstacle, Scenario, Team, World
+from ..sheet.model import Sheet
+from .files import read_mapping, validate_mapping
+
+__all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]
+
+Point = tuple[float, float]
+_POS = {"gt": 0, "allow_inf_nan": False}
+_NONNEG = {"ge": 0, "allow_inf_nan": False}
+
+
+class _Regular(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    n: int = Field(ge=3)
+    circumradius: float = Field(**_POS)
+    phase: float = Field(default=0.0, allow_inf_nan=False)
+
+
+class _Team(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    sheet: list[Point] | None = None
+    regular: _Regular | None = None
+    hold_height: float = Field(**_POS)
+    robot_radius: float = Field(**_POS)
+    height_safety: float = Field(**_NONNEG)
+    lateral_safety: float = Field(**_NONNEG)
+    speed: float = Field(**_POS)
+    rotation_speed: float = Field(**_POS)
+    mass: float | None = Field(default=None, **_POS)
+
+    @model_validator(mode="after")
+    def _one_sheet(self):
+        if (self.sheet is None) == (self.regular is None):
+            raise ValueError("give exactly one of 'sheet' and 'regular'")
+        return self
+
+
+class _Obstacle(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    id: str | int
+    height: float = Field(**_POS)
+    center: Point | None = None
+    radius: float | None = Field(default=None, **_POS)
+    polygon: list[Point] | None = None
+
+    @model_validator(mode="after")
+    def _one_shape(self):
+        if (self.polygon is None) == (self.center is None):
+            raise ValueError("give either center and radius or a polygon")
+        if self.center is not None and self.radius is None:
+            raise ValueError("a circular obstacle needs a radius")
+        return self
+
+
+class _PlanFile(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    name: str | None = None
+    units: str | None = None
+    free_space: list[Point]
+    obstacles: list[_Obstacle] = []
+    start: Point
+    goal: Point
+    team: _Team
+
+
+def plan_scenario_from_mapping(data: dict) -> Scenario:
+    """Validate a parsed mapping into a :class:`~taut.plan.world.Scenario`.
+
+    Raises
+    ------
+    ScenarioError
+        Unknown, missing or mistyped keys; non-positive sizes or speeds; invalid polygons
+        or sheet (the field is the dotted path in the file).
+    PlanningError
+        Obstacles overlapping walls or each other; start or goal outside the free space or
+        inside an obstacle.
+    """
+    raw = validate_mapping(_PlanFile, data)
+    t = raw.team
+    try:
+        if t.sheet is not None:
+            sheet = Sheet(np.array(t.sheet, dtype=float))
+        else:
+            sheet = Sheet.regular(t.regular.n, t.regular.circumradius, phase=t.regular.phase)
+    except TautError as exc:
+        raise ScenarioError("team.sheet", exc.problem) from None
+    team = Team(sheet, t.hold_height, t.robot_radius, t.height_safety, t.lateral_safety,
+                t.speed, t.rotation_speed, t.mass)
+    obstacles = []
+    for k, o in enumerate(raw.obstacles):
+        try:
+            obstacles.append(Obstacle(str(o.id), o.height, center=o.center, radius=o.radius,
+                                      polygon=o.polygon))
+        except TautError as exc:
+            raise ScenarioError(f"obstacles[{k}]", exc.problem) from None
+    try:
+        world = World(np.array(raw.free_space, dtype=float), tuple(obstacles))
+    except ScenarioError:
+        raise
+    except TautError as exc:
+        if exc.field == "free_space":
+            raise ScenarioError("free_space", exc.problem) from None
+        raise
+    return Scenario(world, team, np.array(raw.start), np.array(raw.goal), raw.name)
+
+
+def load_plan_scenario(path: str | Path) -> Scenario:
+    """Read and validate a planning scenario file (see the module docstring)."""
+    return plan_scenario_from_mapping(read_mapping(path))
+
+
+def plan_scenario_to_mapping(scenario: Scenario) -> dict:
+    """The file mapping of a scenario (inverse of :func:`plan_scenario_from_mapping`)."""
+    team = scenario.team
+    obstacles = []
+    for o in scenario.world.obstacles:
+        item: dict = {"id": o.id, "height": float(o.height)}
+        if o.polygon is None:
+            item.update(center=[float(x) for x in o.center], radius=float(o.radius))
+        else:
+            item["polygon"] = [[float(x), float(y)] for x, y in o.polygon]
+        obstacles.append(item)
+    out = {
+        "name": scenario.name,
+        "free_space": [[float(x), float(y)] for x, y in scenario.world.free_space],
+        "obstacles": obstacles,
+        "start": [float(x) for x in scenario.start],
+        "goal": [float(x) for x in scenario.goal],
+        "team": {
+            "sheet": [[float(x), float(y)] for x, y in team.sheet.vertices],
+            "hold_height": team.hold_height, "robot_radius": team.robot_radius,
+            "height_safety": team.height_safety, "lateral_safety": team.lateral_safety,
+            "speed": team.speed, "rotation_speed": team.rotation_speed,
+        },
+    }
+    if team.mass is not None:
+        out["team"]["mass"] = team.mass
+    if scenario.name is None:
+        del out["name"]
+    return out

@@ -1,0 +1,23 @@
+"""Motion planning with obstacle crossing for sheet-carrying robot teams (planning paper,
+Hu et al., Sec. IV): world and team models, optimal formations (eqs. 11-15), the crossing
+motion (Algorithm 2), a global route search, verification by the quasi-static model, a
+bypass-only baseline and a seeded scenario suite."""
+
+from .baseline import plan_baseline
+from .crossing import CrossingRecord, Motion, motion_from_legs
+from .formation import (CostWeights, Formation, crossing_pairs, offset_crossings,
+                        optimal_formation)
+from .planner import plan
+from .result import PlanResult
+from .route import Leg, Route, find_route
+from .suite import generate_scenario, generate_suite
+from .verify import Verification, verify_motion
+from .world import Obstacle, Scenario, Team, World
+
+__all__ = [
+    "plan", "plan_baseline", "PlanResult",
+    "Obstacle", "World", "Team", "Scenario",
+    "Formation", "CostWeights", "optimal_formation", "crossing_pairs", "offset_crossings",
+    "Leg", "Route", "find_route", "Motion", "CrossingRecord", "motion_from_legs",
+    "Verification", "verify_motion", "generate_scenario", "generate_suite",
+]

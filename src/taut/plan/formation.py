@@ -1,0 +1,373 @@
+"""Optimal formation generation (planning paper Sec. IV-A, eqs. 11-15, rebuilt).
+
+Most symbols of eqs. (11)-(15) are lost in our copy of the paper; this is what we rebuilt
+from the prose, and why.
+
+Decision variables (the IK parameters of eq. 10): the contact point :math:`\\mathbf{v}_o`,
+the object height :math:`z_o`, one cable angle :math:`\\theta_i` per robot, the vertical load
+shares :math:`w_i` and an auxiliary radius :math:`\\bar R` bounding the formation. The object's
+projection is the formation's origin; robot ``i`` stands at
+:math:`\\mathbf{r}_i = \\rho_i(\\cos\\theta_i, \\sin\\theta_i)`,
+:math:`\\rho_i = \\sqrt{|\\mathbf{v}_i - \\mathbf{v}_o|^2 - (z_r - z_o)^2}` (eq. 10).
+
+Cost (eq. 11) :math:`J = J_t + J_p + J_c` with
+
+* transport, eq. (12): :math:`J_t = \\alpha_t \\overline{((\\rho_i - \\rho_i^0)/s)^2} +
+  \\beta_t \\sum_i (w_i - 1/N)^2`: stay close to the nominal all-taut formation
+  :math:`\\rho^0` (IK at the sheet centroid) and share the load evenly, so every robot
+  "participates in the handling" (the paper's motivation for all-taut cables);
+* passable area, eq. (13): :math:`J_p = \\alpha_p ((2\\bar R + 2\\delta_s) / W)^2`, the
+  formation's size about the object (an upper bound of eq. 1 that also covers rotating
+  about the object) relative to the free space's width ``W``;
+* crossing, eq. (14): :math:`J_c = \\alpha_c ((z_o - z_{req})/z_r)^2 + \\beta_c
+  \\overline{(D_{req}/|\\mathbf{r}_i - \\mathbf{r}_j|)^2}`: hold the object just at the needed
+  height (higher objects need wider formations) and keep every robot gap wide so the
+  obstacle can enter between any two robots ("cross in any direction").
+
+Constraints: (15b) :math:`h_{max} = z_o - \\delta_h \\ge h_{obs}` and
+:math:`D_{max} = d_{min} - 2\\delta_s \\ge D_{obs}` (eqs. 2-4); (15c) formation limits:
+every cable taut (:math:`\\rho_i` real), the exact equilibrium conditions of the IK module
+(:math:`\\sum w_i = 1`, :math:`\\sum w_i\\mathbf{v}_i = \\mathbf{v}_o`,
+:math:`\\sum w_i\\mathbf{r}_i = 0`, :math:`w_i \\ge w_{min}`, positive reduced-Hessian curvature
+for N <= 4), the sheet must not tear (:math:`|\\mathbf{r}_i - \\mathbf{r}_j| \\le
+|\\mathbf{v}_i - \\mathbf{v}_j|`), robots do not overlap (:math:`\\ge 2` radii), the object
+stays above the ground by :math:`\\delta_h` and at least ``MIN_DEPTH_FRACTION`` of
+:math:`z_r` below the hands, optionally the reach is bounded (eq. 13 as a hard limit).
+Solved with SciPy's SLSQP from the IK solution (``inverse_kinematics`` at the centroid
+contact); if SLSQP stalls, the lowest admissible IK formation is taken instead. A result
+is accepted only if forward kinematics (an independent solver) finds it as a stable
+all-taut equilibrium. Weights: :class:`CostWeights` (crossing height dominates, as the
+paper calls :math:`J_c` "the key item").
+
+Two uses: the *crossing* formation for obstacles up to a height and diameter, and the
+*compact* formation (no crossing term, large :math:`\\alpha_p`) for bypassing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize
+
+from ..errors import TautError
+from ..sheet.fk import forward_kinematics
+from ..sheet.geometry import formation_metrics
+from ..sheet.ik import ik_constraints, inverse_kinematics
+from .world import Team
+
+__all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
+           "offset_crossings", "MIN_DEPTH_FRACTION"]
+
+#: The object hangs at least this fraction of the holding height below the hands (a flat
+#: sheet would need unbounded tensions).
+MIN_DEPTH_FRACTION = 0.05
+#: Smallest load share a cable may carry in a planned formation.
+MIN_SHARE = 0.02
+
+
+@dataclass(frozen=True)
+class CostWeights:
+    """Weights of the rebuilt costs (eqs. 12-14; dimensionless)."""
+
+    transport: float = 1.0        # alpha_t
+    load_share: float = 1.0       # beta_t
+    passable: float = 1.0         # alpha_p
+    crossing_height: float = 10.0  # alpha_c
+    crossing_gap: float = 0.1     # beta_c
+
+
+#: Weights of the compact (bypassing) formation: size dominates.
+COMPACT = CostWeights(transport=0.1, load_share=0.1, passable=10.0, crossing_height=0.0,
+                      crossing_gap=0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class Formation:
+    """A rigid team formation holding the object stably with every cable taut.
+
+    Attributes
+    ----------
+    robots : ndarray, shape (N, 2)
+        Robot positions relative to the object's projection (the formation origin), m.
+    object_height : float
+        :math:`z_o`, m.
+    contact : ndarray, shape (2,)
+        :math:`\\mathbf{v}_o` in the sheet frame.
+    weights : ndarray, shape (N,)
+        Load shares :math:`w_i`.
+    kind : {"crossing", "compact"}
+    size : float
+        :math:`S_f` of eq. (1) with :math:`\\delta_s` the team's side safety, m.
+    max_height : float
+        :math:`h_{max}` of eq. (2), m.
+    min_distance : float
+        :math:`d_{min}` of eq. (3), m.
+    max_diameter : float
+        :math:`D_{max}` of eq. (4), m.
+    reach : float
+        Radius about the object of the disc holding every robot footprint plus the lateral
+        safety, m: the route keeps this disc off walls and non-crossed obstacles, and it is
+        what the formation sweeps when it rotates about the object.
+    cost : float
+        :math:`J` of eq. (11) at the optimum.
+    """
+
+    robots: np.ndarray
+    object_height: float
+    contact: np.ndarray
+    weights: np.ndarray
+    kind: str
+    size: float
+    max_height: float
+    min_distance: float
+    max_diameter: float
+    reach: float
+    cost: float
+
+    @property
+    def n(self) -> int:
+        return int(self.robots.shape[0])
+
+    def placed(self, centre: np.ndarray, heading: np.ndarray) -> np.ndarray:
+        """Robots (..., N, 2) with the object's projection at ``centre`` (..., 2) and the
+        formation turned by ``heading`` (...) radians."""
+        c, s = np.cos(heading)[..., None], np.sin(heading)[..., None]
+        x, y = self.robots[:, 0], self.robots[:, 1]
+        return np.stack([c * x - s * y, s * x + c * y], axis=-1) + np.asarray(centre)[..., None, :]
+
+
+def _hull_order(p: np.ndarray) -> np.ndarray:
+    return np.argsort(np.arctan2(p[:, 1], p[:, 0]))
+
+
+def crossing_pairs(formation: Formation, clearance: float) -> list[tuple[float, float, float]]:
+    """Entering/exiting sides through which an obstacle can pass under the object
+    (Algorithm 2's geometry, in the formation frame).
+
+    Sides are the gaps between robots adjacent in angle about the object. The obstacle's
+    centre enters along the ray from the object through the side's midpoint (for symmetric
+    formations that is the side's normal, as in the paper; the midpoint ray keeps it
+    farthest from both robots of the side), reaches the object, the formation turns about
+    it, and it leaves along the exiting side's ray. A side is usable when every robot stays
+    at least ``clearance`` (obstacle radius + robot radius + lateral safety) from its ray.
+
+    Returns
+    -------
+    list of (angle_in, angle_out, turn)
+        Directions (rad, formation frame) of the entering and exiting rays and the turn
+        :math:`\\Delta` (rad, counter-clockwise positive) made at the obstacle, sorted by
+        :math:`|\\Delta|`.
+    """
+    p = formation.robots
+    order = _hull_order(p)
+    mids = (p[order] + p[np.roll(order, -1)]) / 2
+    dirs = mids / np.linalg.norm(mids, axis=1)[:, None]
+    t = np.maximum(p @ dirs.T, 0.0)                         # (N robots, sides)
+    dist = np.linalg.norm(p[:, None, :] - t[..., None] * dirs[None], axis=2)
+    ok = np.flatnonzero(dist.min(axis=0) >= clearance)
+    ang = np.arctan2(dirs[:, 1], dirs[:, 0])
+    out = []
+    for i in ok:
+        for j in ok:
+            if i == j:
+                continue
+            turn = float(np.angle(np.exp(1j * (np.pi - (ang[j] - ang[i])))))
+            out.append((float(ang[i]), float(ang[j]), turn))
+    out.sort(key=lambda x: abs(x[2]))
+    return out
+
+
+def offset_crossings(formation: Formation, clearance: float, directions: int = 36
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Straight crossings at a fixed heading (our extension of Algorithm 2).
+
+    For a travel direction at angle :math:`\\varphi` in the formation frame, the obstacle's
+    centre moves relative to the formation along a line :math:`\\mathbf{n}\\cdot\\mathbf{q}
+    = e` (:math:`\\mathbf{n}` the left normal). It keeps ``clearance`` from every robot iff
+    :math:`|\\mathbf{n}\\cdot\\mathbf{r}_i - e| \\ge` ``clearance`` for all ``i``; offsets
+    strictly between the outermost robots make it pass under the sheet between two robots.
+    Algorithm 2's turn at the obstacle is then unnecessary, and the obstacle need not pass
+    under the object (useful beside walls). Returns, for each of ``directions`` angles,
+    the widest admissible offset interval.
+
+    Returns
+    -------
+    phi : ndarray, shape (K,)
+        Travel directions (rad, formation frame) that admit a crossing.
+    lo, hi : ndarray, shape (K,)
+        Offset interval :math:`[e_{lo}, e_{hi}]` of the obstacle's path from the object, m.
+    """
+    a = 2 * np.pi * np.arange(directions) / directions
+    n = np.column_stack([-np.sin(a), np.cos(a)])
+    proj = np.sort(formation.robots @ n.T, axis=0)          # (N, K)
+    lo = proj[:-1] + clearance
+    hi = proj[1:] - clearance
+    width = hi - lo
+    k = np.argmax(width, axis=0)
+    cols = np.arange(directions)
+    ok = width[k, cols] >= 0.0
+    return a[ok], lo[k, cols][ok], hi[k, cols][ok]
+
+
+def optimal_formation(team: Team, *, kind: str = "crossing", height: float = 0.0,
+                      diameter: float = 0.0, width: float | None = None,
+                      max_reach: float | None = None, weights: CostWeights | None = None
+                      ) -> Formation | None:
+    """Solve the rebuilt eq. (15) for one formation.
+
+    Parameters
+    ----------
+    team : Team
+    kind : {"crossing", "compact"}
+        ``compact``: minimise the size (bypassing); ``crossing``: eqs. 11-14 in full.
+    height : float
+        Tallest obstacle to cross, m (0: none); the object ends at least
+        ``height + team.height_safety`` high (15b).
+    diameter : float
+        Widest obstacle to cross, m: :math:`D_{max}` >= this (15b).
+    width : float, optional
+        Free-space width ``W`` normalising eq. (13), m (default 4 sheet sizes).
+    max_reach : float, optional
+        Hard bound on :attr:`Formation.reach`, m (e.g. half the corridor width): the
+        passable-area requirement of eq. (13) as a constraint (15c).
+    weights : CostWeights, optional
+
+    Returns
+    -------
+    Formation or None
+        None when no formation meets the constraints.
+    """
+    sheet, zr = team.sheet, team.hold_height
+    s = sheet.size
+    N = sheet.n
+    V = sheet.vertices / s
+    w_ref = (width if width is not None else 4 * s) / s
+    cw = weights or (COMPACT if kind == "compact" else CostWeights())
+    crossing = kind == "crossing" and height > 0
+    ds = team.side_safety / s
+    zr_n = zr / s
+    z_lo = max(height + team.height_safety if crossing else 0.0, team.height_safety,
+               1e-3 * zr) / s
+    z_hi = (1 - MIN_DEPTH_FRACTION) * zr_n
+    if z_lo > z_hi:
+        return None
+    sep = max(2 * team.robot_radius, (diameter + 2 * team.side_safety) if crossing else 0.0) / s
+    iu, ju = np.triu_indices(N, 1)
+    vd2 = np.sum((V[iu] - V[ju]) ** 2, axis=1) * (1 - 1e-6)
+    r_max = 1e6 if max_reach is None else (max_reach - team.clearance) / s
+
+    # Nominal all-taut formation (IK at the centroid contact) as start and reference.
+    start = None
+    for zo in np.linspace(z_lo, z_hi, 7) * s:
+        try:
+            ik = inverse_kinematics(sheet, [0.0, 0.0, zo], zr)
+        except TautError:
+            continue
+        start = ik
+        break
+    if start is None:
+        return None
+    rho0 = start.reach / s
+
+    def parts(z):
+        vo, zo, th, w, Rb = z[:2], z[2], z[3:3 + N], z[3 + N:3 + 2 * N], z[-1]
+        l2 = np.sum((V - vo) ** 2, axis=1)
+        d = zr_n - zo
+        rho = np.sqrt(np.maximum(l2 - d * d, 1e-12))
+        r = rho[:, None] * np.column_stack([np.cos(th), np.sin(th)])
+        return vo, zo, th, w, Rb, l2, d, rho, r
+
+    def cost(z):
+        vo, zo, th, w, Rb, l2, d, rho, r = parts(z)
+        jt = cw.transport * np.mean((rho - rho0) ** 2) + cw.load_share * np.sum((w - 1 / N) ** 2)
+        jp = cw.passable * ((2 * Rb + 2 * ds) / w_ref) ** 2
+        jc = 0.0
+        if crossing:
+            g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
+            jc = (cw.crossing_height * ((zo - z_lo) / zr_n) ** 2
+                  + cw.crossing_gap * np.mean(sep ** 2 / np.maximum(g2, 1e-12)))
+        return float(jt + jp + jc)
+
+    def eq(z):
+        vo, zo, th, w, Rb, l2, d, rho, r = parts(z)
+        return np.concatenate([[w.sum() - 1.0], w @ V - vo, w @ r])
+
+    def ineq(z):
+        vo, zo, th, w, Rb, l2, d, rho, r = parts(z)
+        g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
+        return np.concatenate([w - MIN_SHARE, l2 - d * d - 1e-6, vd2 - g2, g2 - sep ** 2,
+                               Rb ** 2 - rho ** 2, [zo - z_lo, z_hi - zo, r_max - Rb]])
+
+    cons = [{"type": "eq", "fun": eq}, {"type": "ineq", "fun": ineq}]
+    if N <= 4:
+        def curvature(z):
+            vo, zo, th, w = z[:2], z[2], z[3:3 + N], z[3 + N:3 + 2 * N]
+            try:
+                c = ik_constraints(sheet, [0.0, 0.0, zo * s], zr, th, w, contact=vo * s)
+            except TautError:
+                return np.array([-1.0])
+            k = float(np.min(c.curvature))
+            return np.array([-1.0 if np.isnan(k) else min(k, 1.0) - 1e-4])
+        cons.append({"type": "ineq", "fun": curvature})
+    def from_ik(ik) -> np.ndarray:
+        return np.concatenate([ik.contact / s, [ik.object[2] / s], ik.angles, ik.weights,
+                               [ik.reach.max() / s * 1.01]])
+
+    def admissible(z) -> bool:
+        return bool(np.abs(eq(z)).max() <= 1e-7 and ineq(z).min() >= -1e-7)
+
+    try:
+        res = minimize(cost, from_ik(start), method="SLSQP", constraints=cons,
+                       options={"maxiter": 200, "ftol": 1e-10})
+        z = res.x
+    except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - defensive
+        z = np.full(3 + 2 * N + 1, np.nan)
+    if np.all(np.isfinite(z)) and admissible(z):
+        out = _finish(team, z, N, s, cost(z), kind)
+        if out is not None:
+            return out
+    # Fallback when SLSQP stalls: the lowest admissible nominal IK formation (the
+    # smallest one that meets every constraint), without the cost's refinements.
+    for zo in np.linspace(z_lo, z_hi, 25) * s:
+        try:
+            z = from_ik(inverse_kinematics(sheet, [0.0, 0.0, zo], zr))
+        except TautError:
+            continue
+        if admissible(z):
+            out = _finish(team, z, N, s, cost(z), kind)
+            if out is not None:
+                return out
+    return None
+
+
+def _finish(team: Team, z: np.ndarray, N: int, s: float, cost: float, kind: str
+            ) -> Formation | None:
+    """Re-derive the formation exactly from (v_o, z_o, angles) and accept it only when
+    forward kinematics finds it as a stable all-taut equilibrium."""
+    sheet, zr = team.sheet, team.hold_height
+    vo, zo, th = z[:2] * s, z[2] * s, z[3:3 + N]
+    try:
+        c = ik_constraints(sheet, [0.0, 0.0, zo], zr, th, contact=vo)
+    except TautError:
+        return None
+    robots = c.formation
+    try:
+        fk = forward_kinematics(sheet, robots, zr)
+    except TautError:
+        return None
+    target = np.array([0.0, 0.0, zo])
+    match = [e for e in fk.stable if len(e.taut) == N
+             and np.linalg.norm(e.object - target) <= 1e-6 * s]
+    if not match:
+        return None
+    e = match[0]
+    m = formation_metrics(robots, margin=team.side_safety, object_height=e.height,
+                          height_margin=team.height_safety)
+    reach = float(np.linalg.norm(robots - e.object[:2], axis=1).max()) + team.clearance
+    robots = robots - e.object[:2]
+    robots.setflags(write=False)
+    w = np.zeros(N)
+    w[list(e.taut)] = e.weights
+    return Formation(robots, e.height, e.contact, w, kind, m.size, float(m.max_obstacle_height),
+                     m.min_distance, m.max_obstacle_diameter, reach, float(cost))

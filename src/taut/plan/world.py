@@ -1,0 +1,271 @@
+"""World and team models of the obstacle-crossing planner (planning paper, Sec. II and V).
+
+The world is a planar free-space polygon (corridors, rooms, turns; walls are its boundary)
+holding obstacles that stand on the ground, each a circle (a cylinder) or a polygon (a prism)
+with a height. The team is the sheet with its ``N`` robots and the physical and motion
+parameters of the paper's experiment. Every model is immutable and validated when built;
+lengths in metres, times in seconds, angles in radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+from shapely.geometry import Point, Polygon
+
+from .._validate import as_array, as_nonnegative, as_points, as_positive
+from ..errors import InvalidInputError, PlanningError
+from ..sheet.model import Sheet, check_hold_height
+
+__all__ = ["Obstacle", "World", "Team", "Scenario", "CIRCLE_SEGMENTS"]
+
+#: Segments per quarter circle used to turn a circular obstacle into a shapely polygon
+#: (the polygon is circumscribed, so it contains the true circle).
+CIRCLE_SEGMENTS = 16
+
+
+def _circle_polygon(centre: np.ndarray, radius: float) -> Polygon:
+    """Polygon containing the disc: vertices on the circle of radius ``r / cos(pi / n)``."""
+    n = 4 * CIRCLE_SEGMENTS
+    r_out = radius / np.cos(np.pi / n)
+    t = (np.arange(n) + 0.5) * 2 * np.pi / n
+    return Polygon(np.column_stack([centre[0] + r_out * np.cos(t), centre[1] + r_out * np.sin(t)]))
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacle:
+    """An obstacle standing on the ground.
+
+    Parameters
+    ----------
+    id : str
+        Name used in plans (``crossed``/``bypassed`` lists).
+    height : float
+        Height above the ground, m (> 0).
+    center, radius : array_like (2,), float
+        A cylinder (give both, and no ``polygon``).
+    polygon : array_like, shape (K, 2)
+        A prism with this simple footprint, K >= 3 (give it instead of a circle).
+
+    Attributes
+    ----------
+    geometry : shapely.Polygon
+        Footprint (circles as a circumscribed 64-gon).
+    mec_center : ndarray, shape (2,)
+        Centre of the footprint's minimum enclosing circle (the circle's centre).
+    mec_radius : float
+        Its radius, m (for a circle, the circumscribed polygon's, 0.03 % larger than
+        ``radius``); the obstacle "diameter" of the paper's eq. (4) is twice this.
+    """
+
+    id: str
+    height: float
+    center: np.ndarray | None = None
+    radius: float | None = None
+    polygon: np.ndarray | None = None
+    geometry: Polygon = field(init=False, repr=False)
+    mec_center: np.ndarray = field(init=False, repr=False)
+    mec_radius: float = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        f = f"obstacle {self.id!r}"
+        object.__setattr__(self, "id", str(self.id))
+        object.__setattr__(self, "height", as_positive(self.height, f"{f}.height"))
+        if (self.polygon is None) == (self.center is None):
+            raise InvalidInputError(f, "give either center and radius (a cylinder) or a "
+                                       "polygon, not both or neither")
+        if self.polygon is None:
+            c = as_array(self.center, f"{f}.center", shape=(2,))
+            if self.radius is None:
+                raise InvalidInputError(f"{f}.radius", "required for a circular obstacle")
+            r = as_positive(self.radius, f"{f}.radius")
+            geom = _circle_polygon(c, r)
+            object.__setattr__(self, "center", c)
+            object.__setattr__(self, "radius", r)
+            mc, mr = c, r / np.cos(np.pi / (4 * CIRCLE_SEGMENTS))
+        else:
+            if self.radius is not None:
+                raise InvalidInputError(f"{f}.radius", "not allowed with a polygon")
+            pts = as_points(self.polygon, f"{f}.polygon", min_count=3)
+            geom = Polygon(pts)
+            if not geom.is_valid or not geom.area > 0:
+                raise InvalidInputError(f"{f}.polygon", "must be a simple polygon with "
+                                                        "positive area")
+            mec = shapely.minimum_bounding_circle(geom)
+            mc = np.array(mec.centroid.coords[0])
+            mr = float(shapely.minimum_bounding_radius(geom))
+            object.__setattr__(self, "polygon", pts)
+        object.__setattr__(self, "geometry", geom)
+        object.__setattr__(self, "mec_center", mc)
+        object.__setattr__(self, "mec_radius", float(mr))
+
+    @property
+    def diameter(self) -> float:
+        """Diameter of the minimum enclosing circle, m (obstacle size in eq. 4 / 15b)."""
+        return 2.0 * self.mec_radius
+
+
+@dataclass(frozen=True, eq=False)
+class World:
+    """Free space and obstacles.
+
+    Parameters
+    ----------
+    free_space : array_like, shape (M, 2)
+        Simple polygon (m) in which everything happens; its boundary is the walls.
+    obstacles : sequence of Obstacle
+        Each must lie strictly inside the free space, with unique ids, not overlapping.
+
+    Raises
+    ------
+    InvalidInputError
+        Malformed polygon.
+    PlanningError
+        An obstacle overlaps a wall or another obstacle, or two share an id.
+    """
+
+    free_space: np.ndarray
+    obstacles: tuple[Obstacle, ...] = ()
+    geometry: Polygon = field(init=False, repr=False)
+    _width: float = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        pts = as_points(self.free_space, "free_space", min_count=3)
+        geom = Polygon(pts)
+        if not geom.is_valid or not geom.area > 0:
+            raise InvalidInputError("free_space", "must be a simple polygon with positive "
+                                                  "area (no self-intersections)")
+        obs = tuple(self.obstacles)
+        seen: set[str] = set()
+        for k, o in enumerate(obs):
+            if not isinstance(o, Obstacle):
+                raise InvalidInputError(f"obstacles[{k}]", "must be an Obstacle")
+            if o.id in seen:
+                raise PlanningError(f"obstacles[{k}].id", f"id {o.id!r} is used twice")
+            seen.add(o.id)
+            if not geom.contains(o.geometry):
+                raise PlanningError(f"obstacles[{k}]", f"obstacle {o.id!r} overlaps the walls "
+                                    "(it must lie strictly inside the free space)")
+            for j in range(k):
+                if obs[j].geometry.intersects(o.geometry):
+                    raise PlanningError(f"obstacles[{k}]", f"obstacle {o.id!r} overlaps "
+                                        f"obstacle {obs[j].id!r}")
+        pts.setflags(write=False)
+        object.__setattr__(self, "free_space", pts)
+        object.__setattr__(self, "obstacles", obs)
+        object.__setattr__(self, "geometry", geom)
+        radius = shapely.maximum_inscribed_circle(geom, 1e-3 * np.sqrt(geom.area)).length
+        object.__setattr__(self, "_width", 2.0 * float(radius))
+
+    def obstacle(self, oid: str) -> Obstacle:
+        """The obstacle with this id."""
+        for o in self.obstacles:
+            if o.id == oid:
+                return o
+        raise KeyError(oid)
+
+    @property
+    def width(self) -> float:
+        """A passage-width scale, m: twice the largest inscribed-circle radius of the free
+        space (used only to normalise and bound the passable-area term of eq. 13)."""
+        return self._width
+
+
+@dataclass(frozen=True, eq=False)
+class Team:
+    """A sheet-carrying robot team (planning paper Sec. II-A and V-A).
+
+    Parameters
+    ----------
+    sheet : Sheet
+        The sheet; robot ``i`` holds vertex ``i`` (metres).
+    hold_height : float
+        Holding height :math:`z_r`, m (> 0).
+    robot_radius : float
+        Radius of each robot's footprint, m (> 0).
+    height_safety : float
+        :math:`\\delta_h` of eq. (2): the object stays this far above any obstacle beneath
+        the sheet, and above the ground, m (>= 0).
+    lateral_safety : float
+        Extra clearance between a robot's footprint and any obstacle or wall, m (>= 0).
+        The paper's side safety distance of eqs. (1) and (4) is
+        :math:`\\delta_s` = ``robot_radius + lateral_safety`` (its robots are particles).
+    speed : float
+        Constant translational speed of the formation, m/s (> 0).
+    rotation_speed : float
+        Constant rotation speed of the formation about the object, rad/s (> 0).
+    mass : float, optional
+        Object mass, kg (only for reporting tensions).
+    """
+
+    sheet: Sheet
+    hold_height: float
+    robot_radius: float
+    height_safety: float
+    lateral_safety: float
+    speed: float
+    rotation_speed: float
+    mass: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.sheet, Sheet):
+            raise InvalidInputError("sheet", "must be a taut.sheet.Sheet")
+        object.__setattr__(self, "hold_height", check_hold_height(self.hold_height))
+        for name in ("robot_radius", "speed", "rotation_speed"):
+            object.__setattr__(self, name, as_positive(getattr(self, name), name))
+        for name in ("height_safety", "lateral_safety"):
+            object.__setattr__(self, name, as_nonnegative(getattr(self, name), name))
+        if self.mass is not None:
+            object.__setattr__(self, "mass", as_positive(self.mass, "mass"))
+
+    @property
+    def n(self) -> int:
+        """Number of robots."""
+        return self.sheet.n
+
+    @property
+    def side_safety(self) -> float:
+        """:math:`\\delta_s` of eqs. (1) and (4): robot radius plus lateral safety, m."""
+        return self.robot_radius + self.lateral_safety
+
+    @property
+    def clearance(self) -> float:
+        """Least distance from a robot's centre to any obstacle or wall, m."""
+        return self.robot_radius + self.lateral_safety
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A planning problem: move the object's projection from ``start`` to ``goal``.
+
+    Raises
+    ------
+    PlanningError
+        Start or goal outside the free space or inside (or on) an obstacle.
+    """
+
+    world: World
+    team: Team
+    start: np.ndarray
+    goal: np.ndarray
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.world, World):
+            raise InvalidInputError("world", "must be a World")
+        if not isinstance(self.team, Team):
+            raise InvalidInputError("team", "must be a Team")
+        for name in ("start", "goal"):
+            p = as_array(getattr(self, name), name, shape=(2,))
+            pt = Point(p)
+            if not self.world.geometry.contains(pt):
+                raise PlanningError(name, f"({p[0]:.6g}, {p[1]:.6g}) is outside the free "
+                                    "space")
+            for o in self.world.obstacles:
+                if o.geometry.intersects(pt):
+                    raise PlanningError(name, f"({p[0]:.6g}, {p[1]:.6g}) is inside obstacle "
+                                        f"{o.id!r}")
+            p.setflags(write=False)
+            object.__setattr__(self, name, p)

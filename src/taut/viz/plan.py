@@ -1,0 +1,138 @@
+"""Figures of transport plans, after the planning paper's Figs. 8-10: top view with paths
+and obstacles, object height over time against the obstacles beneath it, entering/exiting
+side angles during crossings, inter-robot distances; and an animated GIF."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import shapely  # noqa: E402
+from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
+from matplotlib.patches import Circle  # noqa: E402
+from matplotlib.patches import Polygon as PolygonPatch  # noqa: E402
+
+from ..plan.result import PlanResult  # noqa: E402
+from ..plan.world import Scenario  # noqa: E402
+
+__all__ = ["plot_plan", "animate_plan", "draw_world"]
+
+
+def draw_world(ax, scenario: Scenario) -> None:
+    """Walls and obstacles (shade by height, labelled with id and height)."""
+    fs = scenario.world.free_space
+    ax.add_patch(PolygonPatch(fs, closed=True, fill=False, lw=1.5, ec="k"))
+    hmax = max([o.height for o in scenario.world.obstacles] + [scenario.team.hold_height])
+    for o in scenario.world.obstacles:
+        xy = np.asarray(o.geometry.exterior.coords)
+        ax.add_patch(PolygonPatch(xy, closed=True, fc=plt.cm.Greys(0.3 + 0.6 * o.height / hmax),
+                                  ec="k", lw=0.5))
+        ax.annotate(f"{o.id}\n{o.height:.2f} m", o.mec_center, ha="center", va="center",
+                    fontsize=7, color="tab:red")
+    ax.plot(*scenario.start, "go")
+    ax.plot(*scenario.goal, "r*", ms=10)
+    ax.set_aspect("equal")
+    pad = 0.2
+    ax.set_xlim(fs[:, 0].min() - pad, fs[:, 0].max() + pad)
+    ax.set_ylim(fs[:, 1].min() - pad, fs[:, 1].max() + pad)
+
+
+def _beneath(scenario: Scenario, r: PlanResult) -> np.ndarray:
+    """Height of the tallest obstacle beneath the sheet per sample (0 when none), m."""
+    hulls = shapely.convex_hull(shapely.multipoints(r.robots))
+    out = np.zeros(len(r.times))
+    for o in scenario.world.obstacles:
+        out = np.where(shapely.intersects(hulls, o.geometry), np.maximum(out, o.height), out)
+    return out
+
+
+def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
+    """Four-panel summary figure of a successful plan (PNG/PDF by extension)."""
+    r = result
+    fig, axs = plt.subplots(2, 2, figsize=(12, 8))
+    ax = axs[0, 0]
+    draw_world(ax, scenario)
+    for i in range(r.robots.shape[1]):
+        ax.plot(r.robots[:, i, 0], r.robots[:, i, 1], lw=0.8, label=f"robot {i + 1}")
+    ax.plot(r.object[:, 0], r.object[:, 1], "k--", lw=1, label="object")
+    step = max(1, len(r.times) // 12)
+    for t in range(0, len(r.times), step):
+        ax.add_patch(PolygonPatch(r.robots[t], closed=True, fill=False, ec="tab:blue",
+                                  lw=0.4, alpha=0.6))
+    ax.set_title(f"top view: crossed {list(r.crossed)}, {r.duration:.1f} s")
+    ax.legend(fontsize=6, loc="upper right")
+    ax = axs[0, 1]
+    ax.plot(r.times, r.object[:, 2], label="object height (model)")
+    ax.fill_between(r.times, 0, _beneath(scenario, r), color="0.6", step="mid",
+                    label="obstacle beneath the sheet")
+    ax.axhline(scenario.team.hold_height, color="k", ls=":", lw=0.8, label="hold height")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("height [m]")
+    ax.legend(fontsize=7)
+    ax.set_title("object height vs obstacles")
+    ax = axs[1, 0]
+    for c in r.crossings:
+        sel = (r.times >= c.times[0]) & (r.times <= c.times[4])
+        ent = np.degrees(np.angle(np.exp(1j * (r.heading[sel] + c.entering - c.direction))))
+        ext = np.degrees(np.angle(np.exp(1j * (r.heading[sel] + c.exiting - c.direction
+                                               - np.pi))))
+        ax.plot(r.times[sel], ent, label=f"{c.obstacle}: entering side")
+        ax.plot(r.times[sel], ext, "--", label=f"{c.obstacle}: exiting side")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("angle to travel axis [deg]")
+    ax.set_title("entering/exiting sides during crossings")
+    if r.crossings:
+        ax.legend(fontsize=7)
+    ax = axs[1, 1]
+    n = r.robots.shape[1]
+    iu, ju = np.triu_indices(n, 1)
+    d = np.linalg.norm(r.robots[:, iu] - r.robots[:, ju], axis=2)
+    for k in range(len(iu)):
+        ax.plot(r.times, d[:, k], lw=0.8, label=f"|r{iu[k] + 1} - r{ju[k] + 1}|")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("distance [m]")
+    ax.set_title("inter-robot distances")
+    ax.ticklabel_format(axis="y", useOffset=False)
+    lo, hi = float(d.min()), float(d.max())
+    pad = max(0.05 * (hi - lo), 0.02 * max(hi, 1e-9))      # rigid formations: flat lines
+    ax.set_ylim(lo - pad, hi + pad)
+    if len(iu) <= 10:
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def animate_plan(scenario: Scenario, result: PlanResult, path: str | Path, *,
+                 frames: int = 80, fps: int = 12) -> None:
+    """Animated GIF of the transport (top view: sheet, robot footprints, object; the
+    title gives the time and the object's height), written with Pillow."""
+    r = result
+    idx = np.unique(np.linspace(0, len(r.times) - 1, frames).round().astype(int))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    draw_world(ax, scenario)
+    sheet = PolygonPatch(r.robots[0], closed=True, fc="tab:blue", alpha=0.25, ec="tab:blue")
+    ax.add_patch(sheet)
+    bots = [Circle(p, scenario.team.robot_radius, fc="tab:blue", alpha=0.6)
+            for p in r.robots[0]]
+    for c in bots:
+        ax.add_patch(c)
+    obj = ax.scatter([r.object[0, 0]], [r.object[0, 1]], s=40, c="tab:orange", zorder=5)
+    title = ax.set_title("")
+
+    def update(k: int):
+        t = idx[k]
+        sheet.set_xy(r.robots[t])
+        for c, p in zip(bots, r.robots[t]):
+            c.center = tuple(p)
+        obj.set_offsets(r.object[t, :2][None])
+        title.set_text(f"t = {r.times[t]:.1f} s, object height {r.object[t, 2]:.3f} m")
+        return (sheet, *bots, obj, title)
+
+    anim = FuncAnimation(fig, update, frames=len(idx), blit=False)
+    anim.save(str(path), writer=PillowWriter(fps=fps))
+    plt.close(fig)
