@@ -168,8 +168,11 @@ def test_footprint_checks_on_random_polygons(pts, flip):
         return
     poly = arr[hull.vertices]                          # counter-clockwise
     edges = np.linalg.norm(np.roll(poly, -1, axis=0) - poly, axis=1)
-    if hull.volume < 1e-3 or edges.min() < 1e-6 * np.ptp(poly, axis=0).max():
-        return                                         # near-degenerate: may be refused
+    span = np.ptp(poly, axis=0).max()
+    e = np.roll(poly, -1, axis=0) - poly
+    turns = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
+    if hull.volume < 1e-3 or edges.min() < 1e-6 * span or turns.min() < 1e-9 * span ** 2:
+        return                      # near-degenerate (tiny area, edge or turn): may be refused
     poly = poly[::-1] if flip else poly
     got = check_footprint(poly, "f")
     assert {tuple(p) for p in got} == {tuple(p) for p in poly}

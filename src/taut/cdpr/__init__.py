@@ -1,7 +1,9 @@
 """Cable-driven parallel robots on fixed frames and mobile bases (FASTKIT paper, §3-4):
 validated models, cable kinematics and the wrench matrix (eq. 18), tension distribution
 (eqs. 17, 20), tipping constraints of mobile bases (eqs. 21-23), the exact available wrench
-set (eq. 24) with axis capacities and capacity margins, and wrench-feasible workspaces.
+set (eq. 24) with axis capacities and capacity margins, wrench-feasible workspaces;
+first-order kinematics of mobile bases and cables (eqs. 1-9), the exact available twist set
+(eqs. 10-16), redundancy resolution and deployment planning of the bases.
 
 All quantities are SI (m, kg, N, rad), float64; batched functions take a leading axis of B
 poses ``(x, y, z, roll, pitch, yaw)``.
@@ -12,6 +14,11 @@ from .kinematics import (CableState, as_poses, cable_state, gravity_wrench,
 from .model import Base, Cable, CableRobot, Payload, Platform, check_footprint, with_stabilisers
 from .tension import METHODS, TensionResult, distribute_tensions
 from .tipping import TippingResult, tipping_moments
+from .deploy import DeploymentResult, place_bases, plan_deployment, workspace_box
+from .redundancy import OBJECTIVES, RedundancyResult, resolve_redundancy
+from .twist import (MODES, TWIST_LABELS, AvailableTwistSet, FirstOrderModel, MotionLimits,
+                    TwistCapacities, available_twist_set, fastkit_motion_limits,
+                    first_order_model, twist_capacities)
 from .workspace import WorkspaceResult, grid_points, wrench_feasible_workspace
 from .wrench_set import (AXIS_LABELS, AvailableWrenchSet, AxisCapacities, available_wrench_set,
                          axis_capacities, capacity_margin, disturbance_box, wrench_feasible)
@@ -25,4 +32,9 @@ __all__ = [
     "WorkspaceResult", "grid_points", "wrench_feasible_workspace",
     "AXIS_LABELS", "AvailableWrenchSet", "AxisCapacities", "available_wrench_set",
     "axis_capacities", "capacity_margin", "disturbance_box", "wrench_feasible",
+    "MODES", "TWIST_LABELS", "AvailableTwistSet", "FirstOrderModel", "MotionLimits",
+    "TwistCapacities", "available_twist_set", "fastkit_motion_limits", "first_order_model",
+    "twist_capacities",
+    "OBJECTIVES", "RedundancyResult", "resolve_redundancy",
+    "DeploymentResult", "place_bases", "plan_deployment", "workspace_box",
 ]

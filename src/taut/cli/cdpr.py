@@ -22,6 +22,7 @@ from ..cdpr import (available_wrench_set, axis_capacities, capacity_margin,
 from ..cdpr.model import CableRobot
 from ..errors import InvalidInputError
 from ..io.cdpr_model import load_cdpr_model
+from .cdpr_motion import add_commands
 
 __all__ = ["register"]
 
@@ -234,7 +235,8 @@ def _workspace(model: str, grid, box, rpy, plot: Optional[Path], stabilisers: bo
 def register(app: typer.Typer) -> None:
     """Add the ``cdpr`` sub-app to the `taut` app."""
     sub = typer.Typer(help="Cable-driven parallel robots (fixed or on mobile bases): "
-                           "tensions, wrench sets, workspaces.", no_args_is_help=True)
+                           "tensions, wrench sets, workspaces, twist sets, deployment.",
+                      no_args_is_help=True)
 
     @sub.command("tensions")
     def tensions_cmd(
@@ -287,4 +289,5 @@ def register(app: typer.Typer) -> None:
         """Wrench-feasible workspace with and without tipping; coverage of the desired one."""
         _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep)
 
+    add_commands(sub)
     app.add_typer(sub, name="cdpr")

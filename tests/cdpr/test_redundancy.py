@@ -1,0 +1,92 @@
+"""Redundancy resolution of FASTKIT in task mode (active base + 8 cables, 11 joints)."""
+
+import numpy as np
+import pytest
+
+from taut.cdpr.redundancy import resolve_redundancy
+from taut.cdpr.twist import MotionLimits, first_order_model, twist_capacities
+from taut.errors import InvalidInputError
+
+POSE = np.array([0.3, 0.0, 1.0, 0.0, 0.0, 0.05])
+LO = np.r_[-0.2, -0.2, -0.2, np.full(8, -2.0)]
+HI = -LO
+
+
+def _check(fastkit, res, t, scale=1.0):
+    fom = first_order_model(fastkit, POSE)
+    assert np.all(res.q_dot >= LO - 1e-8) and np.all(res.q_dot <= HI + 1e-8)
+    np.testing.assert_allclose(fom.A[0] @ (scale * t), fom.B[0] @ res.q_dot, atol=1e-8)
+    assert res.residual < 1e-8
+
+
+@pytest.mark.parametrize("objective", ["min_norm", "least_base"])
+def test_feasible_twists_are_reproduced_within_limits(fastkit, objective):
+    g = np.random.default_rng(5)
+    for _ in range(6):
+        t = g.normal(size=6) * [0.3, 0.3, 0.3, 0.2, 0.2, 0.2]
+        res = resolve_redundancy(fastkit, POSE, t, objective=objective)
+        assert res.feasible and res.scale == 1.0 and res.reason == ""
+        _check(fastkit, res, t)
+
+
+def test_least_base_keeps_bases_still_when_cables_suffice(fastkit):
+    t = np.array([0.5, 0.2, -0.1, 0.0, 0.05, 0.1])
+    lb = resolve_redundancy(fastkit, POSE, t, objective="least_base")
+    mn = resolve_redundancy(fastkit, POSE, t, objective="min_norm")
+    assert np.allclose(lb.base_rates, 0.0, atol=1e-7)
+    # the min-norm solution trades base motion for smaller cable speeds
+    w = 1.0 / HI
+    assert np.sum((mn.q_dot * w) ** 2) <= np.sum((lb.q_dot * w) ** 2) + 1e-9
+
+
+def test_twist_needing_the_base(fastkit):
+    """Between the fixed-base and moving-base capacity along x the base must move."""
+    mv = twist_capacities(fastkit, POSE).positive[0, 0]
+    fx = twist_capacities(fastkit, POSE, moving=()).positive[0, 0]
+    assert mv > fx
+    t = np.array([0.5 * (mv + fx), 0, 0, 0, 0, 0])
+    res = resolve_redundancy(fastkit, POSE, t, objective="least_base")
+    assert res.feasible
+    assert np.abs(res.base_rates).max() > 1e-4
+    _check(fastkit, res, t)
+    fixed = resolve_redundancy(fastkit, POSE, t, moving=())
+    assert not fixed.feasible and fixed.scale == pytest.approx(fx / t[0], rel=1e-6)
+
+
+def test_infeasible_twist_reports_largest_fraction(fastkit):
+    cap = twist_capacities(fastkit, POSE).positive[0, 2]
+    t = np.array([0, 0, 1.25 * cap, 0, 0, 0])
+    res = resolve_redundancy(fastkit, POSE, t)
+    assert not res.feasible
+    assert res.scale == pytest.approx(0.8, rel=1e-6)
+    assert "outside the available twist set" in res.reason
+    _check(fastkit, res, t, scale=res.scale)
+
+
+def test_limits_excluding_rest():
+    from taut.io.cdpr_model import load_cdpr_model
+    robot = load_cdpr_model("fastkit")
+    lim = MotionLimits(cable_min=0.5, cable_max=1.0)
+    res = resolve_redundancy(robot, POSE, np.zeros(6), lim)
+    assert not res.feasible and "standing still" in res.reason
+
+
+def test_navigation_mode(fastkit):
+    ok = resolve_redundancy(fastkit, POSE, [0.1, -0.1, 0, 0, 0, 0.01], mode="navigation")
+    assert ok.feasible and np.allclose(ok.cable_speeds, 0.0)
+    assert ok.q_dot.shape == (3,) and np.all(np.abs(ok.q_dot) <= 0.2 + 1e-12)
+    lift = resolve_redundancy(fastkit, POSE, [0, 0, 0.1, 0, 0, 0], mode="navigation")
+    assert not lift.feasible and "planar" in lift.reason
+    fast = resolve_redundancy(fastkit, POSE, [0.4, 0, 0, 0, 0, 0], mode="navigation")
+    assert not fast.feasible and fast.scale == pytest.approx(0.5)
+
+
+def test_bad_input(fastkit):
+    with pytest.raises(InvalidInputError):
+        resolve_redundancy(fastkit, POSE, [1, 2, 3])
+    with pytest.raises(InvalidInputError):
+        resolve_redundancy(fastkit, POSE, [np.nan, 0, 0, 0, 0, 0])
+    with pytest.raises(InvalidInputError, match="objective"):
+        resolve_redundancy(fastkit, POSE, np.zeros(6), objective="fastest")
+    with pytest.raises(InvalidInputError, match="ghost"):
+        resolve_redundancy(fastkit, POSE, np.zeros(6), moving=("ghost",))
