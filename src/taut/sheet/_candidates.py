@@ -132,6 +132,9 @@ _J = np.array([1.0, 1.0, -1.0, -1.0])
 #: solved by the Lagrange kernel rather than in closed form from the facet normals.
 FALLBACK_SIN = 1e-3
 _ONES = np.ones(4)
+#: Positions of the 3-subsets of a 5-vertex simplex, and of the two vertices left out.
+_TRI_POS = np.array(list(combinations(range(5), 3)), dtype=np.intp)
+_TRI_REST = np.array([[i for i in range(5) if i not in c] for c in _TRI_POS], dtype=np.intp)
 _PROBE = np.array([0.6180339887, 0.7071067812, 0.5772156649, 0.3183098862, 0.2718281828,
                    0.1414213562])
 
@@ -161,14 +164,14 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     probe = np.sort(eq @ _PROBE)
     if np.any(probe[1:] == probe[:-1]):
         return None
-    nP = eq[:, :5] @ basis.T                             # outward normals in lifted coords
+    nP = eq[:, :5] @ basis.T         # outward unit normals in lifted coords (basis orthogonal)
     upper = nP[:, 4] > 1e-12
     N = len(P)
-    simp = np.sort(hull.simplices, axis=1)
-    nf = len(simp)
     uf = np.flatnonzero(upper)
+    simp_u = hull.simplices[uf]                  # Qhull's vertex order: neighbours follow it
+    sorted_u = np.sort(simp_u, axis=1)
     # Facets: the stationary point is the facet's own vertex of the arrangement.
-    subsets = [simp[uf]]
+    subsets = [sorted_u]
     xs = [nP[uf, :4] / nP[uf, 4:5]]
     sizes = [np.full(len(uf), 5, dtype=np.intp)]
     curvs = [np.full(len(uf), np.inf)]
@@ -177,69 +180,65 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     nbr = hull.neighbors[uf]
     fi, j = np.nonzero(~upper[nbr] | (uf[:, None] < nbr))
     f, g = uf[fi], nbr[fi, j]
-    rows = simp[f]
+    rows = sorted_u[fi]
     ridge = np.full((len(f), 5), -1, dtype=np.intp)
-    ridge[:, :4] = rows[rows != hull.simplices[f, j][:, None]].reshape(-1, 4)
-    faces = [(ridge, f, g[:, None])]
-    # 2-faces: group the 3-subsets of all simplices; each is shared by >= 3 facets.
-    sub = simp[:, combo_table(5, 3)].reshape(-1, 3)
-    fid = np.repeat(np.arange(nf), 10)
-    key = (sub @ np.array([2 * N * N, 2 * N, 2])) + (~upper[fid])   # upper facets first
-    order = np.argsort(key)
-    key, fid = key[order] // 2, fid[order]
-    start = np.flatnonzero(np.diff(key, prepend=-1))
-    count = np.diff(start, append=len(key))
-    first = fid[start]
-    if np.any(count[upper[first]] < 3):
-        return None
-    start, count = start[upper[first]], count[upper[first]]
-    face = np.full((len(start), 5), -1, dtype=np.intp)
-    face[:, :3] = sub[order[start]]
-    # Of the facets around each 2-face pick the two whose directions u_g (see below) are
-    # best conditioned: nearly coplanar neighbours give nearly parallel directions.
-    f2 = fid[start]
-    width = int(count.max()) if len(count) else 1
-    member = np.minimum(start[:, None] + np.arange(1, width), len(fid) - 1)
-    present = np.arange(1, width) < count[:, None]
-    g_all = np.where(present, fid[member], f2[:, None])
-    n_all = nP[g_all]                                             # (G, K, 5)
-    x2 = nP[f2, :4] / nP[f2, 4:5]
-    u_all = n_all[..., :4] - n_all[..., 4:5] * x2[:, None, :]
-    u_all /= np.linalg.norm(n_all, axis=2)[..., None]
-    len1 = np.linalg.norm(u_all, axis=2)
-    k1 = np.argmax(len1, axis=1)
-    rows2 = np.arange(len(f2))
-    e1 = u_all[rows2, k1] / np.maximum(len1[rows2, k1], 1e-300)[:, None]
-    perp = u_all - (u_all @ e1[:, :, None]) * e1[:, None, :]
-    k2 = np.argmax(np.linalg.norm(perp, axis=2), axis=1)
-    faces.append((face, f2, np.column_stack([g_all[rows2, k1], g_all[rows2, k2]])))
+    ridge[:, :4] = rows[rows != simp_u[fi, j][:, None]].reshape(-1, 4)
+    x1 = nP[f, :4] / nP[f, 4:5]
+    faces = [(ridge, x1, (nP[g, :4] - nP[g, 4:5] * x1,))]
+    # 2-faces: every 3-subset S of an upper facet f. The facets sharing with f the ridges
+    # opposite f's two other vertices also contain S (they are f's neighbours around S).
+    # Of the upper facets containing S keep the one whose two directions u_g (see below)
+    # are best conditioned: nearly coplanar neighbours give tiny or nearly parallel ones.
+    perm = np.argsort(simp_u, axis=1)              # sorted_u = simp_u in the order perm
+    tri = sorted_u[:, _TRI_POS].reshape(-1, 3)
+    f3 = np.repeat(uf, 10)
+    g3 = np.take_along_axis(nbr, perm, axis=1)[:, _TRI_REST].reshape(-1, 2)
+    x3 = nP[f3, :4] / nP[f3, 4:5]
+    u3 = nP[g3[:, 0], :4] - nP[g3[:, 0], 4:5] * x3               # |n_g| = 1
+    v3 = nP[g3[:, 1], :4] - nP[g3[:, 1], 4:5] * x3
+    uu3, vv3, uv3 = (u3 * u3) @ _ONES, (v3 * v3) @ _ONES, (u3 * v3) @ _ONES
+    sin2 = np.maximum(vv3 - uv3 * uv3 / np.maximum(uu3, 1e-300), 0.0) / np.maximum(vv3, 1e-300)
+    score = np.minimum(np.minimum(uu3, vv3), sin2)
+    face_id = tri @ np.array([N * N, N, 1])
+    if N ** 3 < 2 ** 40:
+        # One float sort: by face, best score first within a face (1 / (2 + score) lies
+        # in (0, 1/2] and keeps >= 12 bits beside face ids below 2**40).
+        order = np.argsort(face_id + 1.0 / (2.0 + score))
+    else:                                                 # pragma: no cover - huge teams
+        order = np.lexsort((-score, face_id))
+    face_key = face_id[order]
+    keep = np.ones(len(order), dtype=bool)
+    np.not_equal(face_key[1:], face_key[:-1], out=keep[1:])
+    pick = order[keep]
+    face = np.full((len(pick), 5), -1, dtype=np.intp)
+    face[:, :3] = tri[pick]
+    faces.append((face, x3[pick], (u3[pick], v3[pick])))
     fallback: dict[int, list[np.ndarray]] = {}
-    for face, f, g in faces:
+    for face, xf, dirs in faces:
         # Stationary point of q + g_i on x_f + span(u_g): a 1x1 or 2x2 system in closed
         # form (A = U J U', U the rows u_g; row sums by products with _ONES). Also the
         # reduced Hessian's smallest eigenvalue on span(u_g), in an orthonormal basis.
-        xf = nP[f, :4] / nP[f, 4:5]
         c = _J * xf + 0.5 * P[face[:, 0], :4]             # gradient terms at x_f (any i)
-        u = nP[g[:, 0], :4] - nP[g[:, 0], 4:5] * xf
+        u = dirs[0]
         uu = u * u
         a11, n1 = uu @ _J, uu @ _ONES
         r1 = -((u * c) @ _ONES)
         # Directions nearly lost to cancellation (nearly coplanar neighbouring facets) are
         # solved by the general Lagrange kernel instead.
-        size_u = np.sqrt(n1) / np.linalg.norm(nP[g[:, 0]], axis=1)
-        if g.shape[1] == 1:
+        size_u = np.sqrt(n1)                              # relative to |n_g| = 1
+        if len(dirs) == 1:
             ok = (np.abs(a11) > 1e-12 * n1) & (size_u > FALLBACK_SIN)
             x = xf[ok] + (r1[ok] / a11[ok])[:, None] * u[ok]
             curvs.append(a11[ok] / n1[ok])
         else:
-            v = nP[g[:, 1], :4] - nP[g[:, 1], 4:5] * xf
+            v = dirs[1]
             vv = v * v
             a12, a22 = (u * v) @ _J, vv @ _J
             r2 = -((v * c) @ _ONES)
             det = a11 * a22 - a12 * a12
             m2, g12 = vv @ _ONES, (u * v) @ _ONES
             n2 = n1 + m2
-            size_v = np.sqrt(m2) / np.linalg.norm(nP[g[:, 1]], axis=1)
+            size_v = np.sqrt(m2)
             sin_uv = np.sqrt(np.maximum(m2 - g12 * g12 / np.maximum(n1, 1e-300), 0.0) /
                              np.maximum(m2, 1e-300))
             ok = ((np.abs(det) > 1e-12 * n2 * n2) & (size_u > FALLBACK_SIN)
@@ -262,11 +261,11 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
             curv = 0.5 * (h11 + h22) - np.sqrt(half * half + h12 * h12)
             curvs.append(np.where(good, curv, np.nan))
         if not np.all(ok):
-            s_face = 5 - g.shape[1]
+            s_face = 5 - len(dirs)
             fallback.setdefault(s_face, []).append(face[~ok, :s_face])
         xs.append(x)
         subsets.append(face[ok])
-        sizes.append(np.full(len(x), 5 - g.shape[1], dtype=np.intp))
+        sizes.append(np.full(len(x), 5 - len(dirs), dtype=np.intp))
     subset = np.vstack(subsets)
     x = np.vstack(xs)
     first = P[subset[:, 0]]
