@@ -15,7 +15,6 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/taut fk examples/sheet/example2_r2_r4_353mm.yaml --mass 1.0 --plot out/example2.png
-	@echo "figure written to out/example2.png"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest
