@@ -111,3 +111,9 @@ def test_usage_errors_one_line_exit_2(capsys, args, fragment):
 def test_no_arguments_prints_help(capsys):
     code, out, _ = run(capsys)
     assert code == 0 and "fk" in out
+
+
+def test_version(capsys):
+    import taut
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"taut {taut.__version__}"

@@ -12,6 +12,7 @@ import sys
 import typer
 from typer.exceptions import TyperException
 
+from .. import __version__
 from ..errors import TautError
 from . import cdpr, fk, motion, plan
 
@@ -25,9 +26,16 @@ app = typer.Typer(
 )
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"taut {__version__}")
+        raise typer.Exit()
+
 
 @app.callback()
-def _root() -> None:
+def _root(version: bool = typer.Option(False, "--version", callback=_print_version,
+                                       is_eager=True, help="Print the version and exit.")
+          ) -> None:
     """Carrying loads with cables and mobile robots: sheet-carrying robot teams (VVCM) and
     cable-driven parallel robots on mobile bases. Every input error prints one line
     ``taut: error: <field>: <problem>`` and exits with code 2."""
