@@ -6,20 +6,23 @@
   mobile bases' tipping constraints ("bases moving", mobile) vs without (bases bolted like a
   fixed frame), like Fig. 14;
 * ``fastkit_deployment.png``: top view of a planned deployment for the 5 m long workspace;
-* ``fastkit_motion.json``: every number of the figures.
+* ``fastkit_motion.json``: every number of the figures, plus the lift certificate of the
+  paper's 5 m x 2 m box, the tallest deployable box and the same with exits 0.5 m higher.
 
-Run: ``python examples/cdpr/fastkit_motion.py`` (about 20 s).
+Run: ``python examples/cdpr/fastkit_motion.py`` (about 4 minutes: two height bisections of
+six planner runs each).
 """
 
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from taut.cdpr import axis_capacities, with_stabilisers
-from taut.cdpr.deploy import plan_deployment
+from taut.cdpr.deploy import lift_bound, plan_deployment, tallest_workspace
 from taut.cdpr.twist import fastkit_motion_limits, twist_capacities
 from taut.io.cdpr_model import load_cdpr_model
 from taut.viz.cdpr_motion import plot_capacity_bars, plot_deployment
@@ -28,10 +31,47 @@ HERE = Path(__file__).resolve().parent
 POSE = np.array([1.0, 0.0, 0.8, 0.0, 0.0, 0.0])     # 1 m off-centre towards the passive base
 BOX = [[-2.5, -0.05, 0.2], [2.5, 0.05, 1.0]]
 TWIST = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+FULL = [[-2.5, -0.05, 0.2], [2.5, 0.05, 2.2]]       # the paper's 5 m long, 2 m high box
+RAISE = 0.5                 # m: structures on top of the bases put the exits higher
+PLAN = dict(required_twist=TWIST, maxiter=6, popsize=6, search=(1.5, 0.5, 0.6),
+            grid=(6, 2, 4), verify_grid=(21, 3, 9), seed=0)
 
 
 def rnd(a) -> list:
     return [round(float(x), 4) for x in np.ravel(a)]
+
+
+def raise_exits(robot, dz: float):
+    """The robot with every exit point ``dz`` higher (the frame box follows)."""
+    bases = tuple(replace(b, exit_points={k: np.asarray(v) + (0.0, 0.0, dz)
+                                          for k, v in b.exit_points.items()})
+                  for b in robot.bases)
+    return replace(robot, bases=bases, bounds=None)
+
+
+def certificate(lb) -> dict:
+    return {"height": round(lb.height, 4), "bound_N": round(lb.bound, 2),
+            "required_N": round(lb.required, 2), "refutes": lb.refutes,
+            "per_cable_N": rnd(lb.per_cable), "sample_points": len(lb.points),
+            "reason": lb.explain()}
+
+
+def tallest(robot) -> dict:
+    """Bisection on zmax for x in [-2.5, 2.5], zmin = 0.2, up to the highest exit point."""
+    top = float(robot.exits_world[:, 2].max())
+    tw = tallest_workspace(robot, [FULL[0], [FULL[1][0], FULL[1][1], top]], tol=0.05,
+                           **PLAN)
+    dep = tw.deployment
+    out = {"searched_up_to": top, "height": None if dep is None else round(tw.height, 4),
+           "certified_limit": round(tw.certified_limit, 4),
+           "certificate_at_limit": certificate(tw.certificate),
+           "failed_at": None if np.isnan(tw.failed_below) else round(tw.failed_below, 4),
+           "tried": [[round(z, 4), ok] for z, ok in tw.tried]}
+    if dep is not None:
+        out.update({"base_poses": {k: rnd(v) for k, v in dep.base_poses.items()},
+                    "margin": round(dep.margin, 4), "twist_margin": round(dep.twist_margin, 4),
+                    "points": len(dep.points)})
+    return out
 
 
 def main() -> None:
@@ -57,10 +97,8 @@ def main() -> None:
     plot_deployment(dep, HERE / "fastkit_deployment.png",
                     title=f"FASTKIT deployment, 5 m x 0.1 m x 0.8 m box: worst capacity "
                           f"margin {dep.margin:.2f}")
-    full = plan_deployment(with_stabilisers(robot, True), [[-2.5, -0.05, 0.0],
-                                                           [2.5, 0.05, 2.0]],
-                           maxiter=10, popsize=8, search=(1.5, 0.5, 0.6), grid=(6, 2, 4),
-                           verify_grid=(11, 3, 9), seed=0)
+    full = plan_deployment(with_stabilisers(robot, True), FULL, **PLAN)
+    high = raise_exits(robot, RAISE)
     out = {
         "pose": rnd(POSE),
         "limits": {"base": rnd(lim.base_max), "cable": float(lim.cable_max)},
@@ -76,10 +114,14 @@ def main() -> None:
                        "base_poses": {k: rnd(v) for k, v in dep.base_poses.items()},
                        "margin": round(dep.margin, 4), "twist_margin": round(dep.twist_margin, 4),
                        "points": len(dep.points), "evaluations": dep.evaluations},
-        "full_height_5x2m": {"workspace": [[-2.5, -0.05, 0.0], [2.5, 0.05, 2.0]],
-                             "feasible": full.feasible, "margin": round(full.margin, 4),
-                             "reason": full.reason,
-                             "base_poses": {k: rnd(v) for k, v in full.base_poses.items()}},
+        "full_height_5x2m": {"workspace": FULL, "feasible": full.feasible,
+                             "refuted_without_search": full.refuted,
+                             "evaluations": full.evaluations, "reason": full.reason,
+                             "certificate": certificate(full.lift_bound)},
+        "tallest": tallest(with_stabilisers(robot, True)),
+        "exits_raised_0.5m": {"exit_heights": sorted(set(rnd(high.exits_world[:, 2]))),
+                              "certificate_5x2m": certificate(lift_bound(high, FULL)),
+                              "tallest": tallest(with_stabilisers(high, True))},
     }
     (HERE / "fastkit_motion.json").write_text(json.dumps(out, indent=1) + "\n")
     print(json.dumps(out, indent=1))

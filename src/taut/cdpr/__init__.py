@@ -14,7 +14,8 @@ from .kinematics import (CableState, as_poses, cable_state, gravity_wrench,
 from .model import Base, Cable, CableRobot, Payload, Platform, check_footprint, with_stabilisers
 from .tension import METHODS, TensionResult, distribute_tensions
 from .tipping import TippingResult, tipping_moments
-from .deploy import DeploymentResult, place_bases, plan_deployment, workspace_box
+from .deploy import (DeploymentResult, LiftBound, TallestWorkspace, lift_bound, place_bases,
+                     plan_deployment, tallest_workspace, upward_force_bound, workspace_box)
 from .redundancy import OBJECTIVES, RedundancyResult, resolve_redundancy
 from .twist import (MODES, TWIST_LABELS, AvailableTwistSet, FirstOrderModel, MotionLimits,
                     TwistCapacities, available_twist_set, fastkit_motion_limits,
@@ -37,4 +38,5 @@ __all__ = [
     "twist_capacities",
     "OBJECTIVES", "RedundancyResult", "resolve_redundancy",
     "DeploymentResult", "place_bases", "plan_deployment", "workspace_box",
+    "LiftBound", "lift_bound", "upward_force_bound", "TallestWorkspace", "tallest_workspace",
 ]

@@ -3,7 +3,8 @@ robots (FASTKIT §3: available twist set, Fig. 13) and deployment planning of th
 
 MODEL is a preset name (``fastkit``, ``ipanema``) or a YAML/JSON model file. Joint velocity
 limits are FASTKIT's (eqs. 10-16) unless overridden. Errors are :class:`taut.errors.TautError`
-(the top-level CLI prints ``taut: error: <field>: <problem>`` and exits 2).
+(the top-level CLI prints ``taut: error: <field>: <problem>`` and exits 2). ``deploy`` exits
+1 when it finds no verified placement (like ``taut plan`` without a plan).
 """
 
 from __future__ import annotations
@@ -81,7 +82,7 @@ def _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed
 
 
 def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
-            as_json) -> None:
+            as_json) -> int:
     _finite(ws, "workspace")
     _finite(disturbance, "disturbance")
     _finite(twist, "twist")
@@ -93,27 +94,49 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
     res = plan_deployment(robot, box, disturbance=D,
                           required_twist=None if twist is None else twist[:robot.dof],
                           seed=seed, maxiter=maxiter)
+    lb = res.lift_bound
     out = {"model": robot.name, "workspace": box.tolist(), "feasible": res.feasible,
+           "refuted": res.refuted,
            "base_poses": {k: [round(float(x), 4) for x in v] for k, v in res.base_poses.items()},
            "margin": _r(res.margin),
            "twist_margin": None if res.twist_margin is None else _r(res.twist_margin),
            "points": int(len(res.points)), "feasible_points": int(res.point_feasible.sum()),
-           "evaluations": res.evaluations, "reason": res.reason}
+           "evaluations": res.evaluations, "reason": res.reason,
+           "lift_bound": None if lb is None else {
+               "height": _r(lb.height), "bound": _r(lb.bound), "required": _r(lb.required),
+               "weight": _r(lb.weight), "refutes": lb.refutes,
+               "per_cable": {c.name: _r(v) for c, v in zip(robot.cables, lb.per_cable)}}}
+    note = None
     if plot is not None:
-        from ..viz.cdpr_motion import plot_deployment
-        plot_deployment(res, plot)
-        out["plot"] = str(plot)
+        if res.refuted:
+            note = (f"nothing to plot: no placement exists, so there is no deployment to draw "
+                    f"({plot} not written)")
+            out["plot"] = None
+            out["plot_note"] = note
+        else:
+            from ..viz.cdpr_motion import plot_deployment
+            plot_deployment(res, plot)
+            out["plot"] = str(plot)
+    code = 0 if res.feasible else 1            # valid question, negative answer: exit 1
     if as_json:
         typer.echo(json.dumps(out, indent=2))
-        return
+        return code
     typer.echo(f"{robot.name}: deployment for workspace {box.tolist()} m: "
                + ("FEASIBLE" if res.feasible else "NOT FOUND"))
+    if res.refuted:
+        typer.echo("  " + res.reason)
+        typer.echo("  upper bound per cable (N): " + ", ".join(
+            f"{k} {v:.2f}" for k, v in out["lift_bound"]["per_cable"].items()))
+        if note:
+            typer.echo("  " + note)
+        return code
     for k, v in out["base_poses"].items():
         typer.echo(f"  {k}: x={v[0]} m  y={v[1]} m  theta={v[2]} rad")
     typer.echo(f"  worst capacity margin {out['margin']} over {out['points']} points "
                f"({out['feasible_points']} feasible with tipping)")
     if res.reason:
         typer.echo("  " + res.reason)
+    return code
 
 
 def add_commands(sub: typer.Typer) -> None:
@@ -157,7 +180,9 @@ def add_commands(sub: typer.Typer) -> None:
         maxiter: int = typer.Option(8, "--maxiter", help="Differential-evolution iterations."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Top view (PNG)."),
         as_json: bool = typer.Option(False, "--json", help="Machine-readable output."),
-    ) -> None:
-        """Plan mobile-base placements making a workspace box wrench-feasible with tipping."""
-        _deploy(model, workspace, disturbance, twist, stabilisers, seed, maxiter, plot,
-                as_json)
+    ) -> int:
+        """Plan mobile-base placements making a workspace box wrench-feasible with tipping.
+        A placement-independent bound on the cables' lift is checked first and proves some
+        boxes impossible without a search. Exit 0 with a verified placement, 1 without."""
+        return _deploy(model, workspace, disturbance, twist, stabilisers, seed, maxiter, plot,
+                       as_json)
