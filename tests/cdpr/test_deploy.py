@@ -188,6 +188,16 @@ def test_certificate_refutes_the_paper_box_only(fastkit):
     assert "disturbance adds up to 20.0 N downward" in d.explain()
 
 
+def test_every_2m_high_box_clear_of_the_floor_is_refuted(fastkit):
+    """The paper's "2 m high" workspace, wherever it starts: the preset's payload (a 0.15 m
+    box whose centre hangs 0.175 m under the platform centre) reaches 0.25 m below the
+    platform centre, so a box clear of the floor starts at z >= 0.25 m. Every such 2 m high
+    box is refuted; the certificate stops refuting only for boxes starting below 0.04 m."""
+    for zmin in (0.04, 0.1, 0.25, 0.5, 1.0):
+        assert lift_bound(fastkit, [[-2.5, -0.05, zmin], [2.5, 0.05, zmin + 2.0]]).refutes
+    assert not lift_bound(fastkit, [[-2.5, -0.05, 0.0], [2.5, 0.05, 2.0]]).refutes
+
+
 def test_certificate_hand_checks(fastkit, point_mass):
     """One sample point: the best exit is right above each attachment (vertical cable,
     full t_max) for every cable whose exit is above its attachment point."""
