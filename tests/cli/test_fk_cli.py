@@ -100,6 +100,8 @@ def test_bad_json_scenario(capsys, tmp_path):
     (["fk", "x.yaml", "--method", "magic"], "--method"),
     (["fk", "x.yaml", "--mass", "abc"], "--mass"),
     (["fk", "x.yaml", "--frobnicate"], "--frobnicate: no such option"),
+    (["fk", "x.yaml", "--mass"], "--mass: requires an argument"),
+    (["cdpr", "deploy", "fastkit", "--workspace", "0", "1"], "--workspace: requires 6"),
     (["nonsense"], "nonsense"),
 ])
 def test_usage_errors_one_line_exit_2(capsys, args, fragment):

@@ -55,8 +55,12 @@ def _fail(message: str) -> int:
 def _usage_line(exc: Exception) -> str:
     """One line for a command-line usage error (typer's click exceptions)."""
     option = getattr(exc, "option_name", None)
-    if option:
+    if option and type(exc).__name__ == "NoSuchOption":
         return f"{option}: no such option"
+    if option:                                 # e.g. "Option '--pose' requires 3 arguments."
+        text = " ".join(str(getattr(exc, "message", exc)).split())
+        text = text.replace(f"Option '{option}' ", "").rstrip(".")
+        return f"{option}: {text}"
     param = getattr(exc, "param", None)
     name = None
     if param is not None:
