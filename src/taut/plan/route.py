@@ -333,7 +333,7 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
         why = "no route: the formation cannot pass between the obstacles and walls"
         reasons = list(dict.fromkeys(r for L in layers for r in L.reasons))
         if reasons:
-            why += " and cannot cross " + "; ".join(reasons)
+            why += " and cannot cross (" + "; ".join(reasons) + ")"
         return Route(False, why)
     path = [int(pred[sink])]
     while path[-1] != src:
