@@ -64,7 +64,7 @@ def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
         ax.add_patch(PolygonPatch(r.robots[t], closed=True, fill=False, ec="tab:blue",
                                   lw=0.4, alpha=0.6))
     ax.set_title(f"top view: crossed {list(r.crossed)}, {r.duration:.1f} s")
-    ax.legend(fontsize=6, loc="upper right")
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax = axs[0, 1]
     ax.plot(r.times, r.object[:, 2], label="object height (model)")
     ax.fill_between(r.times, 0, _beneath(scenario, r), color="0.6", step="mid",
