@@ -583,6 +583,7 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
         ref = as_array(reference, "reference", shape=(N, 2))
     V = (sheet.vertices - vo) / s                          # contact at the origin
     rho = np.sqrt(lengths ** 2 - d ** 2) / s
+    _check_radial_spacing(V, rho, s)
     need_curv = N <= 4
     w = _maxent(sheet.vertices, vo, s)
     if ref is None:
@@ -632,6 +633,28 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
     formation.setflags(write=False)
     return IKResult(formation, p, vo, _wrap(th), w, tensions, lengths, rho * s, curv,
                     spacing * s, how)
+
+
+def _check_radial_spacing(V: np.ndarray, rho: np.ndarray, scale: float) -> None:
+    """Exact necessary condition for any all-taut formation (planning paper eq. 10).
+
+    Robot ``i`` must stand at horizontal distance ``rho_i`` from the object, whatever its
+    angle; by the triangle inequality two robots are then at least ``|rho_i - rho_j|``
+    apart, and the sheet allows at most ``|v_i - v_j|``. A pair violating this proves that
+    no all-taut formation exists (no search needed). Lengths normalised by ``scale``.
+    """
+    D = np.linalg.norm(V[:, None, :] - V[None, :, :], axis=2)
+    excess = np.abs(rho[:, None] - rho[None, :]) - D
+    k = int(np.argmax(excess))
+    i, j = divmod(k, len(rho))
+    if excess.flat[k] > SPACING_MARGIN:
+        i, j = min(i, j), max(i, j)
+        raise UnreachableTargetError(
+            "object_position", f"no all-taut formation exists for this target and contact: "
+            f"robots {i + 1} and {j + 1} must stand {rho[i] * scale:.6g} and "
+            f"{rho[j] * scale:.6g} from the object horizontally, at least "
+            f"{abs(rho[i] - rho[j]) * scale:.6g} apart, but the sheet holds them at most "
+            f"{D[i, j] * scale:.6g} apart")
 
 
 def _diagnose(V, rho, w, a, u) -> str:
