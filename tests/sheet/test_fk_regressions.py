@@ -34,3 +34,25 @@ def test_state_at_a_taut_set_change_stays_an_equilibrium():
     for method in ("fast", "subsets", "exhaustive"):
         r = forward_kinematics(sheet, formation, case["hold_height"], method=method)
         assert [(e.taut, e.status) for e in r.equilibria] == [((1, 2, 5, 6), "stable")]
+
+
+def test_formation_within_1e_10_of_a_scaled_sheet_keeps_its_rest_state():
+    """A formation that is the sheet scaled by 0.7 (the FK paper's Lemma 2 configuration:
+    lifted points on a 2-plane) plus 3e-10 of noise. The lifted points are then nearly but
+    not exactly flat: before, the flat-hull candidates failed the exact maximiser test and
+    10 of these 60 teams had no rest state at all. The object must rest where the exact
+    configuration puts it (centre, z = h - sqrt(1 - 0.7^2)) with every cable taut or
+    within the taut tolerance of it."""
+    n, h = 10, 3.0
+    V = np.column_stack([np.cos(np.arange(n) * 2 * np.pi / n),
+                         np.sin(np.arange(n) * 2 * np.pi / n)])
+    exact = forward_kinematics(Sheet(V), 0.7 * V, h).stable
+    assert len(exact) == 1 and len(exact[0].taut) == n
+    target = np.array([0.0, 0.0, h - np.sqrt(1 - 0.7 ** 2)])
+    np.testing.assert_allclose(exact[0].object, target, atol=1e-12)
+    for seed in range(60):
+        R = 0.7 * V + np.random.default_rng(seed).normal(scale=3e-10, size=V.shape)
+        stable = forward_kinematics(Sheet(V), R, h).stable
+        assert stable, seed
+        for e in stable:
+            assert np.linalg.norm(e.object - target) < 1e-7, (seed, e.object)

@@ -25,6 +25,12 @@ from scipy.spatial import ConvexHull, QhullError
 
 #: Singular values of the centred lifted points below this (normalised units) are zero.
 RANK_TOL = 1e-9
+#: Relative thickness (smallest singular value of the centred lifted points over the
+#: largest) between which the points count as nearly flat: see :func:`hull_candidates`.
+EXACT_FLAT = 1e-13
+NEAR_FLAT = 1e-9
+#: Nearly flat teams up to this size get every subset as a candidate.
+NEAR_FLAT_SUBSETS = 14
 
 
 def _combo_table(n: int, k: int) -> np.ndarray:
@@ -300,6 +306,34 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
     d = int(np.sum(sv > RANK_TOL * max(1.0, sv[0])))
     if N <= d + 1 or N <= 5:
         return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
+    thinnest = sv[min(len(sv), 5) - 1] / max(1.0, sv[0])
+    if EXACT_FLAT < thinnest < NEAR_FLAT:
+        # Nearly but not exactly flat (e.g. a formation within ~1e-9 of the sheet scaled,
+        # the Lemma 2 configuration): neither the flat nor the full-dimensional hull is
+        # numerically reliable, and the rest state's taut set is decided by the tiny
+        # thickness. Every subset up to 5 for small teams (complete); otherwise the faces
+        # of the flat hull together with those of a joggled full-dimensional hull.
+        if N <= NEAR_FLAT_SUBSETS:
+            return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
+        flat = _hull_faces(P, Pc, vt, d, pairs, shortcut=False)
+        try:
+            joggled = ConvexHull(Pc, qhull_options="QJ").simplices
+        except QhullError:                             # pragma: no cover - last resort
+            return flat
+        out = dict(flat.subsets)
+        for size, rows in _facet_subsets(joggled, N, pairs).items():
+            out[size] = rows if size not in out else _unique_sorted_rows(
+                np.vstack([out[size], rows]), N)
+        return HullCandidates(out, False)
+    return _hull_faces(P, Pc, vt, d, pairs, shortcut=True)
+
+
+def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bool, *,
+                shortcut: bool) -> HullCandidates:
+    """Candidates from the upper faces of the hull of the lifted points ``P`` (N, 5) in
+    their ``d``-dimensional affine hull (``Pc`` centred, ``vt`` its right singular vectors);
+    ``shortcut``: stationary points straight from the facet normals where it applies."""
+    N = len(P)
     basis = vt[:d].T                                   # (5, d)
     Y = Pc @ basis
     up = basis[4]                                      # e5 expressed in the hull's coordinates
@@ -311,7 +345,7 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
             hull = ConvexHull(Y, qhull_options="QJ")
         except QhullError:                             # pragma: no cover - last resort
             return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
-    if d == 5 and not pairs:
+    if shortcut and d == 5 and not pairs:
         found = _stationary_from_normals(P, hull, basis)
         if found is not None:
             stationary, fallback = found
