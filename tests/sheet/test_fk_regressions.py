@@ -8,6 +8,8 @@ import pytest
 
 from taut.sheet import Sheet, forward_kinematics
 from taut.sheet import fk as fk_module
+from taut.sheet import forward_kinematics_batch
+from taut.sheet.fk import similar_copy
 
 DATA = Path(__file__).parents[1] / "data"
 
@@ -56,3 +58,41 @@ def test_formation_within_1e_10_of_a_scaled_sheet_keeps_its_rest_state():
         assert stable, seed
         for e in stable:
             assert np.linalg.norm(e.object - target) < 1e-7, (seed, e.object)
+
+
+@pytest.mark.parametrize("n", [6, 10, 20])
+@pytest.mark.parametrize("noise", [1e-11, 3e-10, 3e-9])
+def test_near_similar_formations_are_solved_as_the_similar_copy(n, noise):
+    """Rotated, translated, scaled copies of a regular sheet plus noise in the band where
+    float64 cannot resolve the taut set: every team (fast and batched) rests at the
+    exact copy's Lemma 2 point, within the snap distance."""
+    V = np.column_stack([np.cos(np.arange(n) * 2 * np.pi / n),
+                         np.sin(np.arange(n) * 2 * np.pi / n)])
+    th = 0.4
+    rot = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    copy = 0.6 * V @ rot.T + [2.0, -1.0]
+    h = 2.5
+    target = np.array([2.0, -1.0, h - np.sqrt(1 - 0.6 ** 2)])
+    rng = np.random.default_rng(n)
+    forms = copy + rng.normal(scale=noise, size=(30, n, 2))
+    batch = forward_kinematics_batch(Sheet(V), forms, h)
+    for b in range(len(forms)):
+        single = forward_kinematics(Sheet(V), forms[b], h)
+        for res in (single, batch.result(b)):
+            assert res.stable, (b, noise)
+            for e in res.stable:
+                assert np.linalg.norm(e.object - target) < 1e-7
+
+
+def test_similar_copy_fit():
+    rng = np.random.default_rng(1)
+    V = rng.normal(size=(7, 2))
+    th = 0.8
+    rot = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    R = 0.6 * V @ rot.T + [3.0, -1.0]
+    bumped = R + 1e-3 * rng.normal(size=R.shape)
+    copies, scale, dist = similar_copy(V, np.stack([R, R * [1, -1], bumped]))
+    np.testing.assert_allclose(copies[0], R, atol=1e-12)
+    assert scale[0] == pytest.approx(0.6) and dist[0] < 1e-12
+    assert dist[1] == np.inf                         # a mirror image is not a copy
+    assert 1e-4 < dist[2] < 1e-2 and abs(scale[2] - 0.6) < 2e-3

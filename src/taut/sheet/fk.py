@@ -33,8 +33,9 @@ from .._validate import as_array, as_positive
 from ..errors import InvalidInputError
 from ._candidates import Stationary, hull_candidates, padded_small_subsets
 from ._finalize import Classified, classify
-from ._kernel import (STATUS_NAMES, STATUS_NOT_EQUILIBRIUM, Frame, Solved, height_ok,
-                      in_hull_2d, maximiser_masks, pad_groups, solve_candidates, solve_table)
+from ._kernel import (STATUS_NAMES, STATUS_NOT_EQUILIBRIUM, STATUS_STABLE, Frame, Solved,
+                      height_ok, in_hull_2d, maximiser_masks, pad_groups, solve_candidates,
+                      solve_table)
 from .exhaustive import exhaustive_search, funnel_from
 from .model import Sheet, check_formations, check_hold_height
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult
@@ -47,6 +48,9 @@ METHODS: tuple[str, ...] = ("fast", "exhaustive", "subsets")
 #: Up to this many robots every small subset (N = 8: 182 candidates) is cheaper than a
 #: convex hull, for one formation and for batches alike (measured).
 SMALL_TEAM = 8
+#: Formations without a stable state within this distance (relative to the sheet size) of
+#: a similar copy of the sheet are solved as that copy (see ``_snap_near_similar``).
+SNAP_TOL = 1e-8
 #: Candidate systems solved per block when every formation shares one candidate table.
 TABLE_BLOCK = 65_536
 #: Hull candidates: run the maximiser scan before the projection test when it touches at
@@ -129,6 +133,73 @@ def _candidates(frame: Frame, sheet: Sheet, method: str
 
 def _solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
            ) -> tuple[Frame, Classified, dict[str, int] | None]:
+    frame, c, counts = _solve_as_given(sheet, R, hold_height, method)
+    if method != "exhaustive":
+        c = _snap_near_similar(sheet, R, hold_height, method, c)
+    return frame, c, counts
+
+
+def similar_copy(vertices: np.ndarray, formations: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closest similar copy ``s Q V + t`` of the sheet to each formation (Procrustes fit,
+    rotation only, no reflection; centroid kept).
+
+    Returns the copies (B, N, 2), their scale factors ``s`` (B,) and the largest robot
+    displacement to reach them (B,), in the formations' unit (inf where the best fit
+    needs a reflection)."""
+    A = vertices - vertices.mean(axis=0)
+    rc = formations.mean(axis=1, keepdims=True)
+    M = np.einsum("ni,bnj->bij", A, formations - rc)              # (B, 2, 2)
+    U, S, Wt = np.linalg.svd(M)
+    Q = np.swapaxes(U @ Wt, 1, 2)                                 # rotation: A -> formation
+    scale = S.sum(axis=1) / np.sum(A * A)
+    copies = scale[:, None, None] * (A @ np.swapaxes(Q, 1, 2)) + rc
+    dist = np.abs(copies - formations).max(axis=(1, 2))
+    dist[np.linalg.det(Q) < 0] = np.inf
+    return copies, scale, dist
+
+
+def _snap_near_similar(sheet: Sheet, R: np.ndarray, hold_height: float, method: str,
+                       c: Classified) -> Classified:
+    """Formations within ``SNAP_TOL`` (relative) of a similar copy of the sheet, but not
+    exactly one, and without a stable state: solve the copy instead.
+
+    Such formations are within float64 resolution of the FK paper's Lemma 2
+    configuration (lifted points on a 2-plane): the rest state's taut set is decided by a
+    thickness of ~1e-10 and its 4- and 5-cable systems are numerically singular, so the
+    candidates can miss it. The copy is solved exactly (every cable taut at the Lemma 2
+    point); positions move by at most the snap distance, below ``SNAP_TOL`` times the
+    sheet size, and the taut set is the one within that tolerance.
+    """
+    B = R.shape[0]
+    stable = np.zeros(B, dtype=bool)
+    stable[c.form[c.status == STATUS_STABLE]] = True
+    todo = np.flatnonzero(~stable)
+    if len(todo) == 0:
+        return c
+    copies, scale, dist = similar_copy(sheet.vertices, R[todo])
+    near = ((dist > 1e-13 * sheet.size) & (dist <= SNAP_TOL * sheet.size)
+            & (scale <= 1.0))
+    if not near.any():
+        return c
+    todo, copies = todo[near], copies[near]
+    _, c2, _ = _solve_as_given(sheet, copies, hold_height, method)
+    replaced = np.zeros(B, dtype=bool)
+    replaced[todo[np.unique(c2.form[c2.status == STATUS_STABLE])]] = True
+    if not replaced.any():
+        return c
+    take2 = replaced[todo[c2.form]]
+    keep = ~replaced[c.form]
+    form = np.concatenate([c.form[keep], todo[c2.form[take2]]])
+    order = np.argsort(form, kind="stable")
+    parts = [(getattr(c, f)[keep], getattr(c2, f)[take2]) for f in Classified.__dataclass_fields__]
+    fields = {f: np.concatenate(p)[order] for f, p in zip(Classified.__dataclass_fields__, parts)}
+    fields["form"] = form[order]
+    return Classified(**fields)
+
+
+def _solve_as_given(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
+                    ) -> tuple[Frame, Classified, dict[str, int] | None]:
     frame = Frame.build(sheet.vertices, R, hold_height, sheet.size)
     if method == "exhaustive":
         solved, taut, counts = exhaustive_search(frame)
@@ -224,7 +295,11 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
         N (g = 9.81 m/s^2). The formula :math:`F_i = w_i m g L_i / d` (FK paper eq. 16
         solved with the weights) uses only a ratio of lengths, so any length unit works.
     method : {"fast", "exhaustive", "subsets"}
-        Algorithm (see module docstring). All return the same equilibria.
+        Algorithm (see module docstring). All return the same equilibria, except within
+        ``SNAP_TOL`` (1e-8 of the sheet size) of a similar copy of the sheet (the FK
+        paper's Lemma 2 configuration), where float64 cannot resolve the taut set: there
+        "fast" and "subsets" solve the copy when the formation itself shows no stable
+        state, and the paper's Algorithm 1 ("exhaustive") may find nothing.
 
     Returns
     -------
