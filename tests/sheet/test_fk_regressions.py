@@ -96,3 +96,24 @@ def test_similar_copy_fit():
     assert scale[0] == pytest.approx(0.6) and dist[0] < 1e-12
     assert dist[1] == np.inf                         # a mirror image is not a copy
     assert 1e-4 < dist[2] < 1e-2 and abs(scale[2] - 0.6) < 2e-3
+
+
+def test_dependent_taut_set_weights_do_not_depend_on_input_rounding():
+    """Table V's Example 6b: seven taut cables whose lifted points lie on a 2-plane, so the
+    weights are a family and we report the minimum-norm non-negative one. The scenario
+    file's coordinates are rounded at 1e-10 relative; the weights must equal those of the
+    exact coordinates (before, the rounding alone moved them by 0.03: the 1e-12-level
+    equations it creates were kept as constraints)."""
+    ang = np.arange(8) * np.pi / 4
+    unit = np.column_stack([np.cos(ang), np.sin(ang)])
+    V, R = 900 * unit, 500 * unit
+    R[0] = [450.0, 0.0]
+    rounded = [np.round(a, 9) for a in (V, R)]
+    got = [forward_kinematics(Sheet(v), r, 1000.0).stable for v, r in ((V, R), rounded)]
+    assert [e.taut for e in got[0]] == [e.taut for e in got[1]] == [(1, 2, 3, 4, 5, 6, 7)]
+    np.testing.assert_allclose(got[1][0].weights, got[0][0].weights, atol=1e-9)
+    # and they are the minimum-norm ones (mirror-symmetric about robot 5, which the
+    # rounded-file answer 0.203, 0.119 x 5, 0.203 was not: its norm was larger)
+    np.testing.assert_allclose(got[0][0].weights[:4], [0.18535533905932737, 0.15,
+                                                       0.11464466094067263, 0.1], atol=1e-9)
+    assert abs(sum(got[0][0].weights) - 1.0) < 1e-12

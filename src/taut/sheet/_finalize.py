@@ -72,12 +72,18 @@ def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: n
     k = len(idx)
     E = np.vstack([frame.R[f, idx].T, frame.V[idx].T, np.ones(k)])
     rhs = np.concatenate([ro, vo, [1.0]])
+    # Dependent taut sets (e.g. Lemma 2: every lifted point on a 2-plane) make E rank
+    # deficient; rounding then leaves the 5 equations inconsistent at ~1e-12 and the LP
+    # infeasible. Keep the equations along E's significant singular directions.
+    U, S, _ = np.linalg.svd(E, full_matrices=False)
+    rank = int(np.sum(S > 1e-9 * S[0]))
+    E, rhs = U[:, :rank].T @ E, U[:, :rank].T @ rhs
     c = np.zeros(k + 1)
     c[-1] = -1.0
     A_ub = np.hstack([-np.eye(k), np.ones((k, 1))])
-    lp = linprog(c, A_ub=A_ub, b_ub=np.zeros(k), A_eq=np.hstack([E, np.zeros((5, 1))]),
+    lp = linprog(c, A_ub=A_ub, b_ub=np.zeros(k), A_eq=np.hstack([E, np.zeros((rank, 1))]),
                  b_eq=rhs, bounds=[(None, None)] * (k + 1), method="highs")
-    w_min_norm = np.linalg.pinv(E) @ rhs
+    w_min_norm = np.linalg.pinv(E, rcond=1e-9) @ rhs
     if not lp.success:
         return w_min_norm, -np.inf
     t_star = float(lp.x[-1])

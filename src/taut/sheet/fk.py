@@ -50,7 +50,7 @@ METHODS: tuple[str, ...] = ("fast", "exhaustive", "subsets")
 SMALL_TEAM = 8
 #: Formations without a stable state within this distance (relative to the sheet size) of
 #: a similar copy of the sheet are solved as that copy (see ``_snap_near_similar``).
-SNAP_TOL = 1e-8
+SNAP_TOL = 1e-7
 #: Candidate systems solved per block when every formation shares one candidate table.
 TABLE_BLOCK = 65_536
 #: Hull candidates: run the maximiser scan before the projection test when it touches at
@@ -296,7 +296,7 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
         solved with the weights) uses only a ratio of lengths, so any length unit works.
     method : {"fast", "exhaustive", "subsets"}
         Algorithm (see module docstring). All return the same equilibria, except within
-        ``SNAP_TOL`` (1e-8 of the sheet size) of a similar copy of the sheet (the FK
+        ``SNAP_TOL`` (1e-7 of the sheet size) of a similar copy of the sheet (the FK
         paper's Lemma 2 configuration), where float64 cannot resolve the taut set: there
         "fast" and "subsets" solve the copy when the formation itself shows no stable
         state, and the paper's Algorithm 1 ("exhaustive") may find nothing.
