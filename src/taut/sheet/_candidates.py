@@ -86,6 +86,19 @@ def _unique_sorted_rows(rows: np.ndarray, N: int) -> np.ndarray:
     return np.unique(rows, axis=0)
 
 
+def _add_rows(out: dict[int, np.ndarray], size: int, rows: np.ndarray, N: int) -> None:
+    """Merge sorted candidate rows of one size into ``out`` (size -> rows), without
+    duplicates."""
+    if size in out:
+        rows = _unique_sorted_rows(np.vstack([out[size], rows]), N)
+    out[size] = rows
+
+
+def _every_subset(N: int, pairs: bool) -> "HullCandidates":
+    """Every subset of every candidate size: complete, for small or degenerate teams."""
+    return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
+
+
 def _facet_subsets(simplices: np.ndarray, N: int, pairs: bool) -> dict[int, np.ndarray]:
     out: dict[int, np.ndarray] = {}
     simplices = np.sort(simplices, axis=1)        # subsets of sorted rows come out sorted
@@ -305,7 +318,7 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
     _, sv, vt = np.linalg.svd(Pc, full_matrices=False)
     d = int(np.sum(sv > RANK_TOL * max(1.0, sv[0])))
     if N <= d + 1 or N <= 5:
-        return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
+        return _every_subset(N, pairs)
     thinnest = sv[min(len(sv), 5) - 1] / max(1.0, sv[0])
     if EXACT_FLAT < thinnest < NEAR_FLAT:
         # Nearly but not exactly flat (e.g. a formation within ~1e-9 of the sheet scaled,
@@ -314,7 +327,7 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
         # thickness. Every subset up to 5 for small teams (complete); otherwise the faces
         # of the flat hull together with those of a joggled full-dimensional hull.
         if N <= NEAR_FLAT_SUBSETS:
-            return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
+            return _every_subset(N, pairs)
         flat = _hull_faces(P, Pc, vt, d, pairs, shortcut=False)
         try:
             joggled = ConvexHull(Pc, qhull_options="QJ").simplices
@@ -322,8 +335,7 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
             return flat
         out = dict(flat.subsets)
         for size, rows in _facet_subsets(joggled, N, pairs).items():
-            out[size] = rows if size not in out else _unique_sorted_rows(
-                np.vstack([out[size], rows]), N)
+            _add_rows(out, size, rows, N)
         return HullCandidates(out, False)
     return _hull_faces(P, Pc, vt, d, pairs, shortcut=True)
 
@@ -344,7 +356,7 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
         try:
             hull = ConvexHull(Y, qhull_options="QJ")
         except QhullError:                             # pragma: no cover - last resort
-            return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
+            return _every_subset(N, pairs)
     if shortcut and d == 5 and not pairs:
         found = _stationary_from_normals(P, hull, basis)
         if found is not None:
@@ -361,7 +373,5 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
         i0 = int(np.argmax(np.einsum("ij,ij->i", Pc, Pc)))
         _, _, piv = qr((P - P[i0]).T, pivoting=True, mode="economic")
         whole = np.sort(np.concatenate([[i0], piv[:d]]).astype(np.intp))
-        s = len(whole)
-        row = whole[None, :].astype(np.intp)
-        out[s] = row if s not in out else _unique_sorted_rows(np.vstack([out[s], row]), N)
+        _add_rows(out, len(whole), whole[None, :].astype(np.intp), N)
     return HullCandidates(out, d == 5)

@@ -25,6 +25,7 @@ Methods (one interface, chosen by ``method``):
 from __future__ import annotations
 
 import weakref
+from dataclasses import fields
 from typing import Literal
 
 import numpy as np
@@ -192,10 +193,9 @@ def _snap_near_similar(sheet: Sheet, R: np.ndarray, hold_height: float, method: 
     keep = ~replaced[c.form]
     form = np.concatenate([c.form[keep], todo[c2.form[take2]]])
     order = np.argsort(form, kind="stable")
-    parts = [(getattr(c, f)[keep], getattr(c2, f)[take2]) for f in Classified.__dataclass_fields__]
-    fields = {f: np.concatenate(p)[order] for f, p in zip(Classified.__dataclass_fields__, parts)}
-    fields["form"] = form[order]
-    return Classified(**fields)
+    merged = {f.name: np.concatenate([getattr(c, f.name)[keep], getattr(c2, f.name)[take2]])
+              for f in fields(Classified) if f.name != "form"}
+    return Classified(form=form[order], **{k: v[order] for k, v in merged.items()})
 
 
 def _solve_as_given(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
