@@ -459,16 +459,18 @@ class DeploymentResult:
         return self.lift_bound is not None and self.lift_bound.refutes
 
 
-def evaluate_deployment(robot: CableRobot, box: np.ndarray, points: np.ndarray, disturbance,
-                        twist, limits, moving) -> tuple[float, np.ndarray, float | None]:
+def evaluate_deployment(robot: CableRobot, points: np.ndarray, disturbance, twists, limits,
+                        moving) -> tuple[float, np.ndarray, float | None]:
     """Score one placement: (worst wrench margin, per-point margins, worst twist margin).
 
-    Raises :class:`TautError` (e.g. a sample point outside the frame box)."""
+    ``twists`` (T, n) or None: required twists, the worst ATS margin over points and
+    twists is returned (None without twists). Raises :class:`TautError` (e.g. a sample
+    point outside the frame box)."""
     pm = capacity_margin(robot, points, disturbance=disturbance, tipping=True)
     tm = None
-    if twist is not None:
+    if twists is not None:
         ats = available_twist_set(robot, points, limits, "task", moving)
-        tm = float(ats.margin(twist).min())
+        tm = min(float(ats.margin(t).min()) for t in twists)
     return float(pm.min()), pm, tm
 
 
@@ -554,15 +556,12 @@ def plan_deployment(robot: CableRobot, workspace: Any, *, disturbance: Any = Non
         if out > 0:
             return -_PENALTY * (1 + out), None
         try:
-            wm, pm, _ = evaluate_deployment(rr, box, P, D, None, limits, moving)
+            wm, pm, tm = evaluate_deployment(rr, P, D, tw, limits, moving)
         except TautError:
             return -_PENALTY * 5, None
         val = wm
-        if tw is not None:
-            ats = available_twist_set(rr, P, limits, "task", moving)
-            tm = min(float(ats.margin(t).min()) for t in tw)
-            if tm < 0:
-                val -= _PENALTY * (-tm) + 1.0
+        if tm is not None and tm < 0:
+            val -= _PENALTY * (-tm) + 1.0
         ov = _footprint_overlap(rr, box)
         if ov > 0:
             val -= _PENALTY * ov + 1.0
@@ -581,17 +580,13 @@ def plan_deployment(robot: CableRobot, workspace: Any, *, disturbance: Any = Non
     vpts, _ = grid_points(box, verify_grid)
     poses = {n: best[3 * i:3 * i + 3].copy() for i, n in enumerate(names)}
     try:
-        wm, pm, _ = evaluate_deployment(rr, box, vpts, D, None, limits, moving)
+        wm, pm, tm = evaluate_deployment(rr, vpts, D, tw, limits, moving)
         pf = wrench_feasible(rr, vpts, tipping=True, disturbance=D)
     except TautError as exc:
         return DeploymentResult(False, poses, rr, -np.inf, None, vpts, np.full(len(vpts),
                                 -np.inf), np.zeros(len(vpts), bool), box,
                                 f"no placement keeps the workspace inside the frame: {exc}",
                                 count[0], cert)
-    tm = None
-    if tw is not None:
-        ats = available_twist_set(rr, vpts, limits, "task", moving)
-        tm = min(float(ats.margin(t).min()) for t in tw)
     ov = _footprint_overlap(rr, box)
     ok = bool(pf.all()) and (tm is None or tm >= 0) and ov == 0
     reason = ""
