@@ -17,11 +17,10 @@ import numpy as np
 import typer
 
 from ..cdpr import (available_wrench_set, axis_capacities, capacity_margin,
-                    distribute_tensions, disturbance_box, grid_points, with_stabilisers,
+                    distribute_tensions, disturbance_box, grid_points,
                     wrench_feasible_workspace)
-from ..cdpr.model import CableRobot
 from ..errors import InvalidInputError
-from ..io.cdpr_model import load_cdpr_model
+from ._cdpr_common import Vec3, load_robot
 from .cdpr_motion import add_commands
 
 __all__ = ["register"]
@@ -45,12 +44,6 @@ _POSE_OPT = typer.Option(..., "--pose", help=_POSE_HELP)
 _RPY_OPT = typer.Option((0.0, 0.0, 0.0), "--rpy", help=_RPY_HELP)
 _STAB_OPT = typer.Option(False, "--stabilisers", help="Deploy the stabilisers of mobile bases.")
 _JSON_OPT = typer.Option(False, "--json", help="Machine-readable output.")
-Vec3 = tuple[float, float, float]
-
-
-def _load(model: str, stabilisers: bool) -> CableRobot:
-    robot = load_cdpr_model(model)
-    return with_stabilisers(robot, True) if stabilisers else robot
 
 
 def _pose(pose: tuple[float, float, float], rpy: tuple[float, float, float]) -> np.ndarray:
@@ -76,7 +69,7 @@ def _echo_json(obj) -> None:
 
 def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers: bool,
               as_json: bool) -> None:
-    robot = _load(model, stabilisers)
+    robot = load_robot(model, stabilisers)
     P = _pose(pose, rpy)
     res = distribute_tensions(robot, P, method.value, tipping=tipping)
     t = res.tensions[0]
@@ -114,7 +107,7 @@ def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers:
 
 def _wrench_set(model: str, pose, rpy, disturbance, stabilisers: bool, as_json: bool,
                 plot: Optional[Path] = None) -> None:
-    robot = _load(model, stabilisers)
+    robot = load_robot(model, stabilisers)
     P = _pose(pose, rpy)
     D = None
     if disturbance is not None:
@@ -186,7 +179,7 @@ def _orientations(rpy, sweep: float) -> np.ndarray:
 
 def _workspace(model: str, grid, box, rpy, plot: Optional[Path], stabilisers: bool,
                as_json: bool, sweep: float = 0.0) -> None:
-    robot = _load(model, stabilisers)
+    robot = load_robot(model, stabilisers)
     if box is not None:
         region = np.array(box, dtype=float).reshape(2, 3)
     elif robot.desired_workspace is not None:

@@ -16,15 +16,14 @@ from typing import Optional
 import numpy as np
 import typer
 
-from ..cdpr import disturbance_box, with_stabilisers
+from ..cdpr import disturbance_box
 from ..cdpr.deploy import plan_deployment, workspace_box
 from ..cdpr.twist import MotionLimits, available_twist_set, twist_capacities
 from ..errors import InvalidInputError
-from ..io.cdpr_model import load_cdpr_model
+from ._cdpr_common import Vec3, load_robot
 
 __all__ = ["add_commands"]
 
-Vec3 = tuple[float, float, float]
 Vec6 = tuple[float, float, float, float, float, float]
 
 
@@ -42,9 +41,7 @@ def _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed
     _finite(pose, "pose")
     _finite(rpy, "rpy")
     _finite((base_speed, yaw_rate, cable_speed), "limits")
-    robot = load_cdpr_model(model)
-    if stabilisers:
-        robot = with_stabilisers(robot, True)
+    robot = load_robot(model, stabilisers)
     lim = MotionLimits((-yaw_rate, -base_speed, -base_speed), (yaw_rate, base_speed, base_speed),
                        -cable_speed, cable_speed)
     P = np.array([*pose, *rpy])
@@ -87,9 +84,7 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
     _finite(disturbance, "disturbance")
     _finite(twist, "twist")
     box = workspace_box(np.array(ws, dtype=float))
-    robot = load_cdpr_model(model)
-    if stabilisers:
-        robot = with_stabilisers(robot, True)
+    robot = load_robot(model, stabilisers)
     D = None if disturbance is None else disturbance_box(robot, disturbance[:robot.dof])
     res = plan_deployment(robot, box, disturbance=D,
                           required_twist=None if twist is None else twist[:robot.dof],
