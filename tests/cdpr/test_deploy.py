@@ -370,3 +370,26 @@ def test_cli_deploy_refuted_exit_1(capsys, tmp_path):
     # a malformed box is still an input error (exit 2)
     assert taut_main(["cdpr", "deploy", "fastkit", "--workspace", "-2.5", "2.5", "0", "0",
                       "0.2", "2.2"]) == 2
+
+
+@pytest.mark.parametrize("args, field", [
+    (["deploy", "fastkit", "--workspace", "-2.5", "2.5", "0", "0.1", "0.2", "1", "--seed", "-1"],
+     "seed"),
+    (["deploy", "fastkit", "--workspace", "-2.5", "2.5", "0", "0.1", "0.2", "1", "--maxiter",
+      "-1"], "maxiter"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--base-speed", "-1"], "limits.base"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--yaw-rate", "0"], "limits.base"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--cable-speed", "0"], "limits.cable"),
+])
+def test_cli_settings_errors(args, field):
+    """Optimiser settings and speed limits a user can mistype: typed errors, no search run."""
+    with pytest.raises(TautError) as exc:
+        _app()(args=["cdpr", *args], standalone_mode=False)
+    assert exc.value.field == field
+
+
+def test_plan_deployment_rejects_bad_settings(fastkit):
+    for kwargs in ({"seed": -1}, {"seed": 1.5}, {"maxiter": -2}, {"popsize": 0}):
+        with pytest.raises(InvalidInputError) as exc:
+            plan_deployment(fastkit, BOX, **kwargs)
+        assert exc.value.field == next(iter(kwargs))

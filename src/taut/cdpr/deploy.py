@@ -533,6 +533,11 @@ def plan_deployment(robot: CableRobot, workspace: Any, *, disturbance: Any = Non
     sr = as_array(search, "search", shape=(3,))
     if np.any(sr < 0):
         raise InvalidInputError("search", "half-widths must be non-negative")
+    for name, value, low in (("maxiter", maxiter, 0), ("popsize", popsize, 1), ("seed", seed, 0)):
+        integer = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+        if not (integer and low <= value < 2 ** 32):
+            raise InvalidInputError(name, f"must be an integer from {low} to 2**32 - 1, "
+                                          f"got {value!r}")
     cert = lift_bound(robot, box, disturbance=D)
     names = [b.name for b in mobile]
     if cert.refutes:

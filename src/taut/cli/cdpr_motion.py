@@ -41,6 +41,10 @@ def _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed
     _finite(pose, "pose")
     _finite(rpy, "rpy")
     _finite((base_speed, yaw_rate, cable_speed), "limits")
+    for field, value in (("limits.base", base_speed), ("limits.base", yaw_rate),
+                         ("limits.cable", cable_speed)):
+        if value <= 0:
+            raise InvalidInputError(field, f"speed limits must be positive, got {value:g}")
     robot = load_robot(model, stabilisers)
     lim = MotionLimits((-yaw_rate, -base_speed, -base_speed), (yaw_rate, base_speed, base_speed),
                        -cable_speed, cable_speed)
