@@ -1,0 +1,84 @@
+"""The one result convention of taut: every outcome that can fail says so the same way.
+
+Like scipy's ``OptimizeResult`` (``success``, ``status``, ``message``) and CASPR's exit
+types, each analysis that can answer "no" to a valid question returns a frozen result with
+
+``success : bool`` (or a boolean array of shape ``(B,)`` for batched results)
+    True when the analysis produced what was asked for.
+``status : str`` (or an array of str for batched results)
+    One of :data:`STATUSES`; ``"ok"`` exactly when ``success`` is true.
+``message : str``
+    One human line: what was found, or why not.
+
+Exceptions (subclasses of :class:`taut.errors.TautError`) are for invalid input only.
+Old attribute names (``reason``, ``feasible``, ``ok``, ``found``) stay as read-only
+deprecated aliases for one release via :func:`deprecated_alias`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any, Literal
+
+__all__ = ["Status", "STATUSES", "deprecated_alias", "check_status"]
+
+#: Every status value used by a taut result.
+Status = Literal[
+    "ok",                # the analysis produced what was asked for
+    "infeasible",        # no solution satisfies the constraints (e.g. tension limits)
+    "unreachable",       # a target provably cannot be reached (a certificate is attached)
+    "refuted",           # a certificate proves that no solution exists
+    "no_route",          # the planner's search space holds no route
+    "budget_exhausted",  # the search stopped at its budget without a proof either way
+    "not_converged",     # an iterative solver stopped before its tolerance
+    "unverified",        # a candidate was found but failed verification
+    "diverged",          # a simulation left the model's domain
+]
+
+STATUSES: tuple[str, ...] = Status.__args__  # type: ignore[attr-defined]
+
+
+def check_status(status: str) -> str:
+    """Return ``status`` if it is a known status value, else raise ``ValueError``.
+
+    Used by result constructors so a misspelt status cannot escape into user code.
+    """
+    if status not in STATUSES:
+        raise ValueError(f"unknown status {status!r}; expected one of {STATUSES}")
+    return status
+
+
+def deprecated_alias(new: str, old: str, *, transform: Any = None) -> property:
+    """A read-only property ``old`` that warns and returns ``getattr(self, new)``.
+
+    Parameters
+    ----------
+    new : str
+        Name of the attribute that replaces the old one.
+    old : str
+        The deprecated name (used in the warning only).
+    transform : callable, optional
+        Applied to the new attribute's value (e.g. ``message`` -> ``None`` on success
+        for the old ``reason`` field).
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class R:
+    ...     message: str
+    ...     reason = deprecated_alias("message", "reason")
+    >>> import warnings
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     R("no route").reason
+    'no route'
+    """
+
+    def getter(self: Any) -> Any:
+        warnings.warn(f"'{old}' is deprecated; use '{new}'", DeprecationWarning, stacklevel=2)
+        value = getattr(self, new)
+        return transform(self, value) if transform is not None else value
+
+    getter.__doc__ = f"Deprecated alias of ``{new}`` (kept for one release)."
+    return property(getter)
