@@ -9,7 +9,9 @@ import numpy as np
 
 from .errors import InvalidInputError
 
-__all__ = ["as_array", "as_points", "as_positive", "as_finite_scalar", "as_nonnegative"]
+__all__ = ["as_array", "as_points", "as_positive", "as_finite_scalar", "as_nonnegative",
+           "check_range", "as_mass", "as_count", "as_box", "require_instance",
+           "require_nonempty", "LIMITS"]
 
 
 def as_array(value: Any, field: str, *, ndim: int | None = None,
@@ -71,3 +73,138 @@ def as_nonnegative(value: Any, field: str) -> float:
     if not x >= 0.0:
         raise InvalidInputError(field, f"must be non-negative, got {x:g}")
     return x
+
+
+# --- The numeric range every input accepts ----------------------------------------------------
+#
+# One table for the whole package (the README's "Accepted ranges" section repeats it). The
+# limits keep every intermediate product of the solvers far from float64 overflow (squared
+# lengths, tensions times lengths, LP coefficients) and far from sizes no machine solves; a
+# value outside is a typed error, never an ``inf`` in a result or a wrong "no".
+
+#: Largest |coordinate| of a sheet vertex, robot position, object target or hold height (any
+#: length unit, e.g. mm: 1 km). FK normalises by the sheet size, so only the spread between
+#: the largest and the smallest length matters; squared lengths stay <= 1e12, far from
+#: overflow, and a sheet 1e6 units wide still resolves 1e-6 unit details in float64.
+MAX_SHEET_LENGTH = 1e6
+#: Largest |coordinate| of a cable-robot point, pose or workspace box, m (1 km; FASTKIT is 5 m).
+MAX_CDPR_LENGTH_M = 1e3
+#: Largest object / payload mass, kg.
+MAX_MASS_KG = 1e6
+#: Largest cable tension limit, N (the LP/QP and closed-form methods agree up to here).
+MAX_TENSION_N = 1e9
+#: Largest speed or rate limit (m/s, rad/s) and twist component.
+MAX_SPEED = 1e3
+#: Largest number of robots in a team (FK is O(N^2) hull faces; planning far less).
+MAX_ROBOTS = 1000
+#: Largest number of poses / formations / grid points in one call.
+MAX_BATCH = 10_000_000
+
+LIMITS: dict[str, tuple[float, str]] = {
+    "sheet length": (MAX_SHEET_LENGTH, "sheet units"),
+    "cable-robot length": (MAX_CDPR_LENGTH_M, "m"),
+    "mass": (MAX_MASS_KG, "kg"),
+    "tension": (MAX_TENSION_N, "N"),
+    "speed": (MAX_SPEED, "m/s or rad/s"),
+    "robots": (MAX_ROBOTS, "robots"),
+    "batch": (MAX_BATCH, "items"),
+}
+
+
+def check_range(arr: Any, field: str, limit: float, unit: str) -> np.ndarray:
+    """``arr`` (as a finite float64 array) with every ``|value| <= limit``.
+
+    Examples
+    --------
+    >>> check_range([1.0, -2.0], "pose", 1e3, "m").tolist()
+    [1.0, -2.0]
+    >>> check_range([1e308], "pose", 1e3, "m")
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: pose: |value| 1e+308 exceeds the accepted range 1000 m
+    """
+    a = as_array(arr, field)
+    if a.size and float(np.max(np.abs(a))) > limit:
+        big = float(np.max(np.abs(a)))
+        raise InvalidInputError(field, f"|value| {big:g} exceeds the accepted range "
+                                       f"{limit:g} {unit}")
+    return a
+
+
+def as_mass(value: Any, field: str = "mass") -> float:
+    """A mass in kg, ``0 < m <= MAX_MASS_KG``."""
+    m = as_positive(value, field)
+    check_range(m, field, MAX_MASS_KG, "kg")
+    return m
+
+
+def as_count(value: Any, field: str, *, minimum: int = 0, maximum: int | None = None) -> int:
+    """An integer (not a bool, not a float) with ``minimum <= value <= maximum``.
+
+    Examples
+    --------
+    >>> as_count(3, "n", minimum=3)
+    3
+    >>> as_count(-1, "chunk", minimum=1)
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: chunk: must be an integer >= 1, got -1
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InvalidInputError(field, f"must be an integer, got {value!r}")
+    n = int(value)
+    if n < minimum:
+        raise InvalidInputError(field, f"must be an integer >= {minimum}, got {n}")
+    if maximum is not None and n > maximum:
+        raise InvalidInputError(field, f"must be at most {maximum}, got {n} (the accepted "
+                                       "range bounds the work)")
+    return n
+
+
+def as_box(value: Any, field: str, *, limit: float = MAX_CDPR_LENGTH_M, unit: str = "m",
+           allow_flat: bool = True) -> np.ndarray:
+    """An axis-aligned box given as ``xmin xmax ymin ymax zmin zmax`` (the one order every
+    ``taut`` option uses) or as ``[[xmin, ymin, zmin], [xmax, ymax, zmax]]``; returns the
+    (2, 3) corner form.
+
+    A box with some ``max < min`` is an error; ``max == min`` (a slice) is accepted when
+    ``allow_flat``.
+
+    Examples
+    --------
+    >>> as_box([-1, 1, 0, 0, 0.2, 2], "--box").tolist()
+    [[-1.0, 0.0, 0.2], [1.0, 0.0, 2.0]]
+    >>> as_box([1, -1, 0, 0, 0, 1], "--box")
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: --box: xmax -1 < xmin 1 (give XMIN XMAX YMIN YMAX ZMIN ZMAX)
+    """
+    b = check_range(value, field, limit, unit)
+    if b.shape == (6,):
+        b = b.reshape(3, 2).T
+    if b.shape != (2, 3):
+        raise InvalidInputError(field, "must be XMIN XMAX YMIN YMAX ZMIN ZMAX")
+    bad = b[1] < b[0] if allow_flat else b[1] <= b[0]
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        a = "xyz"[k]
+        rel = "<" if allow_flat else "<="
+        raise InvalidInputError(field, f"{a}max {b[1, k]:g} {rel} {a}min {b[0, k]:g} (give "
+                                       "XMIN XMAX YMIN YMAX ZMIN ZMAX)")
+    return b
+
+
+def require_instance(value: Any, cls: type, field: str) -> Any:
+    """``value`` if it is an instance of ``cls``, else an error naming the expected type
+    (so ``None`` in place of a model is a typed error, not an ``AttributeError``)."""
+    if not isinstance(value, cls):
+        raise InvalidInputError(field, f"must be a {cls.__module__.replace('._', '.')}"
+                                       f".{cls.__name__}, got {type(value).__name__}")
+    return value
+
+
+def require_nonempty(arr: np.ndarray, field: str) -> np.ndarray:
+    """``arr`` unless it has a zero-length axis (an empty batch or point list)."""
+    if arr.size == 0:
+        raise InvalidInputError(field, f"is empty (shape {'x'.join(map(str, arr.shape))})")
+    return arr

@@ -302,7 +302,7 @@ def _app():
 
 def test_cli_plan_json_and_figures(tmp_path, capsys):
     out, png = tmp_path / "plan.json", tmp_path / "plan.png"
-    rc = _app()(args=["plan", str(EXAMPLES / "paper_corridor.yaml"), "--json", str(out),
+    rc = _app()(args=["plan", str(EXAMPLES / "paper_corridor.yaml"), "--out", str(out),
                       "--plot", str(png)], standalone_mode=False)
     assert rc == 0 and png.stat().st_size > 10_000
     data = json.loads(out.read_text())
@@ -313,7 +313,7 @@ def test_cli_plan_json_and_figures(tmp_path, capsys):
     assert np.asarray(data["robots"]).shape == (T, 3, 2)
     assert np.asarray(data["object"]).shape == (T, 3) and len(data["taut"]) == T
     rc = _app()(args=["plan", str(EXAMPLES / "paper_corridor.yaml"), "--algorithm2",
-                      "--json", str(out)], standalone_mode=False)
+                      "--out", str(out)], standalone_mode=False)
     assert rc == 0 and json.loads(out.read_text())["duration"] > data["duration"]
     rc = _app()(args=["plan", str(EXAMPLES / "paper_corridor.yaml"), "--baseline"],
                 standalone_mode=False)

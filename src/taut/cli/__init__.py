@@ -3,11 +3,23 @@
 Each subcommand family lives in its own module exposing ``register(app)``. :func:`main`
 turns every user mistake (a :class:`taut.errors.TautError` or a command-line usage error)
 into one line on stderr and exit code 2; nothing a user types produces a traceback.
+
+Exit codes (the same in every command):
+
+====  =====================================================================================
+0     the question was answered "yes" (a plan, a placement, equilibria, feasible tensions)
+1     a valid question answered "no" (no equilibrium, tensions infeasible, target
+      unreachable, no plan, no placement); the reason is printed
+2     invalid input: one line ``taut: error: <field>: <problem>`` on stderr
+====  =====================================================================================
+
+Commands import their solvers when they run, so ``taut --help`` loads no scipy.
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
 
 import typer
 from typer.exceptions import TyperException
@@ -37,13 +49,17 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
                                        is_eager=True, help="Print the version and exit.")
           ) -> None:
     """Carrying loads with cables and mobile robots: sheet-carrying robot teams (VVCM) and
-    cable-driven parallel robots on mobile bases. Every input error prints one line
-    ``taut: error: <field>: <problem>`` and exits with code 2."""
+    cable-driven parallel robots on mobile bases.
+
+    Exit codes: 0 answered yes; 1 a valid question answered no (no equilibrium,
+    infeasible tensions, unreachable target, no plan or placement); 2 invalid input, with
+    one line ``taut: error: <field>: <problem>`` on stderr."""
 
 
 for _module in (fk, motion, plan, cdpr):
     _module.register(app)
 
+EXIT_NO = 1
 EXIT_USAGE = 2
 
 
@@ -74,7 +90,21 @@ def _usage_line(exc: Exception) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; returns the process exit code (0 success, 2 bad input)."""
+    """Run the CLI; returns the process exit code (0 yes, 1 a valid question answered no,
+    2 bad input).
+
+    Numeric warnings of numpy (overflow, invalid values) never reach the terminal: inputs
+    are range-checked before any solver runs (:mod:`taut._validate`), and what remains
+    inside a solver is its own business (it reports NaN/None, never a silent wrong answer).
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        import numpy as np
+        with np.errstate(all="ignore"):
+            return _run(argv)
+
+
+def _run(argv: list[str] | None) -> int:
     try:
         result = app(args=argv, prog_name="taut", standalone_mode=False)
     except TautError as exc:
@@ -93,6 +123,11 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(_usage_line(exc))
     except BrokenPipeError:
         return 0
+    except OSError as exc:                       # e.g. the disk filled up while writing
+        where = exc.filename if isinstance(exc.filename, str) else "file"
+        return _fail(f"{where}: {exc.strerror or exc}")
+    except MemoryError:
+        return _fail("input: too large to fit in memory")
     return int(result) if isinstance(result, int) else 0
 
 

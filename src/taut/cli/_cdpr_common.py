@@ -1,15 +1,57 @@
-"""Pieces shared by the `taut cdpr` command modules."""
+"""Pieces shared by the `taut cdpr` command modules: loading a model inside the accepted
+numeric range and checking poses (all heavy imports happen here, lazily)."""
 
 from __future__ import annotations
 
-from ..cdpr import with_stabilisers
-from ..cdpr.model import CableRobot
-from ..io.cdpr_model import load_cdpr_model
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .._validate import (MAX_CDPR_LENGTH_M, MAX_MASS_KG, MAX_SPEED, MAX_TENSION_N,
+                         check_range)
+from ..errors import InvalidModelError
+
+if TYPE_CHECKING:
+    from ..cdpr.model import CableRobot
 
 Vec3 = tuple[float, float, float]
+Vec6 = tuple[float, float, float, float, float, float]
+
+#: |roll|, |pitch|, |yaw| accepted on the command line, rad (a few turns; angles are periodic).
+MAX_ANGLE_RAD = 100.0
+
+MODEL_HELP = "Preset name (fastkit, ipanema) or model file (YAML/JSON)."
 
 
 def load_robot(model: str, stabilisers: bool) -> CableRobot:
-    """A preset or model file, with the stabilisers of its mobile bases deployed if asked."""
+    """A preset or model file, with the stabilisers of its mobile bases deployed if asked.
+
+    Tension limits above ``MAX_TENSION_N``, masses above ``MAX_MASS_KG`` and points farther
+    than ``MAX_CDPR_LENGTH_M`` are rejected (see :mod:`taut._validate`)."""
+    from ..cdpr import with_stabilisers
+    from ..io.cdpr_model import load_cdpr_model
+
     robot = load_cdpr_model(model)
+    for k, c in enumerate(robot.cables):
+        if c.t_max > MAX_TENSION_N:
+            raise InvalidModelError(f"cables[{k}].t_max", f"{c.t_max:g} N exceeds the "
+                                    f"accepted range {MAX_TENSION_N:g} N")
+    total = robot.platform.mass + robot.payload.mass
+    if total > MAX_MASS_KG:
+        raise InvalidModelError("payload.mass", f"platform + payload {total:g} kg exceeds "
+                                f"the accepted range {MAX_MASS_KG:g} kg")
+    if robot.bounds is not None:
+        check_range(robot.bounds, "bounds", MAX_CDPR_LENGTH_M, "m")
     return with_stabilisers(robot, True) if stabilisers else robot
+
+
+def pose_vector(pose: Any, rpy: Any) -> np.ndarray:
+    """``(x, y, z, roll, pitch, yaw)`` from the ``--pose`` and ``--rpy`` options, in range."""
+    p = check_range(pose, "pose", MAX_CDPR_LENGTH_M, "m")
+    a = check_range(rpy, "rpy", MAX_ANGLE_RAD, "rad")
+    return np.concatenate([p, a])
+
+
+def speeds(values: Any, field: str) -> np.ndarray:
+    """Speeds or twist components (m/s, rad/s) within ``MAX_SPEED``."""
+    return check_range(values, field, MAX_SPEED, "m/s or rad/s")

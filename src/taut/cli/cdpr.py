@@ -7,23 +7,25 @@ as ``--pose X Y Z`` (m) and optionally ``--rpy ROLL PITCH YAW`` (rad).
 
 from __future__ import annotations
 
-import json
-import sys
 from enum import Enum
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 import typer
 
-from ..cdpr import (available_wrench_set, axis_capacities, capacity_margin,
-                    distribute_tensions, disturbance_box, grid_points,
-                    wrench_feasible_workspace)
+from .._validate import MAX_CDPR_LENGTH_M, MAX_TENSION_N, as_box, as_count, check_range
 from ..errors import InvalidInputError
-from ._cdpr_common import Vec3, load_robot
+from ..io.serialize import tensions_to_dict, to_json, workspace_to_dict, wrench_set_to_dict
+from ._cdpr_common import MODEL_HELP, Vec3, load_robot, pose_vector
+from ._paths import FIGURE_SUFFIXES, output_path
+from ._progress import working
 from .cdpr_motion import add_commands
 
 __all__ = ["register"]
+
+#: Largest workspace grid (points x orientations) one command evaluates.
+MAX_GRID_POINTS = 1_000_000
 
 
 class Method(str, Enum):
@@ -33,25 +35,17 @@ class Method(str, Enum):
     qp_min_norm = "qp_min_norm"
 
 
-_MODEL_HELP = "Preset name (fastkit, ipanema) or model file (YAML/JSON)."
 _POSE_HELP = "Platform position X Y Z in m."
 _RPY_HELP = "Platform orientation ROLL PITCH YAW in rad (Rz(yaw) Ry(pitch) Rx(roll))."
 
 
 # Options shared by the three commands (typer option metadata can be reused).
-_MODEL_ARG = typer.Argument(..., help=_MODEL_HELP)
+_MODEL_ARG = typer.Argument(..., help=MODEL_HELP)
 _POSE_OPT = typer.Option(..., "--pose", help=_POSE_HELP)
 _RPY_OPT = typer.Option((0.0, 0.0, 0.0), "--rpy", help=_RPY_HELP)
 _STAB_OPT = typer.Option(False, "--stabilisers", help="Deploy the stabilisers of mobile bases.")
-_JSON_OPT = typer.Option(False, "--json", help="Machine-readable output.")
-
-
-def _pose(pose: tuple[float, float, float], rpy: tuple[float, float, float]) -> np.ndarray:
-    return np.array([*pose, *rpy], dtype=float)
-
-
-def _r(x: float, d: int = 3) -> float:
-    return float(round(float(x), d))
+_JSON_OPT = typer.Option(False, "--json", help="Print machine-readable JSON instead of a "
+                         "table.")
 
 
 def _table(headers: list[str], rows: list[list[str]]) -> str:
@@ -63,38 +57,31 @@ def _table(headers: list[str], rows: list[list[str]]) -> str:
     return "\n".join(out)
 
 
-def _echo_json(obj) -> None:
-    typer.echo(json.dumps(obj, indent=2))
+def _tensions(model: str, pose: Any, rpy: Any, method: Method, tipping: bool,
+              stabilisers: bool, as_json: bool) -> int:
+    """Exit 0 when the pose is wrench-feasible, 1 when it is not."""
+    from ..cdpr import distribute_tensions
 
-
-def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers: bool,
-              as_json: bool) -> None:
+    P = pose_vector(pose, rpy)
     robot = load_robot(model, stabilisers)
-    P = _pose(pose, rpy)
     res = distribute_tensions(robot, P, method.value, tipping=tipping)
+    doc = tensions_to_dict(robot, P, res)
+    code = 0 if doc["feasible"] else 1
     t = res.tensions[0]
     names = [c.name for c in robot.cables]
     if as_json:
-        _echo_json({
-            "model": robot.name, "pose": P.tolist(), "method": method.value,
-            "tipping": res.tipping, "feasible": bool(res.feasible[0]),
-            "residual": None if not np.isfinite(res.residual[0]) else float(res.residual[0]),
-            "tensions": {n: (None if not np.isfinite(v) else float(v)) for n, v in zip(names, t)},
-            "tipping_moments": (None if not np.all(np.isfinite(res.tipping_moments[0])) else
-                                [float(x) for x in res.tipping_moments[0]]),
-            "tipping_edge_base": [robot.bases[k].name for k in robot.edge_base],
-        })
-        return
+        typer.echo(to_json(doc))
+        return code
     note = "" if not res.tipping else (
         "  (tipping checked)" if method == Method.closed_form else "  (tipping imposed)")
     typer.echo(f"{robot.name}: pose {P.round(4).tolist()}  method {method.value}{note}")
     if not np.all(np.isfinite(t)):
         typer.echo("no tension distribution found: the pose is not wrench-feasible")
-        return
+        return code
     rows = [[n, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if lo - 1e-6 <= v <= hi + 1e-6 else "!"]
             for n, v, lo, hi in zip(names, t, robot.t_min, robot.t_max)]
     typer.echo(_table(["cable", "tension [N]", "min", "max", ""], rows))
-    typer.echo(f"feasible: {'yes' if res.feasible[0] else 'no'}   "
+    typer.echo(f"feasible: {'yes' if doc['feasible'] else 'no'}   "
                f"residual max|W t + w_e| = {res.residual[0]:.2e}")
     if robot.has_tipping:
         M = res.tipping_moments[0]
@@ -103,35 +90,31 @@ def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers:
             if np.any(sel):
                 typer.echo(f"base {base.name}: largest edge moment {M[sel].max():.2f} N m "
                            f"({'stable' if M[sel].max() <= 1e-6 else 'TIPS'})")
+    return code
 
 
-def _wrench_set(model: str, pose, rpy, disturbance, stabilisers: bool, as_json: bool,
-                plot: Optional[Path] = None) -> None:
+def _wrench_set(model: str, pose: Any, rpy: Any, disturbance: Any, stabilisers: bool,
+                as_json: bool, plot: Optional[Path] = None) -> None:
+    from ..cdpr import available_wrench_set, axis_capacities, capacity_margin, disturbance_box
+
+    P = pose_vector(pose, rpy)
     robot = load_robot(model, stabilisers)
-    P = _pose(pose, rpy)
     D = None
     if disturbance is not None:
         hw = np.zeros(robot.dof)
-        vals = np.asarray(disturbance, dtype=float)
+        vals = check_range(disturbance, "disturbance", MAX_TENSION_N, "N or N m")
         hw[:min(len(vals), robot.dof)] = vals[:robot.dof]
         D = disturbance_box(robot, hw)
-    out = {"model": robot.name, "pose": P.tolist(), "dof": robot.dof}
-    modes = [False, True] if robot.has_tipping else [False]
-    caps = {}
-    for tip in modes:
-        key = "with_tipping" if tip else "tension_limits_only"
-        cap = axis_capacities(robot, P, tipping=tip)
+    modes: dict[str, dict[str, Any]] = {}
+    for tip in ([False, True] if robot.has_tipping else [False]):
         aws = available_wrench_set(robot, P, tipping=tip)
-        H, h = aws.facets(0)
-        margin = float(capacity_margin(robot, P, D, tipping=tip)[0])
-        caps[key] = cap
-        out[key] = {
-            "capacity_positive": dict(zip(cap.labels, map(_r, cap.positive[0]))),
-            "capacity_negative": dict(zip(cap.labels, map(_r, cap.negative[0]))),
-            "capacity_margin": None if not np.isfinite(margin) else _r(margin, 4),
-            "gravity_feasible": bool(aws.contains(-aws.gravity_wrench)[0]),
-            "halfspaces": {"H": np.round(H, 9).tolist(), "h": np.round(h, 9).tolist()},
-        }
+        modes["with_tipping" if tip else "tension_limits_only"] = {
+            "capacities": axis_capacities(robot, P, tipping=tip),
+            "halfspaces": aws.facets(0),
+            "margin": float(capacity_margin(robot, P, D, tipping=tip)[0]),
+            "gravity_feasible": bool(aws.contains(-aws.gravity_wrench)[0])}
+    out = wrench_set_to_dict(robot, P, modes)
+    caps = {key: m["capacities"] for key, m in modes.items()}
     if plot is not None:
         from ..viz.cdpr import plot_axis_capacities
         import matplotlib.pyplot as plt
@@ -141,7 +124,7 @@ def _wrench_set(model: str, pose, rpy, disturbance, stabilisers: bool, as_json: 
         plt.close(fig)
         out["plot"] = str(plot)
     if as_json:
-        _echo_json(out)
+        typer.echo(to_json(out))
         return
     typer.echo(f"{robot.name}: available wrench set at pose {P.round(4).tolist()}")
     typer.echo("largest extra external wrench on top of the platform and payload weight "
@@ -166,58 +149,49 @@ def _wrench_set(model: str, pose, rpy, disturbance, stabilisers: bool, as_json: 
         typer.echo(f"figure written to {plot}")
 
 
-def _orientations(rpy, sweep: float) -> np.ndarray:
+def _orientations(rpy: Any, sweep: float) -> np.ndarray:
     """The orientation ``rpy`` and, when ``sweep`` > 0, ``rpy`` +- sweep about each axis."""
-    base = np.array([rpy], dtype=float)
-    if not np.isfinite(sweep) or sweep < 0:
-        raise InvalidInputError("sweep", "must be a finite angle >= 0 (rad)")
+    base = pose_vector((0.0, 0.0, 0.0), rpy)[3:][None]
+    if not np.isfinite(sweep) or sweep < 0 or sweep > np.pi:
+        raise InvalidInputError("sweep", "must be a finite angle in [0, pi] rad")
     if sweep == 0:
         return base
     steps = np.vstack([np.zeros(3), sweep * np.eye(3), -sweep * np.eye(3)])
     return base + steps
 
 
-def _workspace(model: str, grid, box, rpy, plot: Optional[Path], stabilisers: bool,
-               as_json: bool, sweep: float = 0.0) -> None:
-    robot = load_robot(model, stabilisers)
-    if box is not None:
-        region = np.array(box, dtype=float).reshape(2, 3)
-    elif robot.desired_workspace is not None:
-        region = robot.desired_workspace
-    else:
-        region = robot.bounds
-    pts, shape = grid_points(region, grid)
+def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
+               stabilisers: bool, as_json: bool, sweep: float = 0.0) -> None:
+    from ..cdpr import grid_points, wrench_feasible_workspace
+
+    nx, ny, nz = (as_count(n, "grid", minimum=1) for n in grid)
     ori = _orientations(rpy, sweep)
-    if not as_json and sys.stdout.isatty():
-        from rich.progress import Progress
-        with Progress(transient=True) as bar:
-            task = bar.add_task("wrench-feasible workspace", total=len(pts) * len(ori) * (
-                2 if robot.has_tipping else 1))
-            ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape,
-                                           chunk=2048,
-                                           progress=lambda d, t: bar.update(task, completed=d))
-    else:
-        ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape)
+    if nx * ny * nz * len(ori) > MAX_GRID_POINTS:
+        raise InvalidInputError("grid", f"{nx}x{ny}x{nz} points x {len(ori)} orientations "
+                                f"exceeds {MAX_GRID_POINTS} evaluations")
+    region = None if box is None else as_box(box, "box", limit=MAX_CDPR_LENGTH_M)
+    robot = load_robot(model, stabilisers)
+    if region is None:
+        region = robot.desired_workspace if robot.desired_workspace is not None \
+            else robot.bounds
+    pts, shape = grid_points(region, (nx, ny, nz))
+    total = len(pts) * len(ori) * (2 if robot.has_tipping else 1)
+    with working("cdpr workspace") as update:
+        ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape,
+                                       chunk=2048, progress=lambda d, t: update(d, total))
     if plot is not None:
         from ..viz.cdpr import plot_workspace
         import matplotlib.pyplot as plt
         fig = plot_workspace(ws, robot, plot)
         plt.close(fig)
     if as_json:
-        _echo_json({
-            "model": robot.name, "grid": list(shape), "box": region.tolist(),
-            "orientations": ori.tolist(), "points": len(pts),
-            "coverage": ws.coverage, "coverage_tipping": ws.coverage_tipping,
-            "feasible": ws.feasible.astype(int).tolist(),
-            "feasible_tipping": (None if ws.feasible_tipping is None else
-                                 ws.feasible_tipping.astype(int).tolist()),
-            "plot": None if plot is None else str(plot)})
+        typer.echo(to_json(workspace_to_dict(robot, region, ws, len(pts), plot)))
         return
     typer.echo(f"{robot.name}: wrench-feasible workspace on a {'x'.join(map(str, shape))} grid "
-               f"over {region.round(3).tolist()} m"
+               f"over {np.round(region, 3).tolist()} m"
                + (f", feasible at all {len(ori)} orientations" if len(ori) > 1 else ""))
     rows = [["tension limits", str(int(ws.feasible.sum())), f"{100 * ws.coverage:.1f} %"]]
-    if ws.feasible_tipping is not None:
+    if ws.feasible_tipping is not None and ws.coverage_tipping is not None:
         rows.append(["+ tipping", str(int(ws.feasible_tipping.sum())),
                      f"{100 * ws.coverage_tipping:.1f} %"])
     typer.echo(_table(["constraints", f"feasible of {len(pts)}", "coverage"], rows))
@@ -242,9 +216,11 @@ def register(app: typer.Typer) -> None:
                                      "constraints of the mobile bases (LP/QP methods)."),
         stabilisers: bool = _STAB_OPT,
         as_json: bool = _JSON_OPT,
-    ) -> None:
-        """Cable tensions holding platform and payload at a pose (FASTKIT eqs. 17-20)."""
-        _tensions(model, pose, rpy, method, tipping, stabilisers, as_json)
+    ) -> int:
+        """Cable tensions holding platform and payload at a pose (FASTKIT eqs. 17-20).
+        Exit 0 when a distribution within the limits exists, 1 when the pose is not
+        wrench-feasible, 2 on bad input."""
+        return _tensions(model, pose, rpy, method, tipping, stabilisers, as_json)
 
     @sub.command("wrench-set")
     def wrench_set_cmd(
@@ -255,13 +231,13 @@ def register(app: typer.Typer) -> None:
             None, "--disturbance", help="Half-widths FX FY FZ MX MY MZ (N, N m) of an extra "
                                         "wrench box for the capacity margin."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write a bar chart of the "
-                                            "axis capacities (like FASTKIT Fig. 14)."),
+                                            "axis capacities (like FASTKIT Fig. 14; .png, "
+                                            ".pdf, .svg)."),
         stabilisers: bool = _STAB_OPT,
         as_json: bool = _JSON_OPT,
     ) -> None:
         """Available wrench set at a pose: axis capacities, margin, half-spaces (eq. 24)."""
-        if disturbance is not None and any(not np.isfinite(v) for v in disturbance):
-            raise InvalidInputError("disturbance", "contains NaN or infinite values")
+        plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
         _wrench_set(model, pose, rpy, disturbance, stabilisers, as_json, plot)
 
     @sub.command("workspace")
@@ -270,16 +246,19 @@ def register(app: typer.Typer) -> None:
         grid: tuple[int, int, int] = typer.Option((41, 1, 21), "--grid",
                                                   help="Points per axis NX NY NZ."),
         box: Optional[tuple[float, float, float, float, float, float]] = typer.Option(
-            None, "--box", help="XMIN YMIN ZMIN XMAX YMAX ZMAX in m (default: the model's "
-                                "desired workspace, else its frame)."),
+            None, "--box", help="XMIN XMAX YMIN YMAX ZMIN ZMAX in m, the order of `deploy "
+                                "--workspace` (default: the model's desired workspace, else "
+                                "its frame)."),
         rpy: Vec3 = _RPY_OPT,
         sweep: float = typer.Option(0.0, "--sweep", help="Also require feasibility at the "
                                     "orientation +- SWEEP rad about each axis (7 in all)."),
-        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a figure (PNG/PDF)."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a figure (.png, "
+                                            ".pdf, .svg)."),
         stabilisers: bool = _STAB_OPT,
         as_json: bool = _JSON_OPT,
     ) -> None:
         """Wrench-feasible workspace with and without tipping; coverage of the desired one."""
+        plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
         _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep)
 
     add_commands(sub)

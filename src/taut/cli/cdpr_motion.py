@@ -9,60 +9,48 @@ limits are FASTKIT's (eqs. 10-16) unless overridden. Errors are :class:`taut.err
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 import typer
 
-from ..cdpr import disturbance_box
-from ..cdpr.deploy import plan_deployment, workspace_box
-from ..cdpr.twist import MotionLimits, available_twist_set, twist_capacities
+from .._validate import MAX_TENSION_N, as_box, as_count, check_range
 from ..errors import InvalidInputError
-from ._cdpr_common import Vec3, load_robot
+from ..io.serialize import deployment_to_dict, to_json, twist_set_to_dict
+from ._cdpr_common import MODEL_HELP, Vec3, Vec6, load_robot, pose_vector, speeds
+from ._paths import FIGURE_SUFFIXES, output_path
+from ._progress import working
 
 __all__ = ["add_commands"]
 
-Vec6 = tuple[float, float, float, float, float, float]
+#: Largest differential-evolution iteration count `deploy` accepts (8 takes about a minute).
+MAX_DEPLOY_ITERATIONS = 1000
 
 
-def _finite(values, field: str) -> None:
-    if values is not None and any(not np.isfinite(v) for v in values):
-        raise InvalidInputError(field, "contains NaN or infinite values")
+def _twist_set(model: str, pose: Any, rpy: Any, mode: str, moving: Any, base_speed: float,
+               yaw_rate: float, cable_speed: float, stabilisers: bool, as_json: bool,
+               plot: Optional[Path]) -> None:
+    from ..cdpr import MotionLimits, available_twist_set, twist_capacities
 
-
-def _r(x: float) -> float | None:
-    return None if not np.isfinite(x) else float(round(float(x), 4))
-
-
-def _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed,
-               stabilisers, as_json, plot) -> None:
-    _finite(pose, "pose")
-    _finite(rpy, "rpy")
-    _finite((base_speed, yaw_rate, cable_speed), "limits")
+    P = pose_vector(pose, rpy)
     for field, value in (("limits.base", base_speed), ("limits.base", yaw_rate),
                          ("limits.cable", cable_speed)):
         if value <= 0:
             raise InvalidInputError(field, f"speed limits must be positive, got {value:g}")
+        speeds(value, field)
     robot = load_robot(model, stabilisers)
     lim = MotionLimits((-yaw_rate, -base_speed, -base_speed), (yaw_rate, base_speed, base_speed),
                        -cable_speed, cable_speed)
-    P = np.array([*pose, *rpy])
     mv = None if not moving else tuple(moving)
-    caps = twist_capacities(robot, P, lim, mode, mv)
-    out = {"model": robot.name, "pose": P.tolist(), "mode": mode,
-           "moving": list(caps.mode.names), "labels": list(caps.labels),
-           "positive": [_r(v) for v in caps.positive[0]],
-           "negative": [_r(v) for v in caps.negative[0]]}
+    with working("cdpr twist-set"):
+        caps = twist_capacities(robot, P, lim, mode, mv)
+        fixed = twist_capacities(robot, P, lim, "task", ()) if mode == "task" else None
+        ats = available_twist_set(robot, P, lim, mode, mv)
+    out = twist_set_to_dict(robot, P, mode, caps, fixed, int(np.isfinite(ats.h[0]).sum()))
     series = {f"{mode}: {', '.join(caps.mode.names) or 'none'} moving": caps.positive[0]}
-    if mode == "task":
-        fixed = twist_capacities(robot, P, lim, "task", ())
-        out["bases_fixed"] = {"positive": [_r(v) for v in fixed.positive[0]],
-                              "negative": [_r(v) for v in fixed.negative[0]]}
+    if fixed is not None:
         series["bases fixed"] = fixed.positive[0]
-    ats = available_twist_set(robot, P, lim, mode, mv)
-    out["facets"] = int(np.isfinite(ats.h[0]).sum())
     if plot is not None:
         from ..viz.cdpr_motion import plot_capacity_bars
         n = len(caps.labels)
@@ -70,41 +58,39 @@ def _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed
                            f"{robot.name}: available twist set (+ axes)", plot)
         out["plot"] = str(plot)
     if as_json:
-        typer.echo(json.dumps(out, indent=2))
+        typer.echo(to_json(out))
         return
     typer.echo(f"{robot.name}: available twist set at {np.round(P, 3).tolist()} ({mode} mode, "
                f"moving: {', '.join(caps.mode.names) or 'none'}; {out['facets']} facets)")
-    typer.echo("axis   +max      -max" + ("    fixed +max" if mode == "task" else ""))
+    typer.echo("axis   +max      -max" + ("    fixed +max" if fixed is not None else ""))
     for k, lab in enumerate(caps.labels):
         row = f"{lab:4s} {caps.positive[0, k]:8.4f}  {caps.negative[0, k]:8.4f}"
-        if mode == "task":
-            row += f"  {out['bases_fixed']['positive'][k]:10.4f}"
+        if fixed is not None:
+            row += f"  {fixed.positive[0, k]:10.4f}"
         typer.echo(row)
 
 
-def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
-            as_json) -> int:
-    _finite(ws, "workspace")
-    _finite(disturbance, "disturbance")
-    _finite(twist, "twist")
-    box = workspace_box(np.array(ws, dtype=float))
+def _deploy(model: str, ws: Any, disturbance: Any, twist: Any, stabilisers: bool, seed: int,
+            maxiter: int, plot: Optional[Path], as_json: bool) -> int:
+    from ..cdpr import disturbance_box, plan_deployment
+
+    box = as_box(ws, "workspace", allow_flat=False)
+    if box[0, 2] < 0:
+        raise InvalidInputError("workspace", f"zmin {box[0, 2]:g} m is below the floor "
+                                "(z = 0); the platform cannot go there")
+    if disturbance is not None:
+        check_range(disturbance, "disturbance", MAX_TENSION_N, "N or N m")
+    if twist is not None:
+        speeds(twist, "twist")
+    as_count(seed, "seed", minimum=0)
+    as_count(maxiter, "maxiter", minimum=0, maximum=MAX_DEPLOY_ITERATIONS)
     robot = load_robot(model, stabilisers)
     D = None if disturbance is None else disturbance_box(robot, disturbance[:robot.dof])
-    res = plan_deployment(robot, box, disturbance=D,
-                          required_twist=None if twist is None else twist[:robot.dof],
-                          seed=seed, maxiter=maxiter)
-    lb = res.lift_bound
-    out = {"model": robot.name, "workspace": box.tolist(), "feasible": res.feasible,
-           "refuted": res.refuted,
-           "base_poses": {k: [round(float(x), 4) for x in v] for k, v in res.base_poses.items()},
-           "margin": _r(res.margin),
-           "twist_margin": None if res.twist_margin is None else _r(res.twist_margin),
-           "points": int(len(res.points)), "feasible_points": int(res.point_feasible.sum()),
-           "evaluations": res.evaluations, "reason": res.reason,
-           "lift_bound": None if lb is None else {
-               "height": _r(lb.height), "bound": _r(lb.bound), "required": _r(lb.required),
-               "weight": _r(lb.weight), "refutes": lb.refutes,
-               "per_cable": {c.name: _r(v) for c, v in zip(robot.cables, lb.per_cable)}}}
+    with working("cdpr deploy"):
+        res = plan_deployment(robot, box, disturbance=D,
+                              required_twist=None if twist is None else twist[:robot.dof],
+                              seed=seed, maxiter=maxiter)
+    out = deployment_to_dict(robot, res)
     note = None
     if plot is not None:
         if res.refuted:
@@ -116,14 +102,14 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
             from ..viz.cdpr_motion import plot_deployment
             plot_deployment(res, plot)
             out["plot"] = str(plot)
-    code = 0 if res.feasible else 1            # valid question, negative answer: exit 1
+    code = 0 if out["feasible"] else 1         # valid question, negative answer: exit 1
     if as_json:
-        typer.echo(json.dumps(out, indent=2))
+        typer.echo(to_json(out))
         return code
     typer.echo(f"{robot.name}: deployment for workspace {box.tolist()} m: "
-               + ("FEASIBLE" if res.feasible else "NOT FOUND"))
+               + ("FEASIBLE" if out["feasible"] else "NOT FOUND"))
     if res.refuted:
-        typer.echo("  " + res.reason)
+        typer.echo("  " + out["reason"])
         typer.echo("  upper bound per cable (N): " + ", ".join(
             f"{k} {v:.2f}" for k, v in out["lift_bound"]["per_cable"].items()))
         if note:
@@ -133,8 +119,8 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
         typer.echo(f"  {k}: x={v[0]} m  y={v[1]} m  theta={v[2]} rad")
     typer.echo(f"  worst capacity margin {out['margin']} over {out['points']} points "
                f"({out['feasible_points']} feasible with tipping)")
-    if res.reason:
-        typer.echo("  " + res.reason)
+    if out["reason"]:
+        typer.echo("  " + out["reason"])
     return code
 
 
@@ -143,7 +129,7 @@ def add_commands(sub: typer.Typer) -> None:
 
     @sub.command("twist-set")
     def twist_set_cmd(
-        model: str = typer.Argument(..., help="Preset name (fastkit, ipanema) or model file."),
+        model: str = typer.Argument(..., help=MODEL_HELP),
         pose: Vec3 = typer.Option(..., "--pose", help="Platform position X Y Z in m."),
         rpy: Vec3 = typer.Option((0.0, 0.0, 0.0), "--rpy",
                                  help="Platform orientation ROLL PITCH YAW in rad."),
@@ -154,20 +140,28 @@ def add_commands(sub: typer.Typer) -> None:
         base_speed: float = typer.Option(0.2, "--base-speed", help="Base speed limit, m/s."),
         yaw_rate: float = typer.Option(0.2, "--yaw-rate", help="Base yaw-rate limit, rad/s."),
         cable_speed: float = typer.Option(2.0, "--cable-speed", help="Cable speed limit, m/s."),
-        stabilisers: bool = typer.Option(False, "--stabilisers"),
-        plot: Optional[Path] = typer.Option(None, "--plot", help="Bar chart (like Fig. 13)."),
-        as_json: bool = typer.Option(False, "--json", help="Machine-readable output."),
+        stabilisers: bool = typer.Option(False, "--stabilisers",
+                                         help="Deploy the stabilisers of mobile bases first "
+                                              "(wider footprints against tipping)."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Bar chart (like Fig. 13; "
+                                            ".png, .pdf, .svg)."),
+        as_json: bool = typer.Option(False, "--json", help="Print machine-readable JSON "
+                                     "instead of a table."),
     ) -> None:
         """Available twist set of the platform (FASTKIT §3.2, Fig. 13): axis capacities with
         the mode's bases moving, and (task mode) with all bases fixed."""
+        if mode not in ("task", "navigation"):
+            raise InvalidInputError("mode", f"must be task or navigation, got {mode!r}")
+        plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
         _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed,
                    stabilisers, as_json, plot)
 
     @sub.command("deploy")
     def deploy_cmd(
-        model: str = typer.Argument(..., help="Preset name (fastkit, ipanema) or model file."),
+        model: str = typer.Argument(..., help=MODEL_HELP),
         workspace: Vec6 = typer.Option(..., "--workspace",
-                                       help="XMIN XMAX YMIN YMAX ZMIN ZMAX in m."),
+                                       help="XMIN XMAX YMIN YMAX ZMIN ZMAX in m (the order "
+                                            "of `workspace --box`)."),
         disturbance: Optional[Vec6] = typer.Option(
             None, "--disturbance", help="Half-widths FX FY FZ MX MY MZ (N, N m) of an extra "
                                         "wrench box to resist everywhere."),
@@ -175,13 +169,18 @@ def add_commands(sub: typer.Typer) -> None:
             None, "--twist", help="Required twist VX VY VZ WX WY WZ (m/s, rad/s)."),
         stabilisers: bool = typer.Option(False, "--stabilisers",
                                          help="Deploy the stabilisers first."),
-        seed: int = typer.Option(0, "--seed"),
+        seed: int = typer.Option(0, "--seed", help="Seed of the differential-evolution "
+                                 "search (>= 0; the same seed gives the same placement)."),
         maxiter: int = typer.Option(8, "--maxiter", help="Differential-evolution iterations."),
-        plot: Optional[Path] = typer.Option(None, "--plot", help="Top view (PNG)."),
-        as_json: bool = typer.Option(False, "--json", help="Machine-readable output."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Top view (.png, .pdf, "
+                                            ".svg)."),
+        as_json: bool = typer.Option(False, "--json", help="Print machine-readable JSON "
+                                     "instead of a table."),
     ) -> int:
         """Plan mobile-base placements making a workspace box wrench-feasible with tipping.
         A placement-independent bound on the cables' lift is checked first and proves some
-        boxes impossible without a search. Exit 0 with a verified placement, 1 without."""
+        boxes impossible without a search. Exit 0 with a verified placement, 1 without, 2 on
+        bad input."""
+        plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
         return _deploy(model, workspace, disturbance, twist, stabilisers, seed, maxiter, plot,
                        as_json)

@@ -2,19 +2,24 @@
 
 from __future__ import annotations
 
-import json
 from enum import Enum
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import typer
 
-from .._validate import as_positive
+from .._validate import MAX_ROBOTS, as_count, as_mass
 from ..errors import ScenarioError
-from ..io.serialize import fk_result_to_dict
-from ..io.sheet_scenario import load_sheet_scenario
-from ..sheet import forward_kinematics
-from ..sheet.results import FKResult
+from ..io.serialize import fk_result_to_dict, to_json
+from ._paths import FIGURE_SUFFIXES, output_path
+from ._progress import working
+
+if TYPE_CHECKING:
+    from ..sheet.results import FKResult
+
+#: Largest team the ``subsets`` method accepts: it tries every set of <= 5 cables, so its
+#: work grows as N**5 (N = 40: 760 000 systems, about a minute on one core).
+SUBSETS_MAX_ROBOTS = 40
 
 
 class FKMethod(str, Enum):
@@ -23,7 +28,7 @@ class FKMethod(str, Enum):
     subsets = "subsets"
 
 
-def _fmt(values, digits: int = 4) -> str:
+def _fmt(values: Any, digits: int = 4) -> str:
     return ", ".join(f"{v:.{digits}g}" for v in values)
 
 
@@ -43,17 +48,43 @@ def format_table(result: FKResult, *, name: str | None, units: str | None) -> st
                      f"{e.object[0]:.2f}", f"{e.object[1]:.2f}", f"{e.object[2]:.2f}",
                      f"({e.contact[0]:.2f}, {e.contact[1]:.2f})", e.status,
                      _fmt(e.weights, 3), "-" if e.tensions is None else _fmt(e.tensions, 4)))
-    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    if len(rows) == 1:
+        rows = []
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))] if rows else []
     right = {0, 2, 3, 4}
     for r in rows:
         lines.append("  ".join(cell.rjust(w) if c in right else cell.ljust(w)
                                for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+    if not result.equilibria:
+        lines.append("no equilibrium: " + explain_no_equilibrium(result))
     f = result.funnel
     if f is not None:
         lines.append(f"Algorithm 1 funnel: {f.combinations} taut sets tried, {f.form_closure} "
                      f"form closure, {f.cqp_feasible} CQP feasible, {f.height_feasible} "
                      f"height feasible, {f.force_closure} force closure")
     return "\n".join(lines)
+
+
+def explain_no_equilibrium(result: FKResult) -> str:
+    """Why forward kinematics found nothing: the rest states the object would reach if the
+    floor were not there (solving the same team with holding points raised by the sheet's
+    diameter, an upper bound of every cable length; the depth below the holding points
+    does not depend on the hold height, FK paper eq. 15 only discards z_o <= 0)."""
+    from ..sheet import forward_kinematics
+
+    v = result.sheet.vertices
+    diameter = float(max(((v[:, None] - v[None]) ** 2).sum(-1).max() ** 0.5, 1.0))
+    raised = forward_kinematics(result.sheet, result.formation, result.hold_height + diameter,
+                                method="fast")
+    below = [e for e in raised.equilibria if e.object[2] - diameter <= 0]
+    if not below:
+        return "no state of this team passes the paper's Algorithm 1"
+    parts = ", ".join("{" + ",".join(str(i + 1) for i in e.taut) + "}"
+                      f" at z_o = {e.object[2] - diameter:.4g}" for e in below[:5])
+    more = f" and {len(below) - 5} more" if len(below) > 5 else ""
+    return (f"{len(below)} state(s) discarded because the object would hang at or below the "
+            f"floor (z_o <= 0, FK paper eq. 15): {parts}{more}; raise the hold height or "
+            "spread the robots apart (a tighter sheet holds the object higher)")
 
 
 def register(app: typer.Typer) -> None:
@@ -72,18 +103,31 @@ def register(app: typer.Typer) -> None:
                                              "(overrides the scenario's); gives tensions in N."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write a 3D figure of every "
                                             "equilibrium to this file (.png, .pdf, .svg)."),
-    ) -> None:
+    ) -> int:
         """Forward kinematics: every place the object can rest, which are stable, and
-        each robot's cable tension."""
+        each robot's cable tension. Exit 0 with at least one equilibrium, 1 when there is
+        none (the reason is printed), 2 on bad input."""
+        from ..io.sheet_scenario import load_sheet_scenario
+        from ..sheet import forward_kinematics
+
+        plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
+        m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
         if sc.formation is None:
             raise ScenarioError("formation", "required key is missing (taut fk needs the "
                                 "robots' positions)")
-        m = as_positive(mass, "--mass") if mass is not None else sc.mass
-        result = forward_kinematics(sc.sheet, sc.formation, sc.hold_height, mass=m,
-                                    method=method.value)
+        if method == FKMethod.subsets:
+            as_count(sc.sheet.n, "sheet", maximum=SUBSETS_MAX_ROBOTS)
+        as_count(sc.sheet.n, "sheet", maximum=MAX_ROBOTS)
+        with working(f"fk ({method.value})"):
+            result = forward_kinematics(sc.sheet, sc.formation, sc.hold_height,
+                                        mass=m if m is not None else sc.mass,
+                                        method=method.value)
         if as_json:
-            typer.echo(json.dumps(fk_result_to_dict(result), indent=2))
+            doc = fk_result_to_dict(result)
+            if not result.equilibria:
+                doc["message"] = "no equilibrium: " + explain_no_equilibrium(result)
+            typer.echo(to_json(doc))
         else:
             typer.echo(format_table(result, name=sc.name, units=sc.units))
         if plot is not None:
@@ -92,3 +136,4 @@ def register(app: typer.Typer) -> None:
             plot_fk(result, plot, units=sc.units, title=sc.name)
             if not as_json:
                 typer.echo(f"figure written to {plot}")
+        return 0 if result.equilibria else 1

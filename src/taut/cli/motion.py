@@ -3,63 +3,28 @@ while they move?)."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any, Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Tuple
 
 import numpy as np
 import typer
 
-from .._validate import as_positive
+from .._validate import MAX_SHEET_LENGTH, as_mass, check_range
 from ..errors import InvalidInputError
-from ..io.sheet_scenario import load_sheet_scenario
-from ..io.trajectory import load_trajectory
-from ..sheet.ik import IKResult, inverse_kinematics
-from ..sheet.simulate import SimulationResult, simulate
+from ..io.serialize import ik_to_dict, simulation_to_dict, to_json
+from ._paths import FIGURE_SUFFIXES, output_path
+from ._progress import working
+
+if TYPE_CHECKING:
+    from ..sheet.ik import IKResult
+    from ..sheet.simulate import SimulationResult
 
 
 def _floats(a: Any) -> list[float] | None:
     return None if a is None else [float(x) for x in np.asarray(a).ravel()]
 
 
-def ik_to_dict(r: IKResult) -> dict[str, Any]:
-    """JSON form of an IK result (robots in order, 0-based lists)."""
-    return {
-        "formation": [_floats(p) for p in r.formation],
-        "object": _floats(r.object),
-        "contact": _floats(r.contact),
-        "angles": _floats(r.angles),
-        "weights": _floats(r.weights),
-        "tensions": _floats(r.tensions),
-        "cable_lengths": _floats(r.cable_lengths),
-        "curvature": None if not np.isfinite(r.curvature) else float(r.curvature),
-        "spacing": float(r.spacing),
-        "construction": r.construction,
-    }
-
-
-def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
-    """JSON form of a simulation (NaN -> null; taut sets 0-based)."""
-    def clean(a: np.ndarray) -> list:
-        return [[None if not np.isfinite(v) else float(v) for v in row] for row in a]
-
-    return {
-        "time": _floats(time),
-        "object": clean(r.object),
-        "contact": clean(r.contact),
-        "taut": [list(s) for s in r.taut],
-        "tensions": None if r.tensions is None else clean(r.tensions),
-        "events": [{
-            "step": e.step, "fraction": e.fraction, "kind": e.kind,
-            "taut_before": list(e.taut_before), "taut_after": list(e.taut_after),
-            "object_before": clean(e.object_before[None])[0],
-            "object_after": clean(e.object_after[None])[0],
-            "drop": None if not np.isfinite(e.drop) else e.drop,
-        } for e in r.events],
-    }
-
-
-def _ik_table(r: IKResult, units: str | None) -> str:
+def _ik_table(r: "IKResult", units: str | None) -> str:
     u = f" {units}" if units else ""
     p = r.object
     lines = [f"object at ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}){u}, contact "
@@ -75,7 +40,7 @@ def _ik_table(r: IKResult, units: str | None) -> str:
     return "\n".join(lines)
 
 
-def _sim_table(r: SimulationResult, time: np.ndarray, units: str | None) -> str:
+def _sim_table(r: "SimulationResult", time: np.ndarray, units: str | None) -> str:
     u = f" {units}" if units else ""
     z = r.object[:, 2]
     lines = [f"{len(r)} steps, {len(r.events)} event(s), {len(r.jumps)} jump(s); object "
@@ -99,7 +64,8 @@ def register(app: typer.Typer) -> None:
     @app.command("ik")
     def ik_command(
         scenario: Path = typer.Argument(..., help="Scenario file (YAML or JSON) with "
-                                        "hold_height and sheet (a formation is ignored)."),
+                                        "hold_height and sheet (a formation, if present, is "
+                                        "validated but not used)."),
         object_position: Tuple[float, float, float] = typer.Option(
             ..., "--object", help="Target object position X Y Z (scenario units)."),
         contact: Optional[Tuple[float, float]] = typer.Option(
@@ -113,12 +79,20 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Inverse kinematics: where the robots must stand so that the object rests
         stably at the target with every cable taut."""
+        from ..io.sheet_scenario import load_sheet_scenario
+        from ..sheet.ik import inverse_kinematics
+
+        check_range(object_position, "--object", MAX_SHEET_LENGTH, "scenario units")
+        if contact is not None:
+            check_range(contact, "--contact", MAX_SHEET_LENGTH, "scenario units")
+        check_range(heading, "--heading", 1e6, "degrees")
+        m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
-        m = as_positive(mass, "--mass") if mass is not None else sc.mass
         r = inverse_kinematics(sc.sheet, object_position, sc.hold_height,
-                               contact=contact, heading=np.radians(heading), mass=m)
+                               contact=contact, heading=np.radians(heading),
+                               mass=m if m is not None else sc.mass)
         if as_json:
-            typer.echo(json.dumps(ik_to_dict(r), indent=2))
+            typer.echo(to_json(ik_to_dict(r)))
         else:
             typer.echo(_ik_table(r, sc.units))
 
@@ -134,15 +108,22 @@ def register(app: typer.Typer) -> None:
                                             "height with events; top view of all paths)."),
     ) -> None:
         """Quasi-static simulation of the object while the robots follow a trajectory."""
+        from ..io.sheet_scenario import load_sheet_scenario
+        from ..io.trajectory import load_trajectory
+        from ..sheet.simulate import simulate
+
+        plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
+        m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
         traj = load_trajectory(trajectory)
         if traj.n_robots != sc.sheet.n:
             raise InvalidInputError(str(trajectory), f"has {traj.n_robots} robots but the "
                                     f"sheet has {sc.sheet.n} vertices")
-        m = as_positive(mass, "--mass") if mass is not None else sc.mass
-        r = simulate(sc.sheet, traj.formations, sc.hold_height, mass=m)
+        with working("simulate"):
+            r = simulate(sc.sheet, traj.formations, sc.hold_height,
+                         mass=m if m is not None else sc.mass)
         if as_json:
-            typer.echo(json.dumps(simulation_to_dict(r, traj.time)))
+            typer.echo(to_json(simulation_to_dict(r, traj.time), indent=None))
         else:
             typer.echo(_sim_table(r, traj.time, sc.units))
         if plot is not None:

@@ -2,70 +2,68 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any, Optional
+from typing import Optional
 
-import numpy as np
 import typer
 
-from ..io.plan_scenario import load_plan_scenario
-from ..plan.planner import plan
-from ..plan.result import PlanResult
+from ..io.serialize import plan_to_dict, to_json
+from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
+from ._progress import working
 
 __all__ = ["register", "plan_to_dict", "plan_command"]
 
 
-def plan_to_dict(r: PlanResult) -> dict[str, Any]:
-    """JSON form of a plan: ``success``, ``reason``, ``times`` [T], ``robots`` [T][N][2],
-    ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``, ``bypassed``, plus
-    ``path_length`` (m) and ``duration`` (s) (null on failure)."""
-    def num(x: float) -> float | None:
-        return float(x) if np.isfinite(x) else None
-
-    return {
-        "success": bool(r.success),
-        "reason": r.reason,
-        "times": [float(t) for t in r.times],
-        "robots": np.asarray(r.robots, dtype=float).tolist(),
-        "object": np.asarray(r.object, dtype=float).tolist(),
-        "taut": [list(s) for s in r.taut],
-        "crossed": list(r.crossed),
-        "bypassed": list(r.bypassed),
-        "path_length": num(r.path_length),
-        "duration": num(r.duration),
-    }
-
-
 def plan_command(
     scenario: Path = typer.Argument(..., help="Planning scenario file (YAML or JSON)."),
-    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the plan as JSON."),
-    animate: Optional[Path] = typer.Option(None, "--animate", help="Write an animated GIF."),
+    as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON on stdout "
+                                 "instead of the one-line summary."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Also write the plan as JSON to "
+                                       "this file (.json)."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="Write an animated GIF "
+                                           "(.gif)."),
     baseline: bool = typer.Option(False, "--baseline", help="Bypass-only baseline planner."),
-    plot: Optional[Path] = typer.Option(None, "--plot", help="Write the summary figure."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Write the summary figure "
+                                        "(.png, .pdf, .svg)."),
     algorithm2: bool = typer.Option(False, "--algorithm2",
                                     help="Cross only as the paper's Algorithm 2 does (the "
                                          "obstacle passes under the object)."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
-    the sheet where that is faster; exit 0 with a plan, 1 when no plan exists."""
+    the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
+    input."""
+    from ..io.plan_scenario import load_plan_scenario
+    from ..plan.planner import plan
+
+    out = output_path(out, "--out", JSON_SUFFIXES)
+    plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
+    animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
     sc = load_plan_scenario(scenario)
-    result = plan(sc, baseline=baseline, straight_crossings=not algorithm2)
-    if json_out is not None:
-        json_out.write_text(json.dumps(plan_to_dict(result)) + "\n", encoding="utf-8")
+    with working("plan"):
+        result = plan(sc, baseline=baseline, straight_crossings=not algorithm2)
+    doc = plan_to_dict(result)
+    if out is not None:
+        out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")
     if result.success and (plot is not None or animate is not None):
         from ..viz.plan import animate_plan, plot_plan
         if plot is not None:
             plot_plan(sc, result, plot)
         if animate is not None:
             animate_plan(sc, result, animate)
-    if result.success:
+    if as_json:
+        typer.echo(to_json(doc))
+    elif result.success:
         typer.echo(f"plan: {len(result.times)} samples, {result.duration:.2f} s, path "
                    f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}], "
                    f"object at {result.formation.object_height:.3f} m")
-        return 0
-    typer.echo(f"no plan: {result.reason}")
-    return 1
+    else:
+        typer.echo(f"no plan: {doc['reason']}")
+    if not result.success:
+        for name, path in (("--plot", plot), ("--animate", animate)):
+            if path is not None:
+                typer.echo(f"taut: {name}: {path} not written: there is no plan to draw",
+                           err=True)
+    return 0 if result.success else 1
 
 
 def register(app: typer.Typer) -> None:

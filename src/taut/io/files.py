@@ -1,5 +1,10 @@
 """Reading YAML/JSON files into plain mappings, and pydantic validation with errors that
-name the offending field. Every loader in :mod:`taut.io` goes through these two functions."""
+name the offending field. Every loader in :mod:`taut.io` goes through these two functions.
+
+Two silent conversions are refused: a key given twice in one mapping (YAML and JSON
+parsers keep the last value) and a boolean where a number is expected (pydantic's lax
+mode reads ``hold_height: true`` as 1).
+"""
 
 from __future__ import annotations
 
@@ -29,23 +34,55 @@ def read_text(path: str | Path) -> str:
         raise ScenarioError(str(path), f"cannot read file ({exc.__class__.__name__})") from None
 
 
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing a key that appears twice in one mapping."""
+
+
+def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode,
+                              deep: bool = False) -> dict[Any, Any]:
+    seen: dict[Any, int] = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=True)  # type: ignore[no-untyped-call]
+        if key in seen:
+            raise ScenarioError(str(key), f"duplicate key (lines {seen[key]} and "
+                                          f"{key_node.start_mark.line + 1})")
+        seen[key] = key_node.start_mark.line + 1
+    return loader.construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
+                                 _construct_unique_mapping)
+
+
+def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ScenarioError(key, "duplicate key")
+        out[key] = value
+    return out
+
+
 def read_mapping(path: str | Path) -> dict[str, Any]:
     """Parse a ``.yaml``/``.yml``/``.json`` file whose top level is a mapping.
 
     Raises
     ------
     ScenarioError
-        Missing or unreadable file, a syntax error, or a top level that is not a mapping.
+        Missing or unreadable file, a syntax error, a key given twice, or a top level that
+        is not a mapping.
     """
     p = Path(path)
     text = read_text(p)
     try:
         if p.suffix.lower() == ".json":
-            data = json.loads(text)
+            data = json.loads(text, object_pairs_hook=_unique_pairs)
         else:
-            data = yaml.safe_load(text)
+            data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader)
     except json.JSONDecodeError as exc:
         raise ScenarioError(str(path), f"invalid JSON at line {exc.lineno}: {exc.msg}") from None
+    except RecursionError:
+        raise ScenarioError(str(path), "nested too deeply") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark is not None else ""
@@ -65,11 +102,41 @@ def _location(loc: tuple[Any, ...]) -> str:
     return out or "(top level)"
 
 
+def _booleans(data: Any, loc: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+    """Locations of every boolean value in parsed file data."""
+    if isinstance(data, bool):
+        return [loc]
+    if isinstance(data, dict):
+        return [p for k, v in data.items() for p in _booleans(v, loc + (k,))]
+    if isinstance(data, list):
+        return [p for k, v in enumerate(data) for p in _booleans(v, loc + (k,))]
+    return []
+
+
+def _at(obj: Any, loc: tuple[Any, ...]) -> Any:
+    """The validated value at ``loc`` (attribute, key or index steps), or ``_NOT_FOUND``."""
+    for part in loc:
+        try:
+            if isinstance(part, int) or isinstance(obj, dict):
+                obj = obj[part]
+            else:
+                obj = getattr(obj, str(part))
+        except (KeyError, IndexError, AttributeError, TypeError):
+            return _NOT_FOUND
+    return obj
+
+
+_NOT_FOUND = object()
+
+
 def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
     """Validate ``data`` against a pydantic model; the first error becomes a
-    :class:`ScenarioError` whose field is the dotted path (``sheet[2]``, ``cables[0].max``)."""
+    :class:`ScenarioError` whose field is the dotted path (``sheet[2]``, ``cables[0].max``).
+
+    A boolean in the file that the model turned into a number is an error too (pydantic's
+    lax mode accepts ``true`` for a float); booleans kept as booleans are fine."""
     try:
-        return model.model_validate(data)
+        validated = model.model_validate(data)
     except ValidationError as exc:
         err = exc.errors()[0]
         loc = _location(tuple(p for p in err["loc"] if not (isinstance(p, str) and "[" in p)))
@@ -79,6 +146,12 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
         elif err["type"] == "missing":
             msg = "required key is missing"
         raise ScenarioError(loc, msg[0].lower() + msg[1:]) from None
+    for where in _booleans(data):
+        value = _at(validated, where)
+        if value is not _NOT_FOUND and not isinstance(value, bool) \
+                and isinstance(value, (int, float)):
+            raise ScenarioError(_location(where), "must be a number, got a boolean")
+    return validated
 
 
 def write_json(obj: Any, path: str | Path) -> None:

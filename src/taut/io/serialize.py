@@ -1,20 +1,96 @@
-"""Plain-data (JSON-ready) forms of result objects, for the CLI's ``--json`` output."""
+"""Plain-data (JSON-ready) forms of result objects: every ``--json`` output of the CLI is
+built here, so the commands only call an analysis and one of these functions.
+
+Conventions: indices are 0-based; lengths in the model's unit (m for cable robots, the
+scenario's unit for sheets); forces in N; a number that is not finite becomes ``null``
+(JSON has no ``Infinity``/``NaN``), and :func:`to_json` refuses anything else non-finite,
+so the output is always valid JSON.
+"""
 
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import asdict
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..sheet.results import Equilibrium, FKResult
+if TYPE_CHECKING:                                  # imported lazily: keep `taut --help` fast
+    from ..cdpr.deploy import DeploymentResult
+    from ..cdpr.model import CableRobot
+    from ..cdpr.tension import TensionResult
+    from ..cdpr.twist import TwistCapacities
+    from ..cdpr.workspace import WorkspaceResult
+    from ..plan.result import PlanResult
+    from ..sheet.ik import IKResult
+    from ..sheet.results import Equilibrium, FKResult
+    from ..sheet.simulate import SimulationResult
 
-__all__ = ["equilibrium_to_dict", "fk_result_to_dict"]
+__all__ = ["to_json", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dict",
+           "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",
+           "wrench_set_to_dict", "workspace_to_dict", "twist_set_to_dict",
+           "deployment_to_dict"]
+
+_MISSING = object()
 
 
-def _floats(a: np.ndarray | None) -> list[float] | None:
-    return None if a is None else [float(x) for x in np.asarray(a).ravel()]
+def _attr(obj: Any, new: str, old: str) -> Any:
+    """``obj.new`` when the result already follows the success/status/message convention,
+    else the old name (so no deprecated alias is ever touched)."""
+    value = getattr(obj, new, _MISSING)
+    return getattr(obj, old) if value is _MISSING else value
 
+
+def finite_or_none(x: Any, digits: int | None = None) -> float | None:
+    """``float(x)`` (rounded to ``digits`` when given), or ``None`` when not finite.
+
+    Examples
+    --------
+    >>> finite_or_none(1.23456, 2), finite_or_none(float("inf"))
+    (1.23, None)
+    """
+    if x is None:
+        return None
+    v = float(x)
+    if not math.isfinite(v):
+        return None
+    return round(v, digits) if digits is not None else v
+
+
+def _clean(obj: Any) -> Any:
+    """Recursively: arrays to lists, numpy scalars to Python, non-finite floats to None."""
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _clean(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return finite_or_none(obj)
+    return obj
+
+
+def to_json(obj: Any, *, indent: int | None = 2) -> str:
+    """Valid JSON text of a plain-data object (non-finite numbers become ``null``).
+
+    Examples
+    --------
+    >>> to_json({"t": [1.0, float("nan")]}, indent=None)
+    '{"t": [1.0, null]}'
+    """
+    return json.dumps(_clean(obj), indent=indent, allow_nan=False)
+
+
+def _floats(a: Any) -> list[float | None] | None:
+    return None if a is None else [finite_or_none(x) for x in np.asarray(a, float).ravel()]
+
+
+# --- sheet-carrying teams -------------------------------------------------------------------
 
 def equilibrium_to_dict(e: Equilibrium) -> dict[str, Any]:
     """``taut`` is 0-based; lengths in the scenario's unit; tensions in N or None."""
@@ -37,3 +113,148 @@ def fk_result_to_dict(result: FKResult) -> dict[str, Any]:
         "equilibria": [equilibrium_to_dict(e) for e in result.equilibria],
         "funnel": None if result.funnel is None else asdict(result.funnel),
     }
+
+
+def ik_to_dict(r: IKResult) -> dict[str, Any]:
+    """JSON form of an IK result (robots in order, 0-based lists)."""
+    return {
+        "formation": [_floats(p) for p in r.formation],
+        "object": _floats(r.object),
+        "contact": _floats(r.contact),
+        "angles": _floats(r.angles),
+        "weights": _floats(r.weights),
+        "tensions": _floats(r.tensions),
+        "cable_lengths": _floats(r.cable_lengths),
+        "curvature": finite_or_none(r.curvature),
+        "spacing": float(r.spacing),
+        "construction": r.construction,
+    }
+
+
+def _rows(a: np.ndarray) -> list[list[float | None]]:
+    return [[finite_or_none(v) for v in row] for row in np.asarray(a, float)]
+
+
+def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
+    """JSON form of a simulation (NaN -> null; taut sets 0-based)."""
+    return {
+        "time": _floats(time),
+        "object": _rows(r.object),
+        "contact": _rows(r.contact),
+        "taut": [list(s) for s in r.taut],
+        "tensions": None if r.tensions is None else _rows(r.tensions),
+        "events": [{
+            "step": e.step, "fraction": e.fraction, "kind": e.kind,
+            "taut_before": list(e.taut_before), "taut_after": list(e.taut_after),
+            "object_before": _floats(e.object_before),
+            "object_after": _floats(e.object_after),
+            "drop": finite_or_none(e.drop),
+        } for e in r.events],
+    }
+
+
+def plan_to_dict(r: PlanResult) -> dict[str, Any]:
+    """JSON form of a plan: ``success``, ``reason``, ``times`` [T], ``robots`` [T][N][2],
+    ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``, ``bypassed``, plus
+    ``path_length`` (m) and ``duration`` (s) (null on failure)."""
+    message = _attr(r, "message", "reason")
+    return {
+        "success": bool(r.success),
+        "reason": message if not r.success else None,
+        "times": [float(t) for t in r.times],
+        "robots": np.asarray(r.robots, dtype=float).tolist(),
+        "object": np.asarray(r.object, dtype=float).tolist(),
+        "taut": [list(s) for s in r.taut],
+        "crossed": list(r.crossed),
+        "bypassed": list(r.bypassed),
+        "path_length": finite_or_none(r.path_length),
+        "duration": finite_or_none(r.duration),
+    }
+
+
+# --- cable-driven parallel robots -----------------------------------------------------------
+
+def tensions_to_dict(robot: CableRobot, pose: np.ndarray, res: TensionResult) -> dict[str, Any]:
+    """One pose of a tension distribution (tensions keyed by cable name, N)."""
+    names = [c.name for c in robot.cables]
+    M = res.tipping_moments[0]
+    return {
+        "model": robot.name, "pose": _floats(pose), "method": res.method,
+        "tipping": res.tipping, "feasible": bool(_attr(res, "success", "feasible")[0]),
+        "residual": finite_or_none(res.residual[0]),
+        "tensions": {n: finite_or_none(v) for n, v in zip(names, res.tensions[0])},
+        "tipping_moments": None if not np.all(np.isfinite(M)) else [float(x) for x in M],
+        "tipping_edge_base": [robot.bases[k].name for k in robot.edge_base],
+    }
+
+
+def wrench_set_to_dict(robot: CableRobot, pose: np.ndarray,
+                       modes: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """Axis capacities, margin and half-spaces per constraint set.
+
+    ``modes`` maps ``"tension_limits_only"`` / ``"with_tipping"`` to the analyses' outputs
+    ``{"capacities": AxisCapacities, "halfspaces": (H, h), "margin": float,
+    "gravity_feasible": bool}``."""
+    out: dict[str, Any] = {"model": robot.name, "pose": _floats(pose), "dof": robot.dof}
+    for key, m in modes.items():
+        cap = m["capacities"]
+        H, h = m["halfspaces"]
+        out[key] = {
+            "capacity_positive": {lab: finite_or_none(v, 3)
+                                  for lab, v in zip(cap.labels, cap.positive[0])},
+            "capacity_negative": {lab: finite_or_none(v, 3)
+                                  for lab, v in zip(cap.labels, cap.negative[0])},
+            "capacity_margin": finite_or_none(m["margin"], 4),
+            "gravity_feasible": bool(m["gravity_feasible"]),
+            "halfspaces": {"H": np.round(H, 9).tolist(), "h": np.round(h, 9).tolist()},
+        }
+    return out
+
+
+def workspace_to_dict(robot: CableRobot, region: np.ndarray, ws: WorkspaceResult,
+                      n_points: int, plot: Any = None) -> dict[str, Any]:
+    """A wrench-feasible workspace on a grid (feasibility as 0/1 lists)."""
+    return {
+        "model": robot.name, "grid": list(ws.shape or ()), "box": np.asarray(region).tolist(),
+        "orientations": np.asarray(ws.orientations).tolist(), "points": int(n_points),
+        "coverage": ws.coverage, "coverage_tipping": ws.coverage_tipping,
+        "feasible": ws.feasible.astype(int).tolist(),
+        "feasible_tipping": (None if ws.feasible_tipping is None else
+                             ws.feasible_tipping.astype(int).tolist()),
+        "plot": None if plot is None else str(plot)}
+
+
+def twist_set_to_dict(robot: CableRobot, pose: np.ndarray, mode: str,
+                      caps: TwistCapacities, fixed: TwistCapacities | None,
+                      facets: int) -> dict[str, Any]:
+    """Available twist set capacities (m/s, rad/s) with the mode's bases moving and, in task
+    mode, with every base fixed."""
+    out: dict[str, Any] = {
+        "model": robot.name, "pose": _floats(pose), "mode": mode,
+        "moving": list(caps.mode.names), "labels": list(caps.labels),
+        "positive": [finite_or_none(v, 4) for v in caps.positive[0]],
+        "negative": [finite_or_none(v, 4) for v in caps.negative[0]]}
+    if fixed is not None:
+        out["bases_fixed"] = {"positive": [finite_or_none(v, 4) for v in fixed.positive[0]],
+                              "negative": [finite_or_none(v, 4) for v in fixed.negative[0]]}
+    out["facets"] = int(facets)
+    return out
+
+
+def deployment_to_dict(robot: CableRobot, res: DeploymentResult) -> dict[str, Any]:
+    """A deployment search: base poses (m, m, rad), margins, the lift certificate."""
+    lb = res.lift_bound
+    r4 = lambda x: finite_or_none(x, 4)  # noqa: E731
+    return {
+        "model": robot.name, "workspace": np.asarray(res.workspace).tolist(),
+        "feasible": bool(_attr(res, "success", "feasible")),
+        "refuted": bool(res.refuted),
+        "base_poses": {k: [round(float(x), 4) for x in v] for k, v in res.base_poses.items()},
+        "margin": r4(res.margin),
+        "twist_margin": None if res.twist_margin is None else r4(res.twist_margin),
+        "points": int(len(res.points)), "feasible_points": int(res.point_feasible.sum()),
+        "evaluations": res.evaluations, "reason": _attr(res, "message", "reason"),
+        "lift_bound": None if lb is None else {
+            "height": r4(lb.height), "bound": r4(lb.bound), "required": r4(lb.required),
+            "weight": r4(lb.weight), "refutes": lb.refutes,
+            "per_cable": {c.name: r4(v) for c, v in zip(robot.cables, lb.per_cable)}}}

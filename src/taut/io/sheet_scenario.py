@@ -2,7 +2,9 @@
 
 Keys: ``hold_height`` (required, > 0), ``sheet`` (required, list of [x, y] vertices in robot
 order), ``formation`` (list of [x, y] robot positions; required by ``taut fk``), and the
-optional ``units`` (a label only), ``mass`` (kg, > 0) and ``name``. Unknown keys are errors.
+optional ``units`` (a label only), ``mass`` (kg, > 0) and ``name``. Unknown keys, keys given
+twice, booleans in place of numbers and values outside the accepted range
+(:data:`taut._validate.MAX_SHEET_LENGTH`, :data:`taut._validate.MAX_MASS_KG`) are errors.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from .._validate import MAX_MASS_KG, MAX_ROBOTS, MAX_SHEET_LENGTH, check_range
 from ..errors import ScenarioError, TautError
 from ..sheet.model import Sheet, check_formation, check_hold_height
 from .files import read_mapping, validate_mapping
@@ -66,6 +69,19 @@ def _rename(exc: TautError, field: str) -> ScenarioError:
 def sheet_scenario_from_mapping(data: dict) -> SheetScenario:
     """Validate an already-parsed mapping (see module docstring for the keys)."""
     raw = validate_mapping(_SheetScenarioFile, data)
+    try:
+        for field, value, limit, unit in (
+                ("sheet", raw.sheet, MAX_SHEET_LENGTH, "scenario units"),
+                ("formation", raw.formation, MAX_SHEET_LENGTH, "scenario units"),
+                ("hold_height", raw.hold_height, MAX_SHEET_LENGTH, "scenario units"),
+                ("mass", raw.mass, MAX_MASS_KG, "kg")):
+            if value is not None:
+                check_range(value, field, limit, unit)
+    except TautError as exc:
+        raise ScenarioError(exc.field, exc.problem) from None
+    if len(raw.sheet) > MAX_ROBOTS:
+        raise ScenarioError("sheet", f"{len(raw.sheet)} vertices exceeds the accepted "
+                                     f"{MAX_ROBOTS} robots")
     try:
         sheet = Sheet(np.array(raw.sheet, dtype=float))
     except TautError as exc:

@@ -1,0 +1,100 @@
+"""Output paths of the `taut` commands, checked before any work starts.
+
+Every ``--plot``, ``--animate``, ``--out`` (and any other file the CLI writes) goes through
+:func:`output_path`, so a mistake in a path costs the user one line and exit code 2 instead
+of a finished computation followed by a traceback.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import InvalidInputError
+
+__all__ = ["output_path", "FIGURE_SUFFIXES", "ANIMATION_SUFFIXES", "JSON_SUFFIXES"]
+
+#: Formats matplotlib writes with its default (Agg) backends.
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
+#: Animated figures (Pillow writer).
+ANIMATION_SUFFIXES = (".gif",)
+#: Machine-readable output files.
+JSON_SUFFIXES = (".json",)
+
+
+def output_path(value: str | os.PathLike[str] | None, field: str,
+                suffixes: tuple[str, ...]) -> Path | None:
+    """Validate a file the command will write; ``None`` passes through.
+
+    Parameters
+    ----------
+    value : path or None
+        What the user typed.
+    field : str
+        The option name used in the error (``"--plot"``).
+    suffixes : tuple of str
+        Accepted extensions, lower case with the dot (``(".png", ".pdf")``).
+
+    Returns
+    -------
+    Path or None
+        The path, unchanged (the file is written exactly where the user asked).
+
+    Raises
+    ------
+    InvalidInputError
+        An empty name, a name without or with an unsupported extension, an existing
+        directory, a parent that is not a directory, or a directory that is not writable.
+
+    Examples
+    --------
+    >>> output_path("fig.png", "--plot", (".png",))
+    PosixPath('fig.png')
+    >>> output_path("fig", "--plot", (".png", ".pdf"))
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: --plot: 'fig' has no file extension; use one of .png, .pdf
+    """
+    if value is None:
+        return None
+    text = os.fspath(value)
+    want = ", ".join(suffixes)
+    if text.strip() == "":
+        raise InvalidInputError(field, f"empty file name; give a file ending in {want}")
+    path = Path(text)
+    if text.strip() == ".":                 # typer turns an empty argument into "."
+        raise InvalidInputError(field, f"empty file name; give a file ending in {want}")
+    if path.is_dir() or text.endswith(("/", os.sep)):
+        raise InvalidInputError(field, f"{text!r} is a directory; give a file ending in {want}")
+    suffix = path.suffix.lower()
+    if not suffix or path.name.startswith(".") and path.name.count(".") == 1:
+        raise InvalidInputError(field, f"{text!r} has no file extension; use one of {want}")
+    if suffix not in suffixes:
+        raise InvalidInputError(field, f"unsupported extension {path.suffix!r}; use one "
+                                       f"of {want}")
+    ancestor = path.parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    if ancestor.exists() and not ancestor.is_dir():
+        raise InvalidInputError(field, f"{str(ancestor)!r} is not a directory")
+    if path.exists() and not os.access(path, os.W_OK):
+        raise InvalidInputError(field, f"{text!r} exists and is not writable")
+    _probe(path, field)
+    return path
+
+
+def _probe(path: Path, field: str) -> None:
+    """Create the parent directories and open the file for appending (removing it again if
+    it did not exist): the only test that holds on every file system (``os.access`` says
+    yes to root on read-only mounts and on ``/proc``)."""
+    existed = path.exists()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "ab"):
+            pass
+    except OSError as exc:
+        where = exc.filename if isinstance(exc.filename, str) else str(path)
+        raise InvalidInputError(field, f"cannot write {where!r} ({exc.strerror or exc})"
+                                ) from None
+    if not existed:
+        path.unlink(missing_ok=True)
