@@ -2,7 +2,8 @@
 
 An optional header row (any first row that is not numeric, e.g. ``t,x1,y1,x2,y2``) and
 lines starting with ``#`` are skipped; blank lines are ignored. Times must be finite and
-strictly increasing; positions finite. Errors name the file row (1-based, as an editor
+strictly increasing; positions finite and within
+:data:`taut._validate.MAX_SHEET_LENGTH`. Errors name the file row (1-based, as an editor
 shows it).
 """
 
@@ -14,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._validate import MAX_BATCH, MAX_SHEET_LENGTH
 from ..errors import InvalidTrajectoryError
 from .files import read_text
 
@@ -102,6 +104,13 @@ def parse_trajectory(lines: list[str], *, n_robots: int | None = None,
     if not finite.all():
         k = int(np.argmax(~finite.all(axis=1)))
         raise InvalidTrajectoryError(f"{source}:{where[k]}", "contains NaN or infinite values")
+    big = np.abs(data[:, 1:]) > MAX_SHEET_LENGTH
+    if big.any():
+        k = int(np.argmax(big.any(axis=1)))
+        raise InvalidTrajectoryError(f"{source}:{where[k]}", f"a position exceeds the accepted "
+                                     f"range |x|, |y| <= {MAX_SHEET_LENGTH:g} sheet units")
+    if len(data) * (width - 1) // 2 > MAX_BATCH:
+        raise InvalidTrajectoryError(source, f"more than {MAX_BATCH} robot positions")
     t = data[:, 0]
     dt = np.diff(t)
     if np.any(dt <= 0):

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import as_array, as_points, as_positive
+from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, as_array, as_points, as_positive, check_range
 from ..errors import InfeasibleFormationError, InvalidInputError, InvalidSheetError
 
 __all__ = ["Sheet", "check_formation", "check_formations", "check_hold_height"]
@@ -45,6 +45,9 @@ class Sheet:
     def __post_init__(self) -> None:
         try:
             v = as_points(self.vertices, "sheet", min_count=3)
+            check_range(v, "sheet", MAX_SHEET_LENGTH, "sheet units")
+            if len(v) > MAX_ROBOTS:
+                raise InvalidInputError("sheet", f"{len(v)} vertices exceeds {MAX_ROBOTS}")
         except InvalidInputError as exc:
             raise InvalidSheetError(exc.field, exc.problem) from None
         centre = v.mean(axis=0)
@@ -93,8 +96,8 @@ class Sheet:
 
         As in the FK paper's Examples 2 and 6 (octagon, :math:`r_s = 0.9` m).
         """
-        if not isinstance(n, (int, np.integer)) or n < 3:
-            raise InvalidSheetError("n", f"must be an integer >= 3, got {n!r}")
+        if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or not 3 <= n <= MAX_ROBOTS:
+            raise InvalidSheetError("n", f"must be an integer in [3, {MAX_ROBOTS}], got {n!r}")
         r = as_positive(circumradius, "circumradius")
         t = phase + 2 * np.pi * np.arange(n) / n
         return cls(np.column_stack([r * np.cos(t), r * np.sin(t)]))

@@ -4,6 +4,7 @@ the events marked, and the top view of the robots' and the object's paths."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -21,8 +22,11 @@ _MARKERS = {"jump": ("v", "tab:red"), "taut_change": ("|", "tab:gray"),
 
 def plot_simulation(result: SimulationResult, path: str | Path | None = None, *,
                     time: np.ndarray | None = None, units: str | None = None,
-                    title: str | None = None):
+                    title: str | None = None, time_unit: str = "s") -> Any:
     """Two panels: :math:`z_o(t)` with events, and the top view of all paths.
+
+    The height axis spans the object's heights only (the hold height is written in the
+    panel, not drawn), so a jump of a few mm on a 1 m stage stays visible.
 
     Parameters
     ----------
@@ -34,6 +38,8 @@ def plot_simulation(result: SimulationResult, path: str | Path | None = None, *,
     units : str, optional
         Length unit label.
     title : str, optional
+    time_unit : str
+        Label of the time stamps' unit (the trajectory file's; default s).
 
     Returns
     -------
@@ -55,9 +61,16 @@ def plot_simulation(result: SimulationResult, path: str | Path | None = None, *,
         ax_h.plot([tk], [z], marker=marker, color=colour, ms=9, ls="none", label=label)
         if e.kind == "jump":
             ax_h.vlines(tk, e.object_after[2], e.object_before[2], colors=colour, lw=1)
-    ax_h.set_xlabel("time" if time is not None else "step")
-    ax_h.set_ylabel(f"height{u}")
-    ax_h.axhline(result.hold_height, color="0.6", ls="--", lw=1, label="hold height $z_r$")
+    ax_h.set_xlabel(f"time [{time_unit}]" if time is not None else "step (no time stamps)")
+    ax_h.set_ylabel(f"object height $z_o${u}")
+    z = result.object[:, 2]
+    z = z[np.isfinite(z)]
+    if z.size:
+        lo, hi = float(z.min()), float(z.max())
+        pad = max(0.08 * (hi - lo), 1e-3 * max(abs(hi), 1.0))
+        ax_h.set_ylim(lo - pad, hi + pad)
+    unit_word = f" {units}" if units else ""
+    ax_h.set_title(f"hold height $z_r$ = {result.hold_height:g}{unit_word}", fontsize=9)
     ax_h.legend(loc="best", fontsize=8)
     ax_h.grid(alpha=0.3)
 

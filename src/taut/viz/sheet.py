@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from matplotlib.lines import Line2D  # noqa: E402
 
 from ..sheet.results import Equilibrium, FKResult  # noqa: E402
 
@@ -19,7 +22,18 @@ __all__ = ["draw_equilibrium", "plot_fk", "STATUS_COLOURS"]
 STATUS_COLOURS = {"stable": "tab:green", "saddle": "tab:orange", "not_equilibrium": "tab:red"}
 
 
-def draw_equilibrium(ax, formation: np.ndarray, hold_height: float, e: Equilibrium, *,
+def legend_handles() -> list[Line2D]:
+    """Legend entries of :func:`draw_equilibrium`'s marks."""
+    obj = [Line2D([], [], ls="none", marker="o", ms=7, mec="k", color=c,
+                  label=f"object: {k.replace('_', ' ')}") for k, c in STATUS_COLOURS.items()]
+    return [Line2D([], [], color="tab:blue", lw=1.6, label="taut cable"),
+            Line2D([], [], color="tab:blue", lw=0.8, ls=":", label="slack cable"),
+            Line2D([], [], color="0.55", lw=0.8, ls="--", label="formation at hold height"),
+            Line2D([], [], ls="none", marker="s", ms=5, color="0.2", label="robot (ground)"),
+            *obj]
+
+
+def draw_equilibrium(ax: Any, formation: np.ndarray, hold_height: float, e: Equilibrium, *,
                      units: str | None = None) -> None:
     """Draw one rest state on a 3D axis.
 
@@ -64,10 +78,15 @@ def draw_equilibrium(ax, formation: np.ndarray, hold_height: float, e: Equilibri
 
 
 def plot_fk(result: FKResult, path: str | Path | None = None, *, units: str | None = None,
-            title: str | None = None, max_panels: int = 12):
-    """One 3D panel per equilibrium (stable first in the paper's order); returns the figure
-    and writes it to ``path`` (PNG/PDF/SVG by extension) when given."""
-    eqs = list(result.equilibria)[:max_panels]
+            title: str | None = None, max_panels: int = 12) -> Any:
+    """One 3D panel per equilibrium, stable ones first, with a legend of the marks; returns
+    the figure and writes it to ``path`` (PNG/PDF/SVG by extension) when given.
+
+    At most ``max_panels`` states are drawn; when there are more, the figure says how many
+    were left out (the stable ones are always drawn first)."""
+    order = sorted(result.equilibria, key=lambda e: (not e.stable, e.status != "saddle"))
+    eqs = order[:max_panels]
+    left_out = len(order) - len(eqs)
     k = max(1, len(eqs))
     cols = min(3, k)
     rows = math.ceil(k / cols)
@@ -78,9 +97,15 @@ def plot_fk(result: FKResult, path: str | Path | None = None, *, units: str | No
     for j, e in enumerate(eqs):
         ax = fig.add_subplot(rows, cols, j + 1, projection="3d")
         draw_equilibrium(ax, result.formation, result.hold_height, e, units=units)
-    if title:
-        fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    head = title or ""
+    if left_out:
+        head += (("\n" if head else "") + f"{len(eqs)} of {len(order)} equilibria drawn "
+                 f"({left_out} left out; `taut fk --json` lists all)")
+    if head:
+        fig.suptitle(head, fontsize=10)
+    fig.legend(handles=legend_handles(), loc="lower center", ncol=4, fontsize=8,
+               frameon=False)
+    fig.tight_layout(rect=(0, 0.08 if rows == 1 else 0.05, 1, 1))
     if path is not None:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(path, dpi=150)
