@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import as_array
+from .._validate import as_array, require_instance
 from ..errors import InfeasiblePoseError, InvalidInputError
 from .model import CableRobot
 
@@ -29,12 +29,15 @@ def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
     zero. Raises :class:`InvalidInputError` on NaN/inf or a wrong shape, and
     :class:`InfeasiblePoseError` when a position lies outside ``robot.bounds``.
     """
+    require_instance(robot, CableRobot, "robot")
     arr = as_array(poses, field)
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] not in (3, 6):
         raise InvalidInputError(field, "must be (x, y, z) or (x, y, z, roll, pitch, yaw), "
                                        "optionally with a leading batch axis")
+    if arr.shape[0] == 0:
+        raise InvalidInputError(field, "is an empty batch (no poses)")
     if arr.shape[1] == 3:
         arr = np.hstack([arr, np.zeros((arr.shape[0], 3))])
     if check_bounds:

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import linprog
 
-from .._validate import as_array
+from .._validate import as_array, as_count, require_instance
 from ..errors import InvalidInputError
 from ._common import constraints, feas_tol, required_wrench, svd_split
 from .kinematics import as_poses, cable_state, gravity_wrench
@@ -250,7 +250,8 @@ def _aws_block(robot: CableRobot, P: np.ndarray, tipping: bool):
 def disturbance_box(robot: CableRobot, half_widths: Any) -> np.ndarray:
     """Vertices (2^n, n) of a box of extra external wrenches ``|w_k| <= half_widths[k]``
     (N, N m); zero half-widths collapse (duplicate vertices are removed)."""
-    hw = as_array(half_widths, "disturbance", shape=(robot.dof,))
+    hw = as_array(half_widths, "disturbance",
+                  shape=(require_instance(robot, CableRobot, "robot").dof,))
     if np.any(hw < 0):
         raise InvalidInputError("disturbance", "half-widths must be non-negative")
     V = np.array(list(product(*[(-x, x) if x > 0 else (0.0,) for x in hw])))
@@ -282,6 +283,7 @@ def wrench_feasible(robot: CableRobot, poses: Any, *, tipping: bool = True,
     ndarray (B,) of bool
     """
     P = as_poses(robot, poses)
+    chunk = as_count(chunk, "chunk", minimum=1)
     D = np.zeros((1, robot.dof)) if disturbance is None else \
         as_array(disturbance, "disturbance", shape=(None, robot.dof))
     out = np.empty(P.shape[0], dtype=bool)
@@ -337,7 +339,7 @@ def axis_capacities(robot: CableRobot, poses: Any, tipping: bool = True,
     """
     if method not in ("hrep", "lp"):
         raise InvalidInputError("method", "must be 'hrep' or 'lp'")
-    n = robot.dof
+    n = require_instance(robot, CableRobot, "robot").dof
     labels = AXIS_LABELS[:n]
     if method == "lp":
         return _axis_lp(robot, poses, tipping, labels)

@@ -30,7 +30,10 @@ from . import cdpr, fk, motion, plan
 
 app = typer.Typer(
     name="taut",
-    help="Carrying loads with cables and mobile robots.",
+    help="Carrying loads with cables and mobile robots. Exit codes: 0 answered yes; 1 a "
+         "valid question answered no (no equilibrium, infeasible tensions, unreachable "
+         "target, no plan or placement), with the reason; 2 invalid input, with one line "
+         "'taut: error: <field>: <problem>' on stderr.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,

@@ -20,10 +20,6 @@ if TYPE_CHECKING:
     from ..sheet.simulate import SimulationResult
 
 
-def _floats(a: Any) -> list[float] | None:
-    return None if a is None else [float(x) for x in np.asarray(a).ravel()]
-
-
 def _ik_table(r: "IKResult", units: str | None) -> str:
     u = f" {units}" if units else ""
     p = r.object

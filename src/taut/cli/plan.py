@@ -53,9 +53,10 @@ def plan_command(
     if as_json:
         typer.echo(to_json(doc))
     elif result.success:
+        height = ("" if result.formation is None else
+                  f", object at {result.formation.object_height:.3f} m")
         typer.echo(f"plan: {len(result.times)} samples, {result.duration:.2f} s, path "
-                   f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}], "
-                   f"object at {result.formation.object_height:.3f} m")
+                   f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}]{height}")
     else:
         typer.echo(f"no plan: {doc['reason']}")
     if not result.success:

@@ -42,7 +42,7 @@ def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode,
                               deep: bool = False) -> dict[Any, Any]:
     seen: dict[Any, int] = {}
     for key_node, _ in node.value:
-        key = loader.construct_object(key_node, deep=True)  # type: ignore[no-untyped-call]
+        key = loader.construct_object(key_node, deep=True)
         if key in seen:
             raise ScenarioError(str(key), f"duplicate key (lines {seen[key]} and "
                                           f"{key_node.start_mark.line + 1})")

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import Point, Polygon
 
+from .._validate import as_count
 from ..sheet.model import Sheet
 from .formation import optimal_formation
 from .world import Obstacle, Scenario, Team, World
@@ -71,8 +72,9 @@ def generate_scenario(seed: int, n_robots: int | None = None) -> Scenario:
     -------
     Scenario
     """
-    rng = np.random.default_rng(seed)
-    n = int(n_robots) if n_robots is not None else int(rng.integers(3, 9))
+    rng = np.random.default_rng(as_count(seed, "seed", minimum=0))
+    n = as_count(n_robots, "n_robots", minimum=3, maximum=8) if n_robots is not None \
+        else int(rng.integers(3, 9))
     team = _team(rng, n)
     low, high = _reaches(team)
     width = rng.uniform(2.05 * low + 0.1, 2.05 * max(high, low) + 0.8)

@@ -30,7 +30,8 @@ from typing import Literal
 
 import numpy as np
 
-from .._validate import as_array, as_positive
+from .._validate import (MAX_SHEET_LENGTH, as_array, as_positive, check_range,
+                         require_nonempty)
 from ..errors import InvalidInputError
 from ._candidates import Stationary, hull_candidates, padded_small_subsets
 from ._finalize import Classified, classify
@@ -87,7 +88,8 @@ def _formations(sheet: Sheet, formations: np.ndarray, field: str, single: bool) 
     closer than their sheet vertices (squared distances below the cached squared side
     lengths) are accepted at once; anything else gets the full check, which decides
     borderline cases and raises the usual errors. Returns shape (B, N, 2)."""
-    r = as_array(formations, field, ndim=2 if single else 3)
+    r = require_nonempty(as_array(formations, field, ndim=2 if single else 3), field)
+    check_range(r, field, MAX_SHEET_LENGTH, "sheet units")
     rb = r[None] if single else r
     if rb.shape[1:] == (sheet.n, 2):
         sides2 = _SIDES2.get(sheet)

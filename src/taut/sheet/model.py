@@ -145,7 +145,9 @@ class Sheet:
 
 def check_hold_height(hold_height: float) -> float:
     """Validate the holding height :math:`z_r` (> 0, finite)."""
-    return as_positive(hold_height, "hold_height")
+    z = as_positive(hold_height, "hold_height")
+    check_range(z, "hold_height", MAX_SHEET_LENGTH, "sheet units")
+    return z
 
 
 def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formations"
@@ -164,7 +166,7 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
         Some pair of robots is farther apart than its sheet vertices; ``step`` holds the
         batch index for batched input.
     """
-    r = as_array(formations, field, ndim=3)
+    r = check_range(as_array(formations, field, ndim=3), field, MAX_SHEET_LENGTH, "sheet units")
     if r.shape[2] != 2:
         raise InvalidInputError(field, f"last axis must have length 2 (x, y), got {r.shape[2]}")
     if r.shape[1] != sheet.n:
