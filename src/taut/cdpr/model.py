@@ -20,7 +20,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .._validate import as_array, as_finite_scalar, as_points
+from .._validate import MAX_TENSION_N, as_array, as_finite_scalar, as_points, check_range
 from ..errors import InvalidModelError
 
 __all__ = ["Base", "Platform", "Payload", "Cable", "CableRobot", "check_footprint",
@@ -364,6 +364,7 @@ class CableRobot:
             seen.add((c.base, c.exit))
             lo = as_finite_scalar(c.t_min, f"{f}.t_min")
             hi = as_finite_scalar(c.t_max, f"{f}.t_max")
+            check_range(hi, f"{f}.t_max", MAX_TENSION_N, "N")
             if lo < 0:
                 raise InvalidModelError(f"{f}.t_min", f"cables cannot push: {lo:g} N < 0")
             if not hi > lo:

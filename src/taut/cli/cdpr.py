@@ -120,7 +120,8 @@ def _wrench_set(model: str, pose: Any, rpy: Any, disturbance: Any, stabilisers: 
         import matplotlib.pyplot as plt
         fig = plot_axis_capacities(caps["tension_limits_only"], caps.get("with_tipping"), plot,
                                    title=f"{robot.name}: wrench capability at "
-                                         f"{np.round(P[:3], 3).tolist()} m")
+                                         f"{np.round(P[:3], 3).tolist()} m (per axis the "
+                                         f"smaller of the + and - directions)")
         plt.close(fig)
         out["plot"] = str(plot)
     if as_json:

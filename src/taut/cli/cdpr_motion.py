@@ -55,7 +55,8 @@ def _twist_set(model: str, pose: Any, rpy: Any, mode: str, moving: Any, base_spe
         from ..viz.cdpr_motion import plot_capacity_bars
         n = len(caps.labels)
         plot_capacity_bars(series, caps.labels, (["m/s"] * 3 + ["rad/s"] * 3)[:n],
-                           f"{robot.name}: available twist set (+ axes)", plot)
+                           f"{robot.name}: available twist set, largest speed along "
+                           f"each + axis", plot)
         out["plot"] = str(plot)
     if as_json:
         typer.echo(to_json(out))

@@ -133,7 +133,10 @@ def register(app: typer.Typer) -> None:
         if plot is not None:
             from ..viz.sheet import plot_fk
 
-            plot_fk(result, plot, units=sc.units, title=sc.name)
+            panels = 12
+            plot_fk(result, plot, units=sc.units, title=sc.name, max_panels=panels)
+            n = len(result.equilibria)
+            note = f" ({panels} of {n} equilibria drawn, stable first)" if n > panels else ""
             if not as_json:
-                typer.echo(f"figure written to {plot}")
+                typer.echo(f"figure written to {plot}{note}")
         return 0 if result.equilibria else 1
