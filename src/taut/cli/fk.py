@@ -70,12 +70,16 @@ def explain_no_equilibrium(result: FKResult) -> str:
     floor were not there (solving the same team with holding points raised by the sheet's
     diameter, an upper bound of every cable length; the depth below the holding points
     does not depend on the hold height, FK paper eq. 15 only discards z_o <= 0)."""
+    from ..errors import TautError
     from ..sheet import forward_kinematics
 
     v = result.sheet.vertices
     diameter = float(max(((v[:, None] - v[None]) ** 2).sum(-1).max() ** 0.5, 1.0))
-    raised = forward_kinematics(result.sheet, result.formation, result.hold_height + diameter,
-                                method="fast")
+    try:
+        raised = forward_kinematics(result.sheet, result.formation,
+                                    result.hold_height + diameter, method="fast")
+    except TautError:                       # the raised height is out of the accepted range
+        return "no state of this team has the object above the floor (0 < z_o < z_r)"
     below = [e for e in raised.equilibria if e.object[2] - diameter <= 0]
     if not below:
         return "no state of this team passes the paper's Algorithm 1"
