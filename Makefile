@@ -17,7 +17,9 @@ demo: $(STAMP)
 	$(BIN)/taut fk examples/sheet/example2_r2_r4_353mm.yaml --mass 1.0 --plot out/example2.png
 
 test: $(STAMP)
+	$(BIN)/python -m mypy
 	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest --doctest-modules src/taut -p no:cacheprovider
 
 # Heavy cases (marked `slow`); CI runs them after `make test`. Exit 5 = none collected.
 test-slow: $(STAMP)
