@@ -14,7 +14,7 @@ from typer.exceptions import TyperException
 
 from .. import __version__
 from ..errors import TautError
-from . import cdpr, fk, motion, plan
+from . import cdpr, fk, motion, plan, sweep
 
 app = typer.Typer(
     name="taut",
@@ -41,7 +41,7 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
     ``taut: error: <field>: <problem>`` and exits with code 2."""
 
 
-for _module in (fk, motion, plan, cdpr):
+for _module in (fk, motion, plan, cdpr, sweep):
     _module.register(app)
 
 EXIT_USAGE = 2
