@@ -8,6 +8,7 @@ Results go to ``DIR/results.parquet``; ``--resume`` continues an interrupted run
 from __future__ import annotations
 
 import sys
+import textwrap
 import time
 from pathlib import Path
 from typing import Any, Optional
@@ -132,9 +133,15 @@ def plot_command(
         if name is not None and name not in columns:
             raise SweepError(flag, f"no column {name!r} in the results; columns: "
                              f"{', '.join(columns)}")
+    from ..sweep import TASKS
     from ..viz.sweep import plot_sweep
-    title = f"{meta.get('sweep_task', 'sweep')}: {value}"
-    plot_sweep(columns, x, value, target, y=y, title=title)
+    task = TASKS.get(meta.get("sweep_task", ""))
+    described = {**task.parameters, **task.outputs} if task is not None else {}
+    labels = {name: textwrap.fill(f"{name}: {text}", 48) for name, text in described.items()}
+    title = f"{meta.get('sweep_task', 'sweep')}: {value}" + ("" if y is not None or
+                                                             columns[value].dtype.kind != "b"
+                                                             else " (rate)")
+    plot_sweep(columns, x, value, target, y=y, title=title, labels=labels)
     print(f"figure -> {target}")
     return 0
 

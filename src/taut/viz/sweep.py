@@ -50,8 +50,19 @@ def plot_sweep(columns: dict[str, np.ndarray], x: str, value: str, path: str | P
         ux, uy = np.unique(xs), np.unique(ys)
         grid = np.full((len(uy), len(ux)), np.nan)
         grid[np.searchsorted(uy, ys), np.searchsorted(ux, xs)] = mean
-        mesh: Any = ax.pcolormesh(ux, uy, grid, shading="nearest", cmap="viridis")
-        fig.colorbar(mesh, ax=ax, label=labels.get(value, value))
+        finite = grid[np.isfinite(grid)]
+        levels = np.unique(finite)
+        if levels.size and levels.size <= 10 and np.all(levels == np.round(levels)):
+            # A count: one colour per value, ticks on the values.
+            from matplotlib.colors import BoundaryNorm
+            edges = np.concatenate([levels - 0.5, [levels[-1] + 0.5]])
+            cmap = plt.get_cmap("viridis", levels.size)
+            mesh: Any = ax.pcolormesh(ux, uy, grid, shading="nearest", cmap=cmap,
+                                      norm=BoundaryNorm(edges, levels.size))
+            fig.colorbar(mesh, ax=ax, ticks=levels, label=labels.get(value, value))
+        else:
+            mesh = ax.pcolormesh(ux, uy, grid, shading="nearest", cmap="viridis")
+            fig.colorbar(mesh, ax=ax, label=labels.get(value, value))
         ax.set_ylabel(labels.get(y, y))
     ax.set_xlabel(labels.get(x, x))
     ax.set_title(title or f"{value} over {x}" + (f" and {y}" if y else ""))

@@ -4,7 +4,8 @@ payloads and tension limits (FASTKIT paper §3-4).
 ``base_separation`` moves the two mobile bases symmetrically along the line joining them
 (their headings kept), so the distance between their frames becomes the given value, m.
 ``payload`` replaces the payload mass, kg; ``t_max`` replaces every cable's maximum tension,
-N. A point whose modified model is invalid (e.g. ``t_max`` below ``t_min``) keeps NaN
+N. Grid points outside the frame spanned by the exit points (bases moved closer) count as
+not feasible. A point whose modified model is invalid (e.g. ``t_max`` below ``t_min``) keeps NaN
 results and its reason in ``message``.
 """
 
@@ -86,23 +87,31 @@ def _run_workspace(ctx: _Context, cols: Columns, seeds: np.ndarray) -> Columns:
     b = len(seeds)
     out: Columns = {"coverage": np.full(b, np.nan), "coverage_tipping": np.full(b, np.nan),
                     "n_points": np.zeros(b, dtype=np.int64),
+                    "n_outside": np.zeros(b, dtype=np.int64),
                     "message": np.full(b, "", dtype=object)}
     points, _ = grid_points(ctx.box, ctx.grid)
     for k in range(b):
         try:
             robot = variant(ctx.robot, cols["base_separation"][k], cols["payload"][k],
                             cols["t_max"][k], bool(cols["stabilisers"][k]))
-            ws = wrench_feasible_workspace(robot, points)
+            lo, hi = np.asarray(robot.bounds, float)
+            inside = np.all((points >= lo) & (points <= hi), axis=1)
+            feas = np.zeros(len(points), bool)
+            feas_t = np.zeros(len(points), bool)
+            if inside.any():
+                ws = wrench_feasible_workspace(robot, points[inside])
+                feas[inside] = ws.feasible
+                feas_t[inside] = ws.feasible if ws.feasible_tipping is None \
+                    else ws.feasible_tipping
         except SweepError:
             raise
         except TautError as exc:
             out["message"][k] = str(exc)
             continue
-        feas = np.asarray(ws.feasible, bool)
-        feas_t = feas if ws.feasible_tipping is None else np.asarray(ws.feasible_tipping, bool)
         out["coverage"][k] = feas.mean()
         out["coverage_tipping"][k] = feas_t.mean()
         out["n_points"][k] = len(points)
+        out["n_outside"][k] = int((~inside).sum())
     return out
 
 
@@ -145,9 +154,11 @@ register(Task(
     summary="wrench-feasible fraction of a workspace grid, with and without tipping",
     parameters={"base_separation": "distance between the two mobile bases' frames, m",
                 **_MODEL_PARAMETERS},
-    outputs={"coverage": "fraction of grid points wrench-feasible (limits only)",
+    outputs={"coverage": "fraction of the box's grid points wrench-feasible (limits only; "
+                         "points outside the frame count as infeasible)",
              "coverage_tipping": "fraction also free of tipping (FASTKIT eqs. 21-23)",
-             "n_points": "grid points evaluated",
+             "n_points": "grid points of the box",
+             "n_outside": "grid points outside the frame spanned by the exit points",
              "message": "why a point has no result (empty when it has one)"},
     defaults=_defaults,
     default_chunk=4,
