@@ -85,7 +85,7 @@ def main() -> None:
     print(f"octagon stability map: {n} formations (N = 8), chunk {args.chunk}")
     runs: dict[str, list[float]] = {k: [] for k in
                                     ("api", "serial", "w1", "w2", "w2 warm")}
-    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None,
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0",
                       silence_logs=logging.ERROR) as cluster, Client(cluster):
         addr = cluster.scheduler_address
         for _ in range(args.repeat):                     # interleaved

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -111,9 +112,12 @@ def _connect(workers: int | None, scheduler: str | None) -> Any:
         except (OSError, TimeoutError, ValueError) as exc:
             raise SweepError("scheduler", f"no Dask scheduler answers at {scheduler} within "
                              f"{CONNECT_TIMEOUT:g} s ({type(exc).__name__})") from None
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
-    return Client(cluster)
+    with warnings.catch_warnings():
+        # Dask warns when its default HTTP port is taken; ":0" picks a free one anyway.
+        warnings.simplefilter("ignore", UserWarning)
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0", silence_logs=logging.ERROR)
+        return Client(cluster)
 
 
 def _params_for(spec: SweepSpec, bounds: list[tuple[int, int]]) -> Callable[[int, int], Columns]:
