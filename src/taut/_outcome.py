@@ -33,6 +33,7 @@ Status = Literal[
     "not_converged",     # an iterative solver stopped before its tolerance
     "unverified",        # a candidate was found but failed verification
     "diverged",          # a simulation left the model's domain
+    "interrupted",       # a run stopped before every point was computed (resumable)
 ]
 
 STATUSES: tuple[str, ...] = Status.__args__  # type: ignore[attr-defined]

@@ -20,6 +20,7 @@ __all__ = [
     "InvalidModelError",
     "InfeasiblePoseError",
     "PlanningError",
+    "SweepError",
 ]
 
 
@@ -86,3 +87,8 @@ class InfeasiblePoseError(TautError):
 
 class PlanningError(TautError):
     """A planning problem is ill-posed (start or goal blocked, overlapping obstacles)."""
+
+
+class SweepError(InvalidInputError):
+    """A sweep file or run request is invalid: unknown task, parameter or output, an empty
+    range, a scheduler that does not answer, an output folder holding another sweep."""

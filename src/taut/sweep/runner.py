@@ -1,0 +1,251 @@
+"""Running a sweep: serially in this process, on a local Dask cluster, or on an existing
+one, with the same chunks and so the same rows.
+
+Each chunk is evaluated by :func:`evaluate_chunk`, a pure function of the spec and the
+chunk's bounds; the client writes each finished chunk once (as its future completes), so a
+worker that dies mid-chunk only makes Dask recompute that chunk elsewhere: nothing is lost
+or duplicated.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from ..errors import SweepError
+from .points import chunk_bounds, expand, point_seeds
+from .spec import SweepSpec
+from .store import Store
+from .tasks import TASKS, Columns
+
+__all__ = ["SweepResult", "run_sweep", "evaluate_chunk", "chunk_size_of"]
+
+#: Seconds to wait for an existing scheduler to answer before giving up.
+CONNECT_TIMEOUT = 5.0
+
+_CONTEXTS: dict[str, Any] = {}
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """What a sweep run did.
+
+    Attributes
+    ----------
+    success : bool
+        True when every requested point has a row in ``path``.
+    status : {"ok", "interrupted"}
+    message : str
+    path : Path or None
+        ``results.parquet`` (None when interrupted).
+    rows : int
+        Rows in ``path``.
+    chunks_run, chunks_reused : int
+        Chunks computed in this run / found finished in the folder.
+    seconds : float
+        Wall time of the run, s.
+    """
+
+    success: bool
+    status: str
+    message: str
+    path: Path | None
+    rows: int
+    chunks_run: int
+    chunks_reused: int
+    seconds: float
+
+
+def chunk_size_of(spec: SweepSpec) -> int:
+    """Points per chunk: the spec's, else the task's default."""
+    return int(spec.chunk_size) or TASKS[spec.task].default_chunk
+
+
+def _context(spec: SweepSpec) -> Any:
+    ctx = _CONTEXTS.get(spec.digest)
+    if ctx is None:
+        ctx = _CONTEXTS[spec.digest] = TASKS[spec.task].prepare(spec)
+    return ctx
+
+
+def evaluate_chunk(spec: SweepSpec, start: int, stop: int,
+                   params: Columns | None = None) -> Columns:
+    """Rows ``start..stop-1`` of the sweep: ``point``, the parameters, the outputs.
+
+    ``params`` (the chunk's parameter columns) may be passed in; by default they are
+    expanded from the spec.
+    """
+    task = TASKS[spec.task]
+    ctx = _context(spec)
+    cols = dict(params) if params is not None else expand(spec, start, stop)
+    n = stop - start
+    defaults = task.defaults(ctx)
+    full = {name: np.asarray(cols[name], float) if name in cols
+            else np.full(n, defaults[name], dtype=float) for name in task.parameters}
+    seeds = point_seeds(spec, cols["point"])
+    outputs = task.run(ctx, full, seeds)
+    if spec.outputs:
+        outputs = {k: outputs[k] for k in spec.outputs}
+    row: Columns = {"point": np.asarray(cols["point"], np.int64)}
+    row.update({name: np.asarray(cols[name], float) for name in spec.names})
+    row.update(outputs)
+    return row
+
+
+def _connect(workers: int | None, scheduler: str | None) -> Any:
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover - depends on the install
+        raise SweepError("workers", "parallel sweeps need dask.distributed: pip install "
+                         "'taut[sweep]' (or run serially with --workers 0)") from None
+    if scheduler is not None:
+        try:
+            return Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise SweepError("scheduler", f"no Dask scheduler answers at {scheduler} within "
+                             f"{CONNECT_TIMEOUT:g} s ({type(exc).__name__})") from None
+    with warnings.catch_warnings():
+        # Dask warns when its default HTTP port is taken; ":0" picks a free one anyway.
+        warnings.simplefilter("ignore", UserWarning)
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=":0", silence_logs=logging.ERROR)
+        return Client(cluster)
+
+
+def _params_for(spec: SweepSpec, bounds: list[tuple[int, int]]) -> Callable[[int, int], Columns]:
+    if spec.mode != "random":
+        return lambda lo, hi: expand(spec, lo, hi)
+    everything = expand(spec)            # random draws: one stream for the whole sweep
+    return lambda lo, hi: {k: v[lo:hi] for k, v in everything.items()}
+
+
+def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
+              scheduler: str | None = None, resume: bool = False, limit: int | None = None,
+              progress: Callable[[int, int], None] | None = None) -> SweepResult:
+    r"""Run ``spec`` and write ``out/results.parquet``.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+    out : path
+        Results folder (see :class:`taut.sweep.store.Store`).
+    workers : int, optional
+        0: serial, in this process. Otherwise the number of worker processes of a local
+        Dask cluster (default: one per CPU). Ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://HOST:PORT``).
+    resume : bool
+        Continue an earlier run of the same sweep in ``out``, skipping finished chunks.
+    limit : int, optional
+        Only the first ``limit`` points (for quick checks); chunks stay those of the full
+        sweep, so a later run with ``resume`` reuses them.
+    progress : callable, optional
+        ``progress(done_points, total_points)`` after each chunk.
+
+    Returns
+    -------
+    SweepResult
+        ``status="interrupted"`` when the run stopped early (Ctrl-C, a worker failing
+        repeatedly); the chunks finished so far are kept for ``resume``.
+
+    Examples
+    --------
+    A 3 x 2 stability map of a square team, run serially:
+
+    >>> import tempfile, pathlib
+    >>> from taut.io.sweep_file import sweep_from_mapping
+    >>> from taut.io.sweep_results import read_results
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (tmp / "team.yaml").write_text(
+    ...     "hold_height: 800\nsheet: [[0, 0], [1000, 0], [1000, 1000], [0, 1000]]\n"
+    ...     "formation: [[100, 100], [800, 50], [900, 850], [50, 700]]\n")
+    >>> spec = sweep_from_mapping({"task": "fk_stability_map", "base": "team.yaml",
+    ...                            "parameters": {"scale": [0.8, 0.9, 1.0],
+    ...                                           "stretch": [1.0, 1.1]}}, root=tmp)
+    >>> run_sweep(spec, tmp / "out", workers=0).rows
+    6
+    >>> columns, meta = read_results(tmp / "out")
+    >>> columns["scale"].tolist(), meta["sweep_task"]
+    ([0.8, 0.8, 0.9, 0.9, 1.0, 1.0], 'fk_stability_map')
+    """
+    t0 = time.perf_counter()
+    total = spec.size if limit is None else min(int(limit), spec.size)
+    if total < 1:
+        raise SweepError("limit" if limit is not None else "parameters", "selects no points")
+    store = Store(out, spec.digest, resume=resume)
+    bounds = [b for b in chunk_bounds(spec.size, chunk_size_of(spec)) if b[0] < total]
+    todo = [k for k in range(len(bounds)) if not store.has(k)]
+    reused = len(bounds) - len(todo)
+    done = sum(min(bounds[k][1], total) - bounds[k][0] for k in range(len(bounds))
+               if k not in set(todo))
+    if progress is not None:
+        progress(done, total)
+    params = _params_for(spec, bounds)
+    try:
+        for k, cols in _execute(spec, bounds, todo, params, workers, scheduler):
+            store.write_chunk(k, cols)
+            done += min(bounds[k][1], total) - bounds[k][0]
+            if progress is not None:
+                progress(done, total)
+    except (KeyboardInterrupt, _WorkerFailure) as exc:
+        msg = "interrupted" if isinstance(exc, KeyboardInterrupt) else str(exc)
+        return SweepResult(False, "interrupted", f"{msg}: {done} of {total} points done; run "
+                           "again with --resume to continue", None, 0, len(todo), reused,
+                           time.perf_counter() - t0)
+    meta = {"taut_version": __version__, "sweep_digest": spec.digest,
+            "sweep_task": spec.task, "sweep_source": spec.source}
+    path = store.assemble(list(range(len(bounds))), total, meta)
+    return SweepResult(True, "ok", f"{total} points", path, total, len(todo), reused,
+                       time.perf_counter() - t0)
+
+
+class _WorkerFailure(Exception):
+    """A chunk failed on the cluster (e.g. its workers kept dying)."""
+
+
+def _execute(spec: SweepSpec, bounds: list[tuple[int, int]], todo: list[int],
+             params: Callable[[int, int], Columns], workers: int | None,
+             scheduler: str | None) -> Any:
+    """Yield ``(chunk index, columns)`` as chunks finish."""
+    if not todo:
+        return
+    if workers == 0 and scheduler is None:
+        for k in todo:
+            lo, hi = bounds[k]
+            yield k, evaluate_chunk(spec, lo, hi, params(lo, hi))
+        return
+    from distributed import as_completed
+
+    client = _connect(workers, scheduler)
+    try:
+        futures, index = [], {}
+        for k in todo:
+            lo, hi = bounds[k]
+            fut = client.submit(evaluate_chunk, spec, lo, hi, params(lo, hi),
+                                key=f"taut-sweep-{spec.digest[:16]}-{k}", pure=False)
+            futures.append(fut)
+            index[fut.key] = k
+        for fut in as_completed(futures):
+            try:
+                cols = fut.result()
+            except Exception as exc:   # a task error travels back from the worker
+                from ..errors import TautError
+                if isinstance(exc, TautError):
+                    raise
+                raise _WorkerFailure(f"chunk {index[fut.key]} failed on the cluster "
+                                     f"({type(exc).__name__})") from None
+            yield index[fut.key], cols
+    finally:
+        cluster = getattr(client, "cluster", None)
+        client.close()
+        if cluster is not None and scheduler is None:
+            cluster.close()
+

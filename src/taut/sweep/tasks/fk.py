@@ -1,0 +1,183 @@
+"""``fk_stability_map``: rest states of one sheet over transformed formations.
+
+Each point transforms the base scenario's formation about its centroid ``c``:
+
+    r_i' = c + scale * Rot(rotation) * Stretch(stretch, stretch_angle) * (r_i - c) + noise,
+
+where ``Stretch(s, a) = Rot(a) diag(s, 1) Rot(-a)`` stretches along the direction ``a``,
+and ``noise`` is seeded normal noise of standard deviation ``jitter`` per robot coordinate
+(0 by default). A plain rotation is a symmetry of the model (FK commutes with rigid motions
+of the formation), so ``rotation`` alone never changes the counts; the heading that matters
+for a non-regular formation is that of the stretch. Formations that the sheet cannot reach
+(a robot pair farther apart than its sheet vertices) are reported with ``feasible`` false.
+Forward kinematics runs batched over each chunk (one call per hold height).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...errors import InfeasibleFormationError
+from ...sheet import Sheet, forward_kinematics_batch
+from . import Columns, Task, register
+
+__all__ = ["transform_formations"]
+
+#: Relative slack of the pre-filter of infeasible formations (the solver's own check
+#: decides; this only keeps clearly infeasible formations out of the batch).
+_FEASIBLE_RTOL = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class _Context:
+    sheet: Sheet
+    formation: np.ndarray
+    hold_height: float
+    mass: float | None
+    limits: np.ndarray       # (N, N) sheet distances
+
+
+def _prepare(spec: Any) -> _Context:
+    from ...io.sweep_file import base_model
+
+    sc = base_model(spec)
+    return _Context(sc.sheet, np.asarray(sc.formation, float), float(sc.hold_height),
+                    sc.mass, sc.sheet.side_lengths())
+
+
+def transform_formations(formation: np.ndarray, cols: Columns, seeds: np.ndarray,
+                         ) -> np.ndarray:
+    """The transformed formations (B, N, 2) of a chunk (see the module docstring)."""
+    c = formation.mean(axis=0)
+    rel = formation - c
+    b = len(seeds)
+    a = np.deg2rad(cols["stretch_angle"])
+    s = cols["stretch"]
+    ca, sa = np.cos(a), np.sin(a)
+    # Stretch(s, a) = I + (s - 1) u u^T with u = (cos a, sin a).
+    stretch = np.empty((b, 2, 2))
+    stretch[:, 0, 0] = 1 + (s - 1) * ca * ca
+    stretch[:, 1, 1] = 1 + (s - 1) * sa * sa
+    stretch[:, 0, 1] = stretch[:, 1, 0] = (s - 1) * ca * sa
+    t = np.deg2rad(cols["rotation"])
+    rot = np.empty((b, 2, 2))
+    rot[:, 0, 0] = rot[:, 1, 1] = np.cos(t)
+    rot[:, 1, 0] = np.sin(t)
+    rot[:, 0, 1] = -np.sin(t)
+    m = cols["scale"][:, None, None] * rot @ stretch
+    out = c + np.einsum("bij,nj->bni", m, rel)
+    jitter = cols["jitter"]
+    if np.any(jitter > 0):
+        for k in np.flatnonzero(jitter > 0):
+            rng = np.random.default_rng(int(seeds[k]))
+            out[k] += rng.normal(0.0, jitter[k], size=out[k].shape)
+    return out
+
+
+def _feasible(ctx: _Context, forms: np.ndarray) -> np.ndarray:
+    d = np.linalg.norm(forms[:, :, None, :] - forms[:, None, :, :], axis=-1)
+    slack = _FEASIBLE_RTOL * ctx.sheet.size
+    return np.all(d <= ctx.limits * (1 + _FEASIBLE_RTOL) + slack, axis=(1, 2))
+
+
+def _solve_group(ctx: _Context, forms: np.ndarray, hold: float, mass: float | None,
+                 out: Columns, rows: np.ndarray) -> None:
+    try:
+        res = forward_kinematics_batch(ctx.sheet, forms, hold, mass=mass)
+    except InfeasibleFormationError:
+        # A borderline formation the pre-filter let through: solve one by one.
+        for k, r in enumerate(rows):
+            try:
+                one = forward_kinematics_batch(ctx.sheet, forms[k:k + 1], hold, mass=mass)
+            except InfeasibleFormationError:
+                out["feasible"][r] = False
+                continue
+            _store(one, 0, out, r)
+        return
+    for k, r in enumerate(rows):
+        _store(res, k, out, r)
+
+
+def _store(res: Any, k: int, out: Columns, r: int) -> None:
+    status = res.status[k]
+    out["n_equilibria"][r] = int(np.sum((status == 0) | (status == 1)))
+    out["n_stable"][r] = int(np.sum(status == 0))
+    out["n_saddle"][r] = int(np.sum(status == 1))
+    out["n_states"][r] = int(res.count[k])
+    stable = np.flatnonzero(status == 0)
+    if stable.size == 0:
+        return
+    low = stable[np.argmin(res.object[k, stable, 2])]
+    taut = np.flatnonzero(res.taut[k, low])
+    out["lowest_height"][r] = res.object[k, low, 2]
+    out["lowest_taut"][r] = ",".join(str(int(i)) for i in taut)
+    out["min_share"][r] = float(res.weights[k, low, taut].min())
+    if res.tensions is not None:
+        out["max_tension"][r] = float(res.tensions[k, low, taut].max())
+
+
+def _run(ctx: _Context, cols: Columns, seeds: np.ndarray) -> Columns:
+    b = len(seeds)
+    out: Columns = {
+        "feasible": np.ones(b, dtype=bool),
+        "n_states": np.zeros(b, dtype=np.int64),
+        "n_equilibria": np.zeros(b, dtype=np.int64),
+        "n_stable": np.zeros(b, dtype=np.int64),
+        "n_saddle": np.zeros(b, dtype=np.int64),
+        "lowest_height": np.full(b, np.nan),
+        "lowest_taut": np.full(b, "", dtype=object),
+        "min_share": np.full(b, np.nan),
+        "max_tension": np.full(b, np.nan),
+    }
+    forms = transform_formations(ctx.formation, cols, seeds)
+    ok = _feasible(ctx, forms)
+    out["feasible"][:] = ok
+    holds, masses = cols["hold_height"], cols["mass"]
+    keys = np.stack([holds, masses], axis=1)
+    for key in np.unique(keys[ok], axis=0):
+        rows = np.flatnonzero(ok & (holds == key[0]) & (masses == key[1]))
+        mass = None if key[1] <= 0 else float(key[1])
+        _solve_group(ctx, forms[rows], float(key[0]), mass, out, rows)
+    return out
+
+
+def _defaults(ctx: _Context) -> dict[str, float]:
+    """Values of parameters that are not swept; hold height and mass are the scenario's."""
+    return {"scale": 1.0, "stretch": 1.0, "stretch_angle": 0.0, "rotation": 0.0,
+            "jitter": 0.0, "hold_height": ctx.hold_height,
+            "mass": -1.0 if ctx.mass is None else float(ctx.mass)}
+
+
+FK_STABILITY_MAP = register(Task(
+    name="fk_stability_map",
+    summary="rest states of a sheet scenario over formation scale, stretch and heading",
+    parameters={
+        "scale": "factor on the formation about its centroid (1 = as in the scenario)",
+        "stretch": "factor along the stretch direction (1 = no stretch)",
+        "stretch_angle": "direction of the stretch, degrees",
+        "rotation": "rotation of the formation about its centroid, degrees (a symmetry)",
+        "jitter": "standard deviation of seeded noise per robot coordinate, length unit",
+        "hold_height": "hold height z_r, length unit (default: the scenario's)",
+        "mass": "object mass, kg (<= 0: none; default: the scenario's)",
+    },
+    outputs={
+        "feasible": "the sheet can span the formation",
+        "n_states": "rest-state candidates passing the paper's checks",
+        "n_equilibria": "stable + saddle states",
+        "n_stable": "stable states (strict local minima of the object's height)",
+        "n_saddle": "equilibria that are not minima",
+        "lowest_height": "object height z_o of the lowest stable state, length unit",
+        "lowest_taut": "taut cables of the lowest stable state, 0-based, comma separated",
+        "min_share": "smallest load share w_i among its taut cables",
+        "max_tension": "largest cable tension of the lowest stable state, N (needs mass)",
+    },
+    defaults=_defaults,
+    default_chunk=2048,
+    needs_base="sheet scenario",
+    prepare=_prepare,
+    run=_run,
+))
+

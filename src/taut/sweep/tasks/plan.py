@@ -1,0 +1,140 @@
+"""``plan_suite`` and ``plan_robustness``: the planner over generated corridors, and one
+plan under robot position noise.
+
+``plan_robustness`` plans the base scenario once per worker process (the planner is
+deterministic), then for each point adds seeded normal noise of standard deviation
+``sigma`` (m, per robot coordinate, independent at every sample of the plan, modelling
+position tracking error) and replays the noisy formations: ``torn`` when some robot pair
+stands farther apart than its sheet vertices (the sheet would tear or a robot slip), else
+the quasi-static simulation runs and ``jumped`` says whether the object left its branch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...errors import SweepError, TautError
+from . import Columns, Task, register
+
+__all__: list[str] = []
+
+
+def _status(res: Any) -> tuple[bool, str, str]:
+    ok = bool(res.success)
+    status = str(getattr(res, "status", "ok" if ok else "no_route"))
+    message = getattr(res, "message", None)
+    if message is None:
+        message = getattr(res, "reason", "")
+    return ok, status, str(message or "")
+
+
+def _run_suite(ctx: Any, cols: Columns, seeds: np.ndarray) -> Columns:
+    from ...plan import generate_scenario, plan
+
+    b = len(seeds)
+    out: Columns = {"success": np.zeros(b, dtype=bool), "status": np.full(b, "", dtype=object),
+                    "path_length": np.full(b, np.nan), "duration": np.full(b, np.nan),
+                    "crossed": np.zeros(b, dtype=np.int64), "n_robots_used": np.zeros(b, np.int64),
+                    "message": np.full(b, "", dtype=object)}
+    for k in range(b):
+        n = int(cols["n_robots"][k])
+        try:
+            sc = generate_scenario(int(cols["scenario_seed"][k]), n if n > 0 else None)
+            res = plan(sc, baseline=bool(cols["baseline"][k]))
+        except TautError as exc:
+            out["message"][k] = str(exc)
+            continue
+        ok, status, message = _status(res)
+        out["success"][k], out["status"][k], out["message"][k] = ok, status, message
+        out["n_robots_used"][k] = sc.team.n
+        if ok:
+            out["path_length"][k] = float(res.path_length)
+            out["duration"][k] = float(res.duration)
+            out["crossed"][k] = len(res.crossed)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class _PlanContext:
+    team: Any
+    robots: np.ndarray       # (T, N, 2) m
+    object: np.ndarray       # (T, 3) m
+    limits: np.ndarray       # (N, N) sheet distances, m
+
+
+def _prepare_robustness(spec: Any) -> _PlanContext:
+    from ...io.sweep_file import base_model
+    from ...plan import plan
+
+    sc = base_model(spec)
+    res = plan(sc)
+    if not res.success:
+        _, _, message = _status(res)
+        raise SweepError("base", f"the base scenario has no plan to perturb ({message})")
+    return _PlanContext(sc.team, np.asarray(res.robots, float), np.asarray(res.object, float),
+                        sc.team.sheet.side_lengths())
+
+
+def _run_robustness(ctx: _PlanContext, cols: Columns, seeds: np.ndarray) -> Columns:
+    from ...sheet import simulate
+
+    b = len(seeds)
+    out: Columns = {"torn": np.zeros(b, dtype=bool), "max_extension": np.full(b, np.nan),
+                    "jumped": np.zeros(b, dtype=bool), "max_deviation": np.full(b, np.nan)}
+    iu, ju = np.triu_indices(ctx.robots.shape[1], 1)
+    for k in range(b):
+        rng = np.random.default_rng(int(seeds[k]))
+        noisy = ctx.robots + rng.normal(0.0, cols["sigma"][k], size=ctx.robots.shape)
+        dist = np.linalg.norm(noisy[:, iu] - noisy[:, ju], axis=-1)
+        ext = float(np.max(dist - ctx.limits[iu, ju]))
+        out["max_extension"][k] = ext
+        if ext > 0:
+            out["torn"][k] = True
+            continue
+        try:
+            sim = simulate(ctx.team.sheet, noisy, ctx.team.hold_height, start=ctx.object[0])
+        except TautError:          # e.g. a formation the sheet cannot span within rounding
+            out["torn"][k] = True
+            continue
+        events = getattr(sim, "events", ())
+        out["jumped"][k] = any(getattr(e, "kind", "") in ("jump", "lost") for e in events)
+        out["max_deviation"][k] = float(np.max(np.linalg.norm(
+            np.asarray(sim.object) - ctx.object, axis=1)))
+    return out
+
+
+register(Task(
+    name="plan_suite",
+    summary="the planner (or the baseline) over seeded generated corridors",
+    parameters={"scenario_seed": "seed of taut.plan.generate_scenario",
+                "n_robots": "team size 3..8 (0: drawn from the seed)",
+                "baseline": "1 for the bypass-only baseline, 0 for the crossing planner"},
+    outputs={"success": "a verified plan was found", "status": "the plan's status",
+             "path_length": "planar length of the object's path, m",
+             "duration": "time to the goal, s", "crossed": "obstacles crossed under the sheet",
+             "n_robots_used": "team size of the scenario", "message": "the plan's message"},
+    defaults=lambda ctx: {"scenario_seed": 0.0, "n_robots": 0.0, "baseline": 0.0},
+    default_chunk=1,
+    needs_base="",
+    prepare=lambda spec: None,
+    run=_run_suite,
+))
+
+register(Task(
+    name="plan_robustness",
+    summary="one plan replayed under seeded robot position noise",
+    parameters={"sigma": "standard deviation of the position noise per coordinate, m",
+                "trial": "trial number (only distinguishes points; seeds derive from it)"},
+    outputs={"torn": "some robot pair exceeded its sheet distance",
+             "max_extension": "largest pair distance beyond its sheet distance, m (< 0: slack)",
+             "jumped": "the object left its branch (jump or lost) in the simulation",
+             "max_deviation": "largest distance of the object from its planned position, m"},
+    defaults=lambda ctx: {"sigma": 0.005, "trial": 0.0},
+    default_chunk=25,
+    needs_base="plan scenario",
+    prepare=_prepare_robustness,
+    run=_run_robustness,
+))
