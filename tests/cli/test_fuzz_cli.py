@@ -211,7 +211,46 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
                                v, "0", "0", "0", "0", "0"]) for v in BAD_NUMBERS]
     cases += [("cdpr deploy", ["cdpr", "deploy", "fastkit", "--workspace", *ws, "--plot", o])
               for o in outs]
+    cases += _sweep_cases(tmp, files, outs)
     cases += [("taut", [w]) for w in ("nosuch", "--nosuch", "cdpr nosuch")]
+    return cases
+
+
+def _sweep_cases(tmp: Path, files: list[str], outs: list[str]) -> list[tuple[str, list[str]]]:
+    """`taut sweep`: bad files, mutated sweep files, bad options, bad figure paths."""
+    good = {"task": "fk_stability_map", "base": str(SHEET),
+            "parameters": {"scale": {"range": [0.8, 1.0], "num": 3}}}
+    mutations = [{"task": "nope"}, {"task": True}, {"base": str(tmp / "none.yaml")},
+                 {"base": None}, {"parameters": {}}, {"parameters": {"scal": 1}},
+                 {"parameters": {"scale": {"range": [1, 0], "num": 3}}},
+                 {"parameters": {"scale": {"range": [0, 1], "num": 0}}},
+                 {"parameters": {"scale": {"range": [0, 1], "step": -1}}},
+                 {"parameters": {"scale": []}}, {"parameters": {"scale": True}},
+                 {"parameters": {"scale": float("nan")}}, {"parameters": {"scale": "big"}},
+                 {"mode": "random"}, {"mode": "random", "samples": -5},
+                 {"mode": "random", "samples": 3, "parameters": {"scale": {"uniform": [1, 1]}}},
+                 {"outputs": ["n_stabel"]}, {"outputs": "n_stable"}, {"seed": -1},
+                 {"seed": 1.5}, {"chunk_size": -1}, {"colour": "red"}, {"options": 3}]
+    specs = []
+    for k, change in enumerate(mutations):
+        p = tmp / f"sweep_{k}.yaml"
+        p.write_text(yaml.safe_dump({**good, **change}))
+        specs.append(str(p))
+    dup = tmp / "sweep_dup.yaml"
+    dup.write_text(yaml.safe_dump(good) + "task: plan_suite\n")
+    specs.append(str(dup))
+    ok = tmp / "sweep_ok.yaml"
+    ok.write_text(yaml.safe_dump(good))
+    (tmp / "sweep_file").write_text("x")
+    out = str(tmp / "sweep_out")
+    cases = [("sweep", ["sweep", f, "--out", out]) for f in files + specs]
+    cases += [("sweep", ["sweep", str(ok), "--out", out, opt, v])
+              for opt, v in (("--workers", "-1"), ("--workers", "x"), ("--limit", "0"),
+                             ("--limit", "-3"), ("--limit", "1.5"))]
+    cases += [("sweep", ["sweep", str(ok), "--out", str(tmp / "sweep_file")]),
+              ("sweep", ["sweep", str(ok)]), ("sweep", ["sweep", str(ok), "--out"])]
+    cases += [("sweep", ["sweep", "plot", d, "--x", "scale", "--value", "n_stable"])
+              for d in (str(tmp), str(tmp / "none"))]
     return cases
 
 
@@ -247,7 +286,7 @@ def test_wrong_input_is_one_line_exit_2(capsys, command, argv):
 def test_every_command_is_fuzzed():
     commands = collections.Counter(c for c, _ in CASES)
     want = {"fk", "ik", "simulate", "plan", "cdpr tensions", "cdpr wrench-set",
-            "cdpr workspace", "cdpr twist-set", "cdpr deploy"}
+            "cdpr workspace", "cdpr twist-set", "cdpr deploy", "sweep"}
     assert want <= set(commands)
     assert min(commands[c] for c in want) >= 20
 

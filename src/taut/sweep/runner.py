@@ -186,8 +186,6 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     reused = len(bounds) - len(todo)
     done = sum(min(bounds[k][1], total) - bounds[k][0] for k in range(len(bounds))
                if k not in set(todo))
-    if progress is not None:
-        progress(done, total)
     params = _params_for(spec, bounds)
     try:
         for k, cols in _execute(spec, bounds, todo, params, workers, scheduler):
