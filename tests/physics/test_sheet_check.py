@@ -6,6 +6,8 @@ Tolerances (scenario units, documented in examples/physics/README.md): heights w
 position is ill-conditioned in flat valleys).
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -17,6 +19,7 @@ mujoco = pytest.importorskip("mujoco")
 
 from taut.physics import check_equilibria, settle  # noqa: E402
 
+EXAMPLES = Path(__file__).parents[2] / "examples" / "sheet"
 HEIGHT_TOL = 5.0          # mm
 LATERAL_FRACTION = 0.02   # of the sheet's width
 
@@ -63,7 +66,7 @@ def test_free_drop_finds_the_triangle_state():
 
 @pytest.mark.slow
 def test_fk_paper_example1():
-    sc = load_sheet_scenario("examples/sheet/example1.yaml")
+    sc = load_sheet_scenario(EXAMPLES / "example1.yaml")
     result = _assert_agrees(sc.sheet, sc.formation, sc.hold_height)
     status = {s.taut: s.status for s in result.states}
     assert status == {(0, 1, 2): "stable", (0, 2, 3): "stable",
@@ -72,7 +75,7 @@ def test_fk_paper_example1():
 
 @pytest.mark.slow
 def test_fk_paper_example2_eight_robots():
-    sc = load_sheet_scenario("examples/sheet/example2_r2_r4_353mm.yaml")
+    sc = load_sheet_scenario(EXAMPLES / "example2_r2_r4_353mm.yaml")
     result = _assert_agrees(sc.sheet, sc.formation, sc.hold_height)
     held = [s.taut for s in result.states if s.held]
     assert held == [(3, 4, 7)]                       # only {4,5,8} (1-based) is held

@@ -15,6 +15,7 @@ from typer.exceptions import TyperException
 from .. import __version__
 from ..errors import TautError
 from . import cdpr, fk, motion, plan
+from . import physics as _physics_cli
 
 app = typer.Typer(
     name="taut",
@@ -43,6 +44,7 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
 
 for _module in (fk, motion, plan, cdpr):
     _module.register(app)
+_physics_cli.register(app)
 
 EXIT_USAGE = 2
 

@@ -45,8 +45,8 @@ def _speeds(sim: SheetSim) -> tuple[float, float]:
     return v_ball, float(np.max(np.abs(others))) if others.size else 0.0
 
 
-def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None
-                 ) -> tuple[bool, float]:
+def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None,
+                 frames: list | None = None) -> tuple[bool, float]:
     """Step until ball and nodes are slower than ``SETTLE_SPEED`` (checked every
     ``CHECK_INTERVAL``) or ``max_time`` passes. Returns (converged, time taken, s)."""
     import mujoco
@@ -59,6 +59,8 @@ def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None
             mujoco.mj_step(m, d)
         if trace is not None:
             trace.append((d.time, *ball_position(sim)))
+        if frames is not None:
+            frames.append(node_positions(sim))
         if not np.all(np.isfinite(d.qpos)):
             return False, d.time - t0
         vb, vn = _speeds(sim)

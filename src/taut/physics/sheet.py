@@ -50,6 +50,8 @@ class SettleResult:
     triangles : ndarray of int, shape (T, 3)
     trace : ndarray, shape (K, 4) or None
         ``(t, x, y, z)`` of the ball's centre at every check, when asked for.
+    frames : ndarray, shape (K, M, 3) or None
+        Node positions at every check, when a trace was asked for (for animations).
     success, status, message
         The result convention of :mod:`taut._outcome`.
     """
@@ -61,6 +63,7 @@ class SettleResult:
     nodes: np.ndarray
     triangles: np.ndarray
     trace: np.ndarray | None
+    frames: np.ndarray | None
     success: bool
     status: str
     message: str
@@ -98,6 +101,9 @@ class StateCheck:
         ``held`` for a stable state, not held for a non-equilibrium (saddles: always).
     time : float
         Wall-clock seconds spent on this state (build and simulation).
+    nodes : ndarray, shape (M, 3)
+        The tied, settled sheet's node positions, scenario units (for figures).
+    triangles : ndarray of int, shape (T, 3)
     """
 
     taut: tuple[int, ...]
@@ -112,6 +118,8 @@ class StateCheck:
     tied_difference: np.ndarray
     agrees: bool
     time: float
+    nodes: np.ndarray
+    triangles: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,21 +201,22 @@ def settle(sheet: Sheet, formation: object, hold_height: float, *,
                           tie=False, corner_tendons=False)
     _run.ramp(sim)
     rows: list | None = [] if trace else None
-    converged, t = _run.settle_phase(sim, max_t, rows)
+    frames: list | None = [] if trace else None
+    converged, t = _run.settle_phase(sim, max_t, rows, frames)
     found = _run.object_on_sheet(sim)
     nodes = _run.node_positions(sim) / sim.scale
+    tr = None if rows is None else np.array(rows) / [1.0, *[sim.scale] * 3]
+    fr = None if frames is None else np.array(frames) / sim.scale
     if found is None:
         nan = np.full(3, np.nan)
-        return SettleResult(nan, nan[:2], t, False, nodes, m.triangles,
-                            None if rows is None else np.array(rows), False,
+        return SettleResult(nan, nan[:2], t, False, nodes, m.triangles, tr, fr, False,
                             check_status("diverged"), "the ball fell off the sheet")
     pos, contact = found
     status = "ok" if converged else "not_converged"
     msg = (f"settled at ({pos[0]:.4g}, {pos[1]:.4g}, {pos[2]:.4g}) after {t:.2f} s"
            if converged else f"still moving after {t:.2f} s simulated")
-    return SettleResult(pos, contact, t, converged, nodes, m.triangles,
-                        None if rows is None else np.array(rows) / [1, *[sim.scale] * 3],
-                        converged, check_status(status), msg)
+    return SettleResult(pos, contact, t, converged, nodes, m.triangles, tr, fr, converged,
+                        check_status(status), msg)
 
 
 def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
@@ -223,6 +232,7 @@ def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: in
     tied_at = _run.object_on_sheet(sim)
     assert tied_at is not None                                         # tied: always on
     tied = tied_at[0]
+    nodes = _run.node_positions(sim) / sim.scale
     sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * 9.81))
     _run.release(sim)
     _run.settle_phase(sim, _tol.MAX_SETTLE_TIME)
@@ -234,7 +244,7 @@ def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: in
     agrees = status == "saddle" or held == (status == "stable")
     return StateCheck(tuple(eq.taut), status, pred, tied, settled, held,
                       sliding, settled - pred, float(np.linalg.norm(settled - tied)),
-                      tied - pred, agrees, time.perf_counter() - t0)
+                      tied - pred, agrees, time.perf_counter() - t0, nodes, m.triangles)
 
 
 def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
