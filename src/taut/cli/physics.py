@@ -92,16 +92,16 @@ def register(app: typer.Typer) -> None:
         except ImportError:
             raise InvalidInputError("physics", "needs MuJoCo: pip install 'taut[physics]'"
                                     ) from None
-        kw = {"mesh": DEFAULT_MESH if mesh is None else mesh}
+        div = DEFAULT_MESH if mesh is None else mesh
         if not as_json and sys.stdout.isatty():
             from rich.progress import Progress
             with Progress(transient=True) as bar:
                 task = bar.add_task("settling each state", total=None)
-                check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, **kw,
+                check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=div,
                                          progress=lambda d, t: bar.update(task, completed=d,
                                                                           total=t))
         else:
-            check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, **kw)
+            check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=div)
         if as_json:
             typer.echo(json.dumps(check_to_dict(check), indent=2))
         else:
@@ -115,7 +115,7 @@ def register(app: typer.Typer) -> None:
                 typer.echo(f"figure written to {plot}")
         if video is not None:
             from ..viz.physics import animate_settle
-            drop = settle(sc.sheet, sc.formation, sc.hold_height, trace=True, **kw)
+            drop = settle(sc.sheet, sc.formation, sc.hold_height, trace=True, mesh=div)
             animate_settle(drop, sc.formation, sc.hold_height, video)
             if not as_json:
                 typer.echo(f"animation written to {video}")
