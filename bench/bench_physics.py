@@ -7,8 +7,8 @@ Usage::
 Measures, in one process on this machine:
 
 * per mesh spacing (``mesh`` = spacings across the sheet's widest vertex pair) on the FK
-  paper's Example 1 (4 robots) and Example 2 (8 robots): nodes, tendons, model build time
-  per state, wall time of ``check_equilibria`` over every state, and the largest height /
+  paper's Example 1 (4 robots) and Example 2 (8 robots): nodes, tendons (with the corner
+  tendons), time to mesh and compile one state's model, wall time of ``check_equilibria`` over every state, and the largest height /
   lateral differences physics vs taut (tied point load and released ball); the spacings
   are interleaved and repeated, medians and ranges quoted;
 * on random teams (``taut.sheet.random.random_team``, 3-8 robots, sheets about 2 units
@@ -31,6 +31,8 @@ import numpy as np
 from taut.io import load_sheet_scenario
 from taut.physics import check_equilibria
 from taut.physics._mesh import sheet_mesh
+from taut.physics._sheet_model import build_sheet_sim
+from taut.sheet import forward_kinematics
 from taut.sheet.random import random_team
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -42,12 +44,26 @@ def _lateral(d: np.ndarray) -> float:
     return float(np.hypot(d[0], d[1]))
 
 
+def _build_time(sc, mesh: int) -> tuple[float, int]:
+    """Seconds to mesh and compile the model of the first state; its tendon count."""
+    eq = forward_kinematics(sc.sheet, sc.formation, sc.hold_height).equilibria[0]
+    D = float(np.max(sc.sheet.side_lengths()))
+    t0 = time.perf_counter()
+    m = sheet_mesh(sc.sheet.vertices, mesh, contact=eq.contact)
+    sim = build_sheet_sim(m, sc.sheet.vertices, sc.formation, sc.hold_height,
+                          ball_radius=0.05 * D / mesh, ball_start=None, tie=True,
+                          corner_tendons=True)
+    return time.perf_counter() - t0, int(sim.model.ntendon)
+
+
 def spacing_table(meshes: list[int], repeats: int) -> list[dict]:
     rows: dict[tuple[str, int], list] = {}
+    builds: dict[tuple[str, int], list] = {}
     for rep in range(repeats):
         for name, path in EXAMPLES.items():
             sc = load_sheet_scenario(path)
             for mesh in meshes:
+                builds.setdefault((name, mesh), []).append(_build_time(sc, mesh))
                 t0 = time.perf_counter()
                 r = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=mesh)
                 wall = time.perf_counter() - t0
@@ -61,7 +77,8 @@ def spacing_table(meshes: list[int], repeats: int) -> list[dict]:
         stable = [s for s in r.states if s.status == "stable"]
         out.append({
             "example": name, "mesh": mesh, "spacing": m.spacing, "nodes": len(m.nodes),
-            "tendons": len(m.pairs) + len(m.nodes) * sc.sheet.n,
+            "tendons": builds[(name, mesh)][0][1],
+            "build_median_s": float(np.median([b for b, _ in builds[(name, mesh)]])),
             "states": len(r.states), "wall_median_s": float(np.median(walls)),
             "wall_min_s": float(walls.min()), "wall_max_s": float(walls.max()),
             "tied_dz_max": max(abs(s.tied_difference[2]) for s in stable),
@@ -106,12 +123,13 @@ def main() -> None:
     ap.add_argument("--json", type=Path)
     a = ap.parse_args()
     table = spacing_table([int(m) for m in a.meshes.split(",")], a.repeats)
-    print("| example | mesh | spacing | nodes | tendons | states | check wall s (median [min, max]) "
-          "| tied max dz / lateral | released max dz / lateral | agrees |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| example | mesh | spacing | nodes | tendons | build s | states "
+          "| check wall s (median [min, max]) | tied max dz / lateral "
+          "| released max dz / lateral | agrees |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in table:
         print(f"| {r['example']} | {r['mesh']} | {r['spacing']:.0f} | {r['nodes']} | "
-              f"{r['tendons']} | {r['states']} | {r['wall_median_s']:.2f} "
+              f"{r['tendons']} | {r['build_median_s']:.2f} | {r['states']} | {r['wall_median_s']:.2f} "
               f"[{r['wall_min_s']:.2f}, {r['wall_max_s']:.2f}] | {r['tied_dz_max']:.1f} / "
               f"{r['tied_lateral_max']:.1f} | {r['released_dz_max']:.1f} / "
               f"{r['released_lateral_max']:.1f} | {r['agree']} |")

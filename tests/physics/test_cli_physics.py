@@ -41,6 +41,7 @@ def test_missing_formation(capsys, tmp_path):
     assert code == 2 and err.startswith("taut: error: formation:")
 
 
+@pytest.mark.slow
 def test_triangle_json_and_figure(capsys, triangle, tmp_path):
     pytest.importorskip("mujoco")
     png = tmp_path / "tri.png"

@@ -49,6 +49,7 @@ def test_triangle_team():
     assert len(result.states) == 1
 
 
+@pytest.mark.slow
 def test_free_drop_finds_the_triangle_state():
     # A triangle has one rest state; a ball dropped over the robots' centroid finds it:
     # the height closely, the place within 5 % of the width (a dropped ball keeps the

@@ -134,8 +134,9 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     pairs, rest = mesh.pairs, mesh.rest * scale
     if corner_tendons:
         M = len(mesh.nodes)
+        have = set(map(tuple, np.sort(pairs, axis=1).tolist()))
         extra = np.array([(c, k) for c in corners for k in range(M)
-                          if k != c and not np.any(np.all(pairs == sorted((c, k)), axis=1))],
+                          if k != c and (min(c, k), max(c, k)) not in have],
                          dtype=np.intp).reshape(-1, 2)
         if len(extra):
             pairs = np.vstack([pairs, extra])

@@ -48,10 +48,17 @@ START_SHRINK = 0.98
 RAMP_TIME = 0.3
 #: Settled when the ball and every node move slower than this, m/s (sim scale).
 SETTLE_SPEED = 2e-3
+#: Stricter rest criterion for the tied phase, m/s: the sheet's pull on the contact node
+#: (which decides "held") is read there, and residual motion at 2e-3 m/s left pulls of up
+#: to 0.2 mg at well-conditioned stable states (0.002 mg at 2e-4).
+TIED_SETTLE_SPEED = 2e-4
 #: Settling is checked every this many seconds of simulated time.
 CHECK_INTERVAL = 0.1
 #: Longest simulated settling time of one phase, s.
 MAX_SETTLE_TIME = 6.0
+#: Longest simulated time after release, s: only the released ball's rest position comes
+#: from it (a ball rolling off a non-equilibrium can run for long).
+RELEASE_TIME = 3.0
 #: The object counts as held when the sheet's net sideways pull on it at the contact point
 #: is at most this fraction of its weight. Measured (mesh 10): 0.01-0.05 at the stable
 #: states of the FK paper's Example 1 (<= 0.02 with corner tendons), 0.33 at its

@@ -228,14 +228,14 @@ def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: in
     sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=None,
                           tie=True, corner_tendons=corner_tendons)
     _run.ramp(sim)
-    _run.settle_phase(sim, _tol.MAX_SETTLE_TIME)
+    _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
     tied_at = _run.object_on_sheet(sim)
     assert tied_at is not None                                         # tied: always on
     tied = tied_at[0]
     nodes = _run.node_positions(sim) / sim.scale
     sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * 9.81))
     _run.release(sim)
-    _run.settle_phase(sim, _tol.MAX_SETTLE_TIME)
+    _run.settle_phase(sim, _tol.RELEASE_TIME)
     found = _run.object_on_sheet(sim)
     settled = found[0] if found is not None else _run.ball_position(sim) / sim.scale
     held = sliding <= tol
