@@ -197,6 +197,7 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     jid = model.body_jntadr[bb]
     sim = SheetSim(model, data, mesh, scale, node_qpos, node_body, mocap,
                    pos[corners].copy(), goal, bb, int(model.jnt_qposadr[jid]),
-                   int(model.jnt_dofadr[jid]), offset, model.geom("ball").id, 0 if tie else -1, pairs)
+                   int(model.jnt_dofadr[jid]), offset, model.geom("ball").id,
+                   0 if tie else -1, pairs)
     mujoco.mj_forward(model, data)
     return sim

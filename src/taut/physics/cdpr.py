@@ -48,7 +48,7 @@ class TippingCheck:
     physics_stays : bool
         Every base stays (or is fixed) in the simulation.
     success, status, message
-        ``success`` when both verdicts agree (status ``"ok"``, else ``"refuted"``).
+        ``success`` when both verdicts agree (status ``"ok"``, else ``"unverified"``).
     """
 
     verdicts: tuple[str, ...]
@@ -246,7 +246,7 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
     msg = (f"physics: {said}; taut margin {margin:.4g} N m "
            f"({'no base tips' if taut_stays else 'a base tips'})")
     return TippingCheck(verdicts, tilt, slip, moments, margin, taut_stays, phys, ok,
-                        check_status("ok" if ok else "refuted"), msg)
+                        check_status("ok" if ok else "unverified"), msg)
 
 
 def check_tipping_grid(robot: CableRobot, poses: Any, *, method: str = "lp_min_sum",

@@ -128,8 +128,9 @@ class EquilibriaCheck:
 
     ``success`` is true when every state's physics verdict agrees with taut's (stable
     states held, states that are not equilibria not held; saddles either way);
-    ``status`` is ``"ok"`` or ``"refuted"``. ``hold_tolerance`` is the sliding pull, as a
-    fraction of the object's weight, up to which the object counts as held.
+    ``status`` is ``"ok"`` or ``"unverified"`` (taut's answer failed the physics check).
+    ``hold_tolerance`` is the sliding pull, as a fraction of the object's weight, up to
+    which the object counts as held.
     """
 
     states: tuple[StateCheck, ...]
@@ -298,4 +299,4 @@ def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
         msg = (f"{len(bad)} of {len(states)} state(s) disagree; first: {taut} ({s.status}) "
                f"was {'held' if s.held else 'left'} in physics")
     return EquilibriaCheck(tuple(states), tol, div, radius, ok,
-                           check_status("ok" if ok else "refuted"), msg)
+                           check_status("ok" if ok else "unverified"), msg)

@@ -70,16 +70,16 @@ def animate_settle(result: SettleResult, formation: np.ndarray, hold_height: flo
 
     if result.frames is None or result.trace is None:
         raise ValueError("settle(..., trace=True) records the frames an animation needs")
+    frames, trace = result.frames, result.trace
     fig = plt.figure(figsize=(5, 4.5))
     ax = fig.add_subplot(projection="3d")
 
     def draw(k: int) -> None:
         ax.clear()
-        _draw_sheet(ax, result.frames[k], result.triangles, np.asarray(formation),  # type: ignore[index]
-                    hold_height)
-        ax.scatter(*result.trace[k, 1:], s=40, color="tab:red", depthshade=False)  # type: ignore[index]
-        ax.set_title(f"t = {result.trace[k, 0]:.1f} s", fontsize=9)  # type: ignore[index]
+        _draw_sheet(ax, frames[k], result.triangles, np.asarray(formation), hold_height)
+        ax.scatter(*trace[k, 1:], s=40, color="tab:red", depthshade=False)
+        ax.set_title(f"t = {trace[k, 0]:.1f} s", fontsize=9)
 
-    anim = FuncAnimation(fig, draw, frames=len(result.frames), interval=1000 / fps)
+    anim = FuncAnimation(fig, draw, frames=len(frames), interval=1000 / fps)
     anim.save(str(path), writer=PillowWriter(fps=fps))
     plt.close(fig)
