@@ -91,3 +91,18 @@ def test_bad_options_are_typed_errors():
         settle(sheet, R, 700.0, ball=-1.0)
     with pytest.raises(InvalidInputError, match="start"):
         settle(sheet, R, 700.0, start=[0.0, 0.0])
+
+
+@pytest.mark.slow
+def test_units_and_placement_do_not_change_the_answer():
+    # The same team in metres, moved by (3, -2) m: the same verdicts, and differences that
+    # are the millimetre ones scaled by 1/1000 (the simulation is scaled to the sheet).
+    sc = load_sheet_scenario(EXAMPLES / "example1.yaml")
+    mm = check_equilibria(sc.sheet, sc.formation, sc.hold_height)
+    shift = np.array([3.0, -2.0])
+    m = check_equilibria(Sheet(sc.sheet.vertices / 1000 + shift), sc.formation / 1000 + shift,
+                         sc.hold_height / 1000)
+    assert [s.held for s in m.states] == [s.held for s in mm.states]
+    for a, b in zip(mm.states, m.states):
+        np.testing.assert_allclose(b.tied_difference * 1000, a.tied_difference, atol=0.5)
+        assert abs(b.sliding - a.sliding) <= 0.01
