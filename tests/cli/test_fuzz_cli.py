@@ -212,6 +212,11 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("cdpr deploy", ["cdpr", "deploy", "fastkit", "--workspace", *ws, "--plot", o])
               for o in outs]
     cases += _sweep_cases(tmp, files, outs)
+    # physics (MuJoCo): every check comes before the model is built
+    cases += [("physics", ["physics", f]) for f in files + sheets]
+    cases += [("physics", ["physics", sheet, "--plot", o]) for o in outs]
+    cases += [("physics", ["physics", sheet, "--video", o]) for o in outs + [str(tmp / "a.png")]]
+    cases += [("physics", ["physics", sheet, "--mesh", v]) for v in BAD_COUNTS + ["2", "61"]]
     cases += [("taut", [w]) for w in ("nosuch", "--nosuch", "cdpr nosuch")]
     return cases
 
@@ -286,7 +291,7 @@ def test_wrong_input_is_one_line_exit_2(capsys, command, argv):
 def test_every_command_is_fuzzed():
     commands = collections.Counter(c for c, _ in CASES)
     want = {"fk", "ik", "simulate", "plan", "cdpr tensions", "cdpr wrench-set",
-            "cdpr workspace", "cdpr twist-set", "cdpr deploy", "sweep"}
+            "cdpr workspace", "cdpr twist-set", "cdpr deploy", "sweep", "physics"}
     assert want <= set(commands)
     assert min(commands[c] for c in want) >= 20
 

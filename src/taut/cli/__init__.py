@@ -26,7 +26,7 @@ from typer.exceptions import TyperException
 
 from .. import __version__
 from ..errors import TautError
-from . import cdpr, fk, motion, plan, sweep
+from . import cdpr, fk, motion, physics, plan, sweep
 
 app = typer.Typer(
     name="taut",
@@ -59,7 +59,7 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
     one line ``taut: error: <field>: <problem>`` on stderr."""
 
 
-for _module in (fk, motion, plan, cdpr, sweep):
+for _module in (fk, motion, plan, cdpr, physics, sweep):
     _module.register(app)
 
 EXIT_NO = 1

@@ -17,10 +17,9 @@ import typer
 from typer.core import TyperGroup
 
 from ..errors import InvalidInputError, SweepError
+from ._paths import FIGURE_SUFFIXES, output_path
 
 __all__ = ["register"]
-
-_PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 class _DefaultRun(TyperGroup):
@@ -123,12 +122,10 @@ def plot_command(
 ) -> int:
     from ..io.sweep_results import read_results
 
-    target = out if out is not None else folder / f"{value}.png"
-    if target.suffix.lower() not in _PLOT_SUFFIXES:
-        raise InvalidInputError("--out", f"must end in {', '.join(_PLOT_SUFFIXES)}")
-    if not target.parent.is_dir():
-        raise InvalidInputError("--out", f"folder {target.parent} does not exist")
     columns, meta = read_results(folder)
+    target = output_path(out if out is not None else folder / f"{value}.png", "--out",
+                         FIGURE_SUFFIXES)
+    assert target is not None
     for flag, name in (("--x", x), ("--y", y), ("--value", value)):
         if name is not None and name not in columns:
             raise SweepError(flag, f"no column {name!r} in the results; columns: "

@@ -30,7 +30,7 @@ if TYPE_CHECKING:                                  # imported lazily: keep `taut
 __all__ = ["to_json", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dict",
            "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",
            "wrench_set_to_dict", "workspace_to_dict", "twist_set_to_dict",
-           "deployment_to_dict"]
+           "deployment_to_dict", "equilibria_check_to_dict"]
 
 _MISSING = object()
 
@@ -258,3 +258,21 @@ def deployment_to_dict(robot: CableRobot, res: DeploymentResult) -> dict[str, An
             "height": r4(lb.height), "bound": r4(lb.bound), "required": r4(lb.required),
             "weight": r4(lb.weight), "refutes": lb.refutes,
             "per_cable": {c.name: r4(v) for c, v in zip(robot.cables, lb.per_cable)}}}
+
+
+def equilibria_check_to_dict(check: Any) -> dict[str, Any]:
+    """JSON-ready form of an :class:`~taut.physics.EquilibriaCheck` (0-based taut sets,
+    scenario units)."""
+    def f(a: np.ndarray) -> list[float]:
+        return [float(x) for x in np.asarray(a).ravel()]
+
+    return {
+        "success": bool(check.success), "status": check.status, "message": check.message,
+        "mesh": check.mesh, "ball_radius": check.ball, "hold_tolerance": check.hold_tolerance,
+        "states": [{"taut": list(s.taut), "status": s.status, "held": s.held,
+                    "agrees": s.agrees, "predicted": f(s.predicted), "tied": f(s.tied),
+                    "settled": f(s.settled), "difference": f(s.difference),
+                    "tied_difference": f(s.tied_difference), "sliding": float(s.sliding),
+                    "moved": float(s.moved), "time_s": float(s.time)}
+                   for s in check.states],
+    }

@@ -1,0 +1,170 @@
+"""taut.physics benchmark and accuracy study: MuJoCo vs taut's sheet forward kinematics.
+
+Usage::
+
+    python bench/bench_physics.py [--teams 20] [--seed 0] [--json OUT]
+
+Measures, in one process on this machine:
+
+* per mesh spacing (``mesh`` = spacings across the sheet's widest vertex pair) on the FK
+  paper's Example 1 (4 robots) and Example 2 (8 robots): nodes, tendons (with the corner
+  tendons), time to mesh and compile one state's model, wall time of ``check_equilibria`` over every state, and the largest height /
+  lateral differences physics vs taut (tied point load and released ball); the spacings
+  are interleaved and repeated, medians and ranges quoted;
+* on random teams (``taut.sheet.random.random_team``, 3-8 robots, sheets about 2 units
+  across, hold height 1.6): the distribution of the differences, the sheet's sideways pull
+  at stable and at non-equilibrium states, how often physics holds a state taut does not
+  call stable and vice versa, and the wall time per team.
+
+Numbers depend on the machine's load (it is shared); quote them with that caveat.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from taut.io import load_sheet_scenario
+from taut.physics import check_equilibria
+from taut.physics._mesh import sheet_mesh
+from taut.physics._sheet_model import build_sheet_sim
+from taut.sheet import forward_kinematics
+from taut.sheet.random import random_team
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = {"Example 1": ROOT / "examples/sheet/example1.yaml",
+            "Example 2": ROOT / "examples/sheet/example2_r2_r4_353mm.yaml"}
+
+
+def _lateral(d: np.ndarray) -> float:
+    return float(np.hypot(d[0], d[1]))
+
+
+def _build_time(sc, mesh: int) -> tuple[float, int]:
+    """Seconds to mesh and compile the model of the first state; its tendon count."""
+    eq = forward_kinematics(sc.sheet, sc.formation, sc.hold_height).equilibria[0]
+    D = float(np.max(sc.sheet.side_lengths()))
+    t0 = time.perf_counter()
+    m = sheet_mesh(sc.sheet.vertices, mesh, contact=eq.contact)
+    sim = build_sheet_sim(m, sc.sheet.vertices, sc.formation, sc.hold_height,
+                          ball_radius=0.05 * D / mesh, ball_start=None, tie=True,
+                          corner_tendons=True)
+    return time.perf_counter() - t0, int(sim.model.ntendon)
+
+
+def spacing_table(meshes: list[int], repeats: int) -> list[dict]:
+    rows: dict[tuple[str, int], list] = {}
+    builds: dict[tuple[str, int], list] = {}
+    for rep in range(repeats):
+        for name, path in EXAMPLES.items():
+            sc = load_sheet_scenario(path)
+            for mesh in meshes:
+                builds.setdefault((name, mesh), []).append(_build_time(sc, mesh))
+                t0 = time.perf_counter()
+                r = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=mesh)
+                wall = time.perf_counter() - t0
+                rows.setdefault((name, mesh), []).append((wall, r))
+    out = []
+    for (name, mesh), runs in rows.items():
+        sc = load_sheet_scenario(EXAMPLES[name])
+        m = sheet_mesh(sc.sheet.vertices, mesh)
+        walls = np.array([w for w, _ in runs])
+        r = runs[-1][1]
+        stable = [s for s in r.states if s.status == "stable"]
+        out.append({
+            "example": name, "mesh": mesh, "spacing": m.spacing, "nodes": len(m.nodes),
+            "tendons": builds[(name, mesh)][0][1],
+            "build_median_s": float(np.median([b for b, _ in builds[(name, mesh)]])),
+            "states": len(r.states), "wall_median_s": float(np.median(walls)),
+            "wall_min_s": float(walls.min()), "wall_max_s": float(walls.max()),
+            "tied_dz_max": max(abs(s.tied_difference[2]) for s in stable),
+            "tied_lateral_max": max(_lateral(s.tied_difference) for s in stable),
+            "released_dz_max": max(abs(s.difference[2]) for s in stable),
+            "released_lateral_max": max(_lateral(s.difference) for s in stable),
+            "agree": bool(r.success),
+        })
+    return out
+
+
+def random_study(teams: int, seed: int) -> dict:
+    rng = np.random.default_rng(seed)
+    states, walls = [], []
+    for k in range(teams):
+        n = int(rng.integers(3, 9))
+        sheet, R = random_team(n, rng)
+        width = float(np.max(sheet.side_lengths()))
+        t0 = time.perf_counter()
+        r = check_equilibria(sheet, R, 1.6)
+        walls.append((n, time.perf_counter() - t0, len(r.states)))
+        for s in r.states:
+            states.append({"team": k, "n": n, "status": s.status, "held": s.held,
+                           "sliding": s.sliding,
+                           "tied": (s.tied_difference / width).tolist(),
+                           "released": (s.difference / width).tolist()})
+    return {"states": states, "walls": walls}
+
+
+def _pct(x: list[float]) -> str:
+    a = np.asarray(x) * 1000
+    return (f"median {np.median(a):.2f}, 90% {np.percentile(a, 90):.2f}, "
+            f"max {a.max():.2f}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--teams", type=int, default=20)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--meshes", default="7,10,13")
+    ap.add_argument("--repeats", type=int, default=2)
+    ap.add_argument("--json", type=Path)
+    a = ap.parse_args()
+    table = spacing_table([int(m) for m in a.meshes.split(",")], a.repeats)
+    print("| example | mesh | spacing | nodes | tendons | build s | states "
+          "| check wall s (median [min, max]) | tied max dz / lateral "
+          "| released max dz / lateral | agrees |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in table:
+        print(f"| {r['example']} | {r['mesh']} | {r['spacing']:.0f} | {r['nodes']} | "
+              f"{r['tendons']} | {r['build_median_s']:.2f} | {r['states']} | {r['wall_median_s']:.2f} "
+              f"[{r['wall_min_s']:.2f}, {r['wall_max_s']:.2f}] | {r['tied_dz_max']:.1f} / "
+              f"{r['tied_lateral_max']:.1f} | {r['released_dz_max']:.1f} / "
+              f"{r['released_lateral_max']:.1f} | {r['agree']} |")
+    study = random_study(a.teams, a.seed)
+    st = study["states"]
+    stable = [s for s in st if s["status"] == "stable"]
+    noneq = [s for s in st if s["status"] == "not_equilibrium"]
+    print(f"\nrandom teams: {a.teams}, states: {len(st)} ({len(stable)} stable, "
+          f"{len(noneq)} not an equilibrium, "
+          f"{sum(s['status'] == 'saddle' for s in st)} saddle)")
+    print("differences at stable states, per mille of the sheet's width (x1000):")
+    print("  tied |dz|       :", _pct([abs(s["tied"][2]) for s in stable]))
+    print("  tied lateral    :", _pct([np.hypot(*s["tied"][:2]) for s in stable]))
+    print("  released |dz|   :", _pct([abs(s["released"][2]) for s in stable]))
+    print("  released lateral:", _pct([np.hypot(*s["released"][:2]) for s in stable]))
+    sl_st = np.array([s["sliding"] for s in stable])
+    sl_ne = np.array([s["sliding"] for s in noneq])
+    print(f"sideways pull / weight: stable max {sl_st.max():.3f} (median {np.median(sl_st):.3f});"
+          f" not-equilibrium min {sl_ne.min():.3f} (median {np.median(sl_ne):.3f})"
+          if len(sl_ne) else "")
+    print(f"physics holds a state taut does not call stable: "
+          f"{sum(s['held'] and s['status'] != 'stable' for s in st)} of "
+          f"{sum(s['status'] != 'stable' for s in st)}")
+    print(f"taut stable but physics does not hold: {sum(not s['held'] for s in stable)} "
+          f"of {len(stable)}")
+    w = np.array([(n, t, k) for n, t, k in study["walls"]])
+    for lo, hi in ((3, 5), (6, 8)):
+        sel = (w[:, 0] >= lo) & (w[:, 0] <= hi)
+        if sel.any():
+            print(f"wall per team, {lo}-{hi} robots: median {np.median(w[sel, 1]):.2f} s, "
+                  f"max {w[sel, 1].max():.2f} s ({int(sel.sum())} teams, "
+                  f"{w[sel, 2].mean():.1f} states on average)")
+    if a.json:
+        a.json.write_text(json.dumps({"spacing": table, "random": study}, indent=1))
+
+
+if __name__ == "__main__":
+    main()

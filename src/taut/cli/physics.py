@@ -1,0 +1,95 @@
+"""`taut physics`: check every rest state taut reports for a scenario in MuJoCo."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any, Optional
+
+import typer
+
+from ..errors import InvalidInputError, ScenarioError
+from ._paths import ANIMATION_SUFFIXES, output_path
+
+
+def format_check(check: Any, *, name: str | None, units: str | None) -> str:
+    """Plain-text table, robots numbered 1..N as in the papers."""
+    u = f" [{units}]" if units else ""
+    head = ("taut", "taut says", "physics", "pull/mg", f"tied dx, dy, dz{u}",
+            f"released dx, dy, dz{u}", "agrees", "s")
+    rows = [head]
+    for s in check.states:
+        rows.append(("{" + ",".join(str(i + 1) for i in s.taut) + "}",
+                     s.status.replace("_", " "), "held" if s.held else "not held",
+                     f"{s.sliding:.3f}", ", ".join(f"{v:+.1f}" for v in s.tied_difference),
+                     ", ".join(f"{v:+.1f}" for v in s.difference),
+                     "yes" if s.agrees else "NO", f"{s.time:.1f}"))
+    widths = [max(len(r[c]) for r in rows) for c in range(len(head))]
+    lines = [name] if name else []
+    lines.append(f"MuJoCo check, mesh {check.mesh}, ball radius {check.ball:.3g}{u}: "
+                 f"{check.message}")
+    lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    return "\n".join(lines)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``taut physics``."""
+
+    @app.command("physics")
+    def physics_command(
+        scenario: Path = typer.Argument(..., help="Sheet scenario file (YAML or JSON) with "
+                                        "hold_height, sheet and formation."),
+        as_json: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Write a figure of the "
+                                            "settled sheet of every state (.png)."),
+        video: Optional[Path] = typer.Option(None, "--video", help="Write an animation of "
+                                             "a ball dropped over the robots (.gif)."),
+        mesh: Optional[int] = typer.Option(None, "--mesh", help="Mesh spacings across the "
+                                           "sheet's widest vertex pair (default 10)."),
+    ) -> None:
+        """Check taut's rest states in MuJoCo: tie the object at each state's contact
+        point, settle, release; exit 1 when physics disagrees with taut."""
+        from ..io.serialize import equilibria_check_to_dict, to_json
+        from ..io.sheet_scenario import load_sheet_scenario
+
+        output_path(plot, "--plot", (".png",))
+        output_path(video, "--video", ANIMATION_SUFFIXES)
+        sc = load_sheet_scenario(scenario)
+        if sc.formation is None:
+            raise ScenarioError("formation", "required key is missing (taut physics needs "
+                                "the robots' positions)")
+        try:
+            from ..physics import DEFAULT_MESH, check_equilibria, settle
+            import mujoco  # noqa: F401
+        except ImportError:
+            raise InvalidInputError("physics", "needs MuJoCo: pip install 'taut[physics]'"
+                                    ) from None
+        div = DEFAULT_MESH if mesh is None else mesh
+        if not as_json and sys.stdout.isatty():
+            from rich.progress import Progress
+            with Progress(transient=True) as bar:
+                task = bar.add_task("settling each state", total=None)
+                check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=div,
+                                         progress=lambda d, t: bar.update(task, completed=d,
+                                                                          total=t))
+        else:
+            check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=div)
+        if as_json:
+            typer.echo(to_json(equilibria_check_to_dict(check)))
+        else:
+            typer.echo(format_check(check, name=sc.name, units=sc.units))
+        if plot is not None:
+            import matplotlib.pyplot as plt
+            from ..viz.physics import plot_equilibria_check
+            plt.close(plot_equilibria_check(check, sc.formation, sc.hold_height, plot,
+                                            units=sc.units, title=sc.name))
+            if not as_json:
+                typer.echo(f"figure written to {plot}")
+        if video is not None:
+            from ..viz.physics import animate_settle
+            drop = settle(sc.sheet, sc.formation, sc.hold_height, trace=True, mesh=div)
+            animate_settle(drop, sc.formation, sc.hold_height, video)
+            if not as_json:
+                typer.echo(f"animation written to {video}")
+        if not check.success:
+            raise typer.Exit(1)

@@ -1,0 +1,84 @@
+"""Tolerances and numerical settings of taut.physics, each with its unit and reason.
+
+Lengths marked "spacings" are multiples of the mesh spacing; the simulation itself runs in
+metres with the sheet scaled to :data:`SIM_DIAMETER` (statics of an inextensible, massless
+sheet are scale-free, so answers are scaled back to the scenario's unit).
+"""
+
+#: Interior lattice nodes keep this far from every side (spacings): closer ones would
+#: make sliver triangles against the boundary nodes.
+INTERIOR_MARGIN = 0.45
+#: A third node this close to a pair's segment (spacings) makes the pair redundant.
+ON_SEGMENT = 0.05
+#: Nodes closer than this to the contact node are dropped (spacings).
+CONTACT_CLEARANCE = 0.5
+#: A contact point this close to a corner (spacings) is that corner.
+SNAP = 0.05
+#: Triangles with a smaller area (spacings squared) are dropped (collinear boundary nodes).
+SLIVER = 1e-6
+
+#: The sheet's largest vertex distance in the simulation, m (the scenario is scaled to it).
+SIM_DIAMETER = 1.0
+#: Time step, s (the recipe: about 4 ms with implicitfast and Newton).
+TIMESTEP = 0.004
+#: Node mass per squared time step, kg/s^2: node mass 3 g at 4 ms. Kept constant when the
+#: step changes so the constraint impedance (set by mass / dt^2) stays the same.
+NODE_MASS_PER_DT2 = 0.003 / 0.004 ** 2
+#: Damping time constant of the nodes' slide joints, s (light: much slower than a step).
+NODE_DAMPING_TIME = 0.02
+#: Object (ball) mass in the simulation, kg. FK of the massless inextensible sheet does not
+#: depend on the mass, so it is fixed rather than taken from the scenario.
+BALL_MASS = 1.0
+#: Damping time constant of the ball's free joint, s.
+BALL_DAMPING_TIME = 0.15
+#: Soft-constraint reference (time constant s, damping ratio) of tendon limits and contacts:
+#: stiff (two time steps) and critically damped.
+SOLREF = (2 * TIMESTEP, 1.0)
+#: Soft-constraint impedance (dmin, dmax, width m, midpoint, power): nearly hard.
+SOLIMP = (0.99, 0.9999, 0.001, 0.5, 2.0)
+#: Flex collision radius as a fraction of the spacing (0.02 let a small released ball
+#: tunnel through the sheet when it rolled away fast).
+FLEX_RADIUS = 0.05
+#: Default ball radius, spacings: small, so the ball rests where a point would (a ball of
+#: radius r in a cone of taut cables sits about r (1/sin(half-angle) - 1) too high).
+BALL_RADIUS = 0.05
+#: Shrink factor of the flat starting copy (its tendons start slack).
+START_SHRINK = 0.98
+#: Corners are ramped from the flat copy to the robots over this time, s (gravity off).
+RAMP_TIME = 0.3
+#: Settled when the ball and every node move slower than this, m/s (sim scale).
+SETTLE_SPEED = 2e-3
+#: Stricter rest criterion for the tied phase, m/s: the sheet's pull on the contact node
+#: (which decides "held") is read there, and residual motion at 2e-3 m/s left pulls of up
+#: to 0.2 mg at well-conditioned stable states (0.002 mg at 2e-4).
+TIED_SETTLE_SPEED = 2e-4
+#: Settling is checked every this many seconds of simulated time.
+CHECK_INTERVAL = 0.1
+#: Longest simulated settling time of one phase, s.
+MAX_SETTLE_TIME = 6.0
+#: Longest simulated time after release, s: only the released ball's rest position comes
+#: from it (a ball rolling off a non-equilibrium can run for long).
+RELEASE_TIME = 3.0
+#: The object counts as held when the sheet's net sideways pull on it at the contact point
+#: is at most this fraction of its weight. Measured (mesh 10): 0.01-0.05 at the stable
+#: states of the FK paper's Example 1 (<= 0.02 with corner tendons), 0.33 at its
+#: not-an-equilibrium state; see the 20-team table in examples/physics/README.md.
+HOLD_FRACTION = 0.05
+
+# --- mobile cable robot (taut.physics.check_tipping) ---
+#: Time step of the cable-robot simulation, s.
+CDPR_TIMESTEP = 0.002
+#: Simulated time after which the bases are judged, s (a base tips within a fraction of
+#: a second when its tipping moment is clearly positive).
+CDPR_DURATION = 1.0
+#: Coulomb friction coefficient of wheels and feet on the floor (rubber on concrete ~0.6).
+FLOOR_FRICTION = 0.6
+#: Radius of the contact spheres at the support-polygon vertices, m.
+FOOT_RADIUS = 0.02
+#: A base whose vertical axis tilts by more than this has tipped, degrees.
+TIP_ANGLE = 1.0
+#: A base whose origin moves horizontally by more than this (without tipping) slid, m.
+SLIDE_DISTANCE = 0.005
+#: Damping time constant of the platform's free joint, s: slows the drift of a platform
+#: under constant tensions (unstable for most poses) while the bases are watched.
+PLATFORM_DAMPING_TIME = 0.05

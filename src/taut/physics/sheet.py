@@ -1,0 +1,302 @@
+"""Sheet-carrying teams in MuJoCo: drop the object, and check taut's rest states.
+
+See :mod:`taut.physics._sheet_model` for the recipe and examples/physics/README.md for the
+measured accuracy. Lengths in the scenario's unit (any consistent unit); the object's mass
+does not enter (forward kinematics of the massless inextensible sheet does not depend on
+it), the simulation uses a fixed 1 kg ball.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .._outcome import check_status
+from .._validate import as_array, as_positive
+from ..errors import InvalidInputError
+from ..sheet import Equilibrium, Sheet, check_formation, forward_kinematics
+from ..sheet.model import check_hold_height
+from . import _run, _tol
+from ._mesh import sheet_mesh
+from ._sheet_model import build_sheet_sim
+
+__all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "check_equilibria",
+           "DEFAULT_MESH"]
+
+#: Default mesh: spacings across the sheet's widest vertex pair (about 156 mm on the FK
+#: paper's Example 1 sheet, 1.56 m across; see the speed/accuracy table in the README).
+DEFAULT_MESH = 10
+
+
+@dataclass(frozen=True, eq=False)
+class SettleResult:
+    """Where a dropped object came to rest on the simulated sheet.
+
+    Attributes
+    ----------
+    position : ndarray, shape (3,)
+        The object's rest position: the sheet point under the ball's centre (so the ball
+        radius is accounted for), scenario units.
+    contact : ndarray, shape (2,)
+        That point in the flat sheet frame (taut's contact point :math:`\\mathbf{v}_o`).
+    time : float
+        Simulated settling time, s.
+    converged : bool
+        Ball and sheet came to rest before the time limit.
+    nodes : ndarray, shape (M, 3)
+        Settled node positions, scenario units (for figures).
+    triangles : ndarray of int, shape (T, 3)
+    trace : ndarray, shape (K, 4) or None
+        ``(t, x, y, z)`` of the ball's centre at every check, when asked for.
+    frames : ndarray, shape (K, M, 3) or None
+        Node positions at every check, when a trace was asked for (for animations).
+    success, status, message
+        The result convention of :mod:`taut._outcome`.
+    """
+
+    position: np.ndarray
+    contact: np.ndarray
+    time: float
+    converged: bool
+    nodes: np.ndarray
+    triangles: np.ndarray
+    trace: np.ndarray | None
+    frames: np.ndarray | None
+    success: bool
+    status: str
+    message: str
+
+
+@dataclass(frozen=True, eq=False)
+class StateCheck:
+    """One of taut's rest states checked in MuJoCo.
+
+    Attributes
+    ----------
+    taut : tuple of int
+        The state's taut cables (0-based), as taut reported them.
+    status : str
+        taut's verdict: ``"stable"``, ``"saddle"`` or ``"not_equilibrium"``.
+    predicted : ndarray, shape (3,)
+        taut's object position.
+    tied : ndarray, shape (3,)
+        Where the object settled tied to the sheet at taut's contact point.
+    settled : ndarray, shape (3,)
+        Where it came to rest after being released there.
+    held : bool
+        The simulated sheet holds the object at taut's contact point: its tendons' net pull
+        on the tied contact node, resolved in the flat sheet, is at most ``hold_tolerance``
+        times the object's weight (a frictionless object is pulled sideways otherwise).
+    sliding : float
+        That net pull divided by the object's weight (0 at an exact equilibrium).
+    difference : ndarray, shape (3,)
+        ``settled - predicted`` (ball radius accounted for), scenario units.
+    moved : float
+        Distance between where the object was tied and where the released ball rests.
+    tied_difference : ndarray, shape (3,)
+        ``tied - predicted``.
+    agrees : bool
+        ``held`` for a stable state, not held for a non-equilibrium (saddles: always).
+    time : float
+        Wall-clock seconds spent on this state (build and simulation).
+    nodes : ndarray, shape (M, 3)
+        The tied, settled sheet's node positions, scenario units (for figures).
+    triangles : ndarray of int, shape (T, 3)
+    """
+
+    taut: tuple[int, ...]
+    status: str
+    predicted: np.ndarray
+    tied: np.ndarray
+    settled: np.ndarray
+    held: bool
+    sliding: float
+    difference: np.ndarray
+    moved: float
+    tied_difference: np.ndarray
+    agrees: bool
+    time: float
+    nodes: np.ndarray
+    triangles: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class EquilibriaCheck:
+    """Every rest state taut reports for one formation, checked in MuJoCo.
+
+    ``success`` is true when every state's physics verdict agrees with taut's (stable
+    states held, states that are not equilibria not held; saddles either way);
+    ``status`` is ``"ok"`` or ``"unverified"`` (taut's answer failed the physics check).
+    ``hold_tolerance`` is the sliding pull, as a fraction of the object's weight, up to
+    which the object counts as held.
+    """
+
+    states: tuple[StateCheck, ...]
+    hold_tolerance: float
+    mesh: int
+    ball: float
+    success: bool
+    status: str
+    message: str
+
+
+def _check_inputs(sheet: Sheet, formation: object, hold_height: float, mesh: int,
+                  ball: float | None) -> tuple[np.ndarray, float, int, float]:
+    if not isinstance(sheet, Sheet):
+        raise InvalidInputError("sheet", "must be a taut.sheet.Sheet")
+    R = check_formation(sheet, as_array(formation, "formation", ndim=2))
+    z = check_hold_height(hold_height)
+    if not isinstance(mesh, (int, np.integer)) or not 4 <= mesh <= 60:
+        raise InvalidInputError("mesh", f"must be an integer from 4 to 60 (spacings across "
+                                        f"the sheet), got {mesh!r}")
+    D = float(np.max(sheet.side_lengths()))
+    r = (_tol.BALL_RADIUS * D / mesh) if ball is None else as_positive(ball, "ball")
+    if r > 0.2 * D:
+        raise InvalidInputError("ball", f"radius {r:g} is too large for a sheet {D:g} across")
+    return R, z, int(mesh), r
+
+
+def settle(sheet: Sheet, formation: object, hold_height: float, *,
+           start: object = None, mesh: int = DEFAULT_MESH, ball: float | None = None,
+           max_time: float = _tol.MAX_SETTLE_TIME, trace: bool = False) -> SettleResult:
+    """Drop the object on the simulated sheet and return where it comes to rest.
+
+    Parameters
+    ----------
+    sheet : Sheet
+    formation : array_like, shape (N, 2)
+        Robot positions :math:`\\mathbf{r}_i`, scenario units.
+    hold_height : float
+        :math:`z_r`.
+    start : array_like, shape (3,), optional
+        Initial ball centre; default above the robots' centroid, just over the hold height.
+    mesh : int
+        Mesh spacings across the sheet's widest vertex pair (spacing = width / mesh).
+    ball : float, optional
+        Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings).
+    max_time : float
+        Simulated time limit, s.
+    trace : bool
+        Record the ball's centre at every settling check.
+
+    Returns
+    -------
+    SettleResult
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from taut.sheet import Sheet
+    >>> sheet = Sheet.regular(3, 500.0)
+    >>> r = settle(sheet, 0.8 * sheet.vertices, 800.0, mesh=8)
+    >>> bool(r.converged), bool(0 < r.position[2] < 800)
+    (True, True)
+    """
+    R, z, div, radius = _check_inputs(sheet, formation, hold_height, mesh, ball)
+    p0 = None if start is None else as_array(start, "start", shape=(3,))
+    max_t = as_positive(max_time, "max_time")
+    m = sheet_mesh(sheet.vertices, div)
+    sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=p0,
+                          tie=False, corner_tendons=False)
+    _run.ramp(sim)
+    rows: list | None = [] if trace else None
+    frames: list | None = [] if trace else None
+    converged, t = _run.settle_phase(sim, max_t, rows, frames)
+    found = _run.object_on_sheet(sim)
+    nodes = _run.node_positions(sim) / sim.scale
+    tr = None if rows is None else np.array(rows) / [1.0, *[sim.scale] * 3]
+    fr = None if frames is None else np.array(frames) / sim.scale
+    if found is None:
+        nan = np.full(3, np.nan)
+        return SettleResult(nan, nan[:2], t, False, nodes, m.triangles, tr, fr, False,
+                            check_status("diverged"), "the ball fell off the sheet")
+    pos, contact = found
+    status = "ok" if converged else "not_converged"
+    msg = (f"settled at ({pos[0]:.4g}, {pos[1]:.4g}, {pos[2]:.4g}) after {t:.2f} s"
+           if converged else f"still moving after {t:.2f} s simulated")
+    return SettleResult(pos, contact, t, converged, nodes, m.triangles, tr, fr, converged,
+                        check_status(status), msg)
+
+
+def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
+                 tol: float, corner_tendons: bool) -> StateCheck:
+    import time
+
+    t0 = time.perf_counter()
+    m = sheet_mesh(sheet.vertices, div, contact=eq.contact)
+    sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=None,
+                          tie=True, corner_tendons=corner_tendons)
+    _run.ramp(sim)
+    _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
+    tied_at = _run.object_on_sheet(sim)
+    assert tied_at is not None                                         # tied: always on
+    tied = tied_at[0]
+    nodes = _run.node_positions(sim) / sim.scale
+    sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * 9.81))
+    _run.release(sim)
+    _run.settle_phase(sim, _tol.RELEASE_TIME)
+    found = _run.object_on_sheet(sim)
+    settled = found[0] if found is not None else _run.ball_position(sim) / sim.scale
+    held = sliding <= tol
+    pred = np.asarray(eq.object, dtype=float)
+    status = str(eq.status)
+    agrees = status == "saddle" or held == (status == "stable")
+    return StateCheck(tuple(eq.taut), status, pred, tied, settled, held,
+                      sliding, settled - pred, float(np.linalg.norm(settled - tied)),
+                      tied - pred, agrees, time.perf_counter() - t0, nodes, m.triangles)
+
+
+def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
+                     mesh: int = DEFAULT_MESH, ball: float | None = None,
+                     hold_tolerance: float | None = None, corner_tendons: bool = True,
+                     progress: Callable[[int, int], None] | None = None) -> EquilibriaCheck:
+    """Check every rest state taut reports for a formation in MuJoCo.
+
+    For each state of :func:`taut.sheet.forward_kinematics`: the object is tied to the
+    simulated sheet at taut's contact point :math:`\\mathbf{v}_o` and settled under gravity
+    (``tied``), then released there and settled again (``settled``); ``held`` says whether
+    it stayed put.
+
+    Parameters
+    ----------
+    sheet, formation, hold_height
+        As for :func:`taut.sheet.forward_kinematics` (scenario units).
+    mesh : int
+        Mesh spacings across the sheet's widest vertex pair.
+    ball : float, optional
+        Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings).
+    hold_tolerance : float, optional
+        A released object that moves less than this is held (default one ball radius
+        ``HOLD_FRACTION`` of the sheet's width), scenario units.
+    corner_tendons : bool
+        Add a tendon from every node to every held corner (makes the tied point load
+        nearly exact; see the README's table).
+    progress : callable(done, total), optional
+        Called after each state (the CLI's progress bar).
+
+    Returns
+    -------
+    EquilibriaCheck
+    """
+    R, z, div, radius = _check_inputs(sheet, formation, hold_height, mesh, ball)
+    tol = _tol.HOLD_FRACTION if hold_tolerance is None else as_positive(
+        hold_tolerance, "hold_tolerance")
+    fk = forward_kinematics(sheet, R, z)
+    states = []
+    for k, eq in enumerate(fk.equilibria):
+        states.append(_check_state(sheet, R, z, eq, div, radius, tol, corner_tendons))
+        if progress is not None:
+            progress(k + 1, len(fk.equilibria))
+    bad = [s for s in states if not s.agrees]
+    ok = not bad
+    if ok:
+        msg = f"physics agrees with taut on all {len(states)} state(s)"
+    else:
+        s = bad[0]
+        taut = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
+        msg = (f"{len(bad)} of {len(states)} state(s) disagree; first: {taut} ({s.status}) "
+               f"was {'held' if s.held else 'left'} in physics")
+    return EquilibriaCheck(tuple(states), tol, div, radius, ok,
+                           check_status("ok" if ok else "unverified"), msg)

@@ -1,0 +1,85 @@
+"""Figures of MuJoCo cross-checks (matplotlib only: no OpenGL context needed): the settled
+sheet of every checked state beside taut's prediction, and an animation of a drop."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..physics.sheet import EquilibriaCheck, SettleResult  # noqa: E402
+from .sheet import STATUS_COLOURS  # noqa: E402
+
+__all__ = ["plot_equilibria_check", "animate_settle"]
+
+
+def _draw_sheet(ax: Any, nodes: np.ndarray, triangles: np.ndarray, formation: np.ndarray,
+                hold_height: float) -> None:
+    ax.plot_trisurf(nodes[:, 0], nodes[:, 1], nodes[:, 2], triangles=triangles,
+                    color="tab:blue", alpha=0.35, edgecolor="0.3", linewidth=0.3)
+    for i, (x, y) in enumerate(formation):
+        ax.plot([x, x], [y, y], [0, hold_height], color="0.35", lw=1.2)
+        ax.text(x, y, hold_height * 1.05, str(i + 1), fontsize=8, ha="center")
+    ax.set_zlim(0, hold_height * 1.1)
+    span = np.ptp(np.vstack([nodes[:, :2], formation]), axis=0)
+    ax.set_box_aspect((max(span[0], 1e-9), max(span[1], 1e-9), hold_height * 1.1))
+
+
+def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_height: float,
+                          path: str | Path | None = None, *, units: str | None = None,
+                          title: str | None = None) -> Any:
+    """One 3D panel per state: the simulated sheet settled with the object tied at taut's
+    contact point, taut's object position (coloured by taut's status) and the released
+    ball's rest position (black cross). Returns the figure; saves it when ``path``."""
+    n = max(len(check.states), 1)
+    cols = min(n, 3)
+    rows = math.ceil(n / cols)
+    fig = plt.figure(figsize=(4.2 * cols, 4.0 * rows))
+    u = f" {units}" if units else ""
+    for k, s in enumerate(check.states):
+        ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
+        _draw_sheet(ax, s.nodes, s.triangles, np.asarray(formation), hold_height)
+        ax.scatter(*s.predicted, s=60, color=STATUS_COLOURS.get(s.status, "k"),
+                   edgecolor="k", depthshade=False, label="taut")
+        ax.scatter(*s.settled, s=50, marker="x", color="k", depthshade=False,
+                   label="physics, released")
+        label = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
+        verdict = "held" if s.held else "not held"
+        ax.set_title(f"{label} taut: {s.status.replace('_', ' ')}; physics: {verdict}\n"
+                     f"tied dz = {s.tied_difference[2]:+.1f}{u}, pull {s.sliding:.2f} mg",
+                     fontsize=8)
+        ax.tick_params(labelsize=6)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=130)
+    return fig
+
+
+def animate_settle(result: SettleResult, formation: np.ndarray, hold_height: float,
+                   path: str | Path, *, fps: int = 10) -> None:
+    """Write a GIF of a drop (:func:`taut.physics.settle` with ``trace=True``)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    if result.frames is None or result.trace is None:
+        raise ValueError("settle(..., trace=True) records the frames an animation needs")
+    frames, trace = result.frames, result.trace
+    fig = plt.figure(figsize=(5, 4.5))
+    ax = fig.add_subplot(projection="3d")
+
+    def draw(k: int) -> None:
+        ax.clear()
+        _draw_sheet(ax, frames[k], result.triangles, np.asarray(formation), hold_height)
+        ax.scatter(*trace[k, 1:], s=40, color="tab:red", depthshade=False)
+        ax.set_title(f"t = {trace[k, 0]:.1f} s", fontsize=9)
+
+    anim = FuncAnimation(fig, draw, frames=len(frames), interval=1000 / fps)
+    anim.save(str(path), writer=PillowWriter(fps=fps))
+    plt.close(fig)
