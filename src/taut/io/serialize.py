@@ -245,15 +245,18 @@ def deployment_to_dict(robot: CableRobot, res: DeploymentResult) -> dict[str, An
     """A deployment search: base poses (m, m, rad), margins, the lift certificate."""
     lb = res.lift_bound
     r4 = lambda x: finite_or_none(x, 4)  # noqa: E731
+    ok = bool(_attr(res, "success", "feasible"))
+    message = str(_attr(res, "message", "reason") or "")
     return {
         "model": robot.name, "workspace": np.asarray(res.workspace).tolist(),
-        "feasible": bool(_attr(res, "success", "feasible")),
+        "success": ok, "status": getattr(res, "status", "ok" if ok else "infeasible"),
+        "message": message, "feasible": ok,
         "refuted": bool(res.refuted),
         "base_poses": {k: [round(float(x), 4) for x in v] for k, v in res.base_poses.items()},
         "margin": r4(res.margin),
         "twist_margin": None if res.twist_margin is None else r4(res.twist_margin),
         "points": int(len(res.points)), "feasible_points": int(res.point_feasible.sum()),
-        "evaluations": res.evaluations, "reason": _attr(res, "message", "reason"),
+        "evaluations": res.evaluations, "reason": "" if ok else message,
         "lift_bound": None if lb is None else {
             "height": r4(lb.height), "bound": r4(lb.bound), "required": r4(lb.required),
             "weight": r4(lb.weight), "refutes": lb.refutes,
