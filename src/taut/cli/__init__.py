@@ -44,6 +44,11 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
 for _module in (fk, motion, plan, cdpr):
     _module.register(app)
 
+# `taut app` (module webapp: a submodule named `app` would shadow the Typer object above).
+from . import webapp  # noqa: E402
+
+webapp.register(app)
+
 EXIT_USAGE = 2
 
 
