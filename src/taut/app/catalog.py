@@ -72,8 +72,8 @@ def regular_team(n: int, *, radius: float = 1000.0, hold_height: float = 1000.0,
     """A sheet scenario mapping: a regular ``n``-gon sheet (circumradius ``radius``, mm)
     held at ``hold_height`` by a formation that rests the object in a generic stable
     state (the all-taut inverse-kinematics formation for the object at half the hold
-    height, pulled 3 % towards the object and jittered by 1 % of the sheet size, so no
-    cable set is degenerate).
+    height, pulled 20 % towards the object, leaving the robots room to be dragged, and
+    jittered by 1 % of the sheet size, so no cable set is degenerate).
 
     Examples
     --------
@@ -88,7 +88,7 @@ def regular_team(n: int, *, radius: float = 1000.0, hold_height: float = 1000.0,
     target = (*centre, 0.5 * hold_height)
     ik = inverse_kinematics(sheet, target, hold_height)
     rng = np.random.default_rng(seed)
-    formation = centre + 0.97 * (ik.formation - centre)
+    formation = centre + 0.8 * (ik.formation - centre)
     formation = formation + rng.uniform(-0.01, 0.01, formation.shape) * radius
     return {
         "name": f"regular {n}-gon team (generated)", "units": "mm",

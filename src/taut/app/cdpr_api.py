@@ -99,7 +99,8 @@ class CdprAPI:
         if field(body, "stabilisers", bool, default=False):
             cmd += " --stabilisers"
         text = (f"# cable-robot model '{robot.name}' saved by `taut app`; the pose shown:\n"
-                f"#   {cmd}\n" + yaml.safe_dump(field(body, "model", dict), sort_keys=False))
+                f"#   {cmd}\n" + yaml.safe_dump(field(body, "model", dict), sort_keys=False,
+                                               default_flow_style=None))
         return {"yaml": text, "filename": "cdpr_model.yaml"}
 
     def state(self, body: dict[str, Any]) -> dict[str, Any]:
@@ -128,7 +129,7 @@ class CdprAPI:
             label = "closed-form attempt (violates the limits)"
         t = shown.tensions[0]
         margins = []
-        if robot.has_tipping and np.all(np.isfinite(t)):
+        if robot.has_tipping and (ok_tip or ok_lim):   # margins of a valid distribution
             tm = tipping_moments(robot, pose, t)
             for k, b in enumerate(robot.bases):
                 sel = tm.edge_base == k

@@ -134,7 +134,8 @@ class PlanAPI:
         """The scenario as a YAML file that ``taut plan`` reads back."""
         sc = self._scenario(field(body, "scenario", dict))
         text = ("# planning scenario saved by `taut app`; read it back with: taut plan FILE\n"
-                + yaml.safe_dump(plan_scenario_to_mapping(sc), sort_keys=False))
+                + yaml.safe_dump(plan_scenario_to_mapping(sc), sort_keys=False,
+                                 default_flow_style=None))
         return {"yaml": text, "filename": "plan_scenario.yaml"}
 
     def run(self, body: dict[str, Any]) -> dict[str, Any]:

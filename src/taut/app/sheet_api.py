@@ -129,6 +129,6 @@ class SheetAPI:
         data = field(body, "scenario", dict)
         mapping = scenario_mapping(sheet_scenario_from_mapping(data))
         text = ("# sheet scenario saved by `taut app`; read it back with: taut fk FILE\n"
-                + yaml.safe_dump(mapping, sort_keys=False))
+                + yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None))
         return {"yaml": text, "filename": "sheet_scenario.yaml"}
 

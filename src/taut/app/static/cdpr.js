@@ -152,8 +152,9 @@ const CdprView = {
       el("rect", {x: X(g.t_min[i]), y, width: X(g.t_max[i]) - X(g.t_min[i]), height: h - 4, fill: "#eef", stroke: "#99b"}, svg);
       if (t !== null) {
         const bad = t < g.t_min[i] - 1e-6 || t > g.t_max[i] + 1e-6;
-        el("rect", {x: X(0), y: y + 3, width: Math.max(0, X(t) - X(0)), height: h - 10, fill: bad ? "#d33" : "#3a7", class: "tension-bar"}, svg);
-        el("text", {x: X(Math.max(t, 0)) + 4, y: y + h * 0.7, "font-size": 10}, svg).textContent = t.toFixed(1);
+        const tc = Math.min(Math.max(t, 0), top);                 // bar clipped to the axis
+        el("rect", {x: X(0), y: y + 3, width: X(tc) - X(0), height: h - 10, fill: bad ? "#d33" : "#3a7", class: "tension-bar"}, svg);
+        el("text", {x: X(tc) + 4, y: y + h * 0.7, "font-size": 10}, svg).textContent = t.toFixed(1);
       }
     });
     el("text", {x: L, y: 4 + m * h + 12, "font-size": 10}, svg).textContent =
@@ -163,6 +164,9 @@ const CdprView = {
   drawMargins() {
     const tb = document.getElementById("cdpr-margins");
     tb.innerHTML = "<tr><th>base</th><th>margin [N m]</th><th></th></tr>";
+    if (!this.st.margins.length && this.geo.has_tipping) {
+      tb.insertRow().insertCell().textContent = "no valid tensions: margins undefined";
+    }
     for (const m of this.st.margins) {
       const row = tb.insertRow();
       [m.base, m.margin.toFixed(2), m.stable ? "stable" : "TIPS"].forEach(c => { row.insertCell().textContent = c; });

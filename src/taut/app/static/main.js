@@ -21,7 +21,7 @@ async function downloadCurrent() {
   else if (name === "plan" && v.sc) r = await api("/api/plan/yaml", {scenario: v.sc});
   else if (name === "cdpr" && v.model) r = await api("/api/cdpr/yaml", v.body({pose: v.pose}));
   else { showMessage("nothing loaded to download", "error"); return; }
-  if (r.ok) { download(r.data.yaml, r.data.filename); taut.lastYaml = r.data.yaml; }
+  if (r.ok) { taut.lastYaml = r.data.yaml; download(r.data.yaml, r.data.filename); }
 }
 
 async function restore() {

@@ -1,7 +1,8 @@
 // Sheet explorer: drag robots in a top view; every drag asks the server for forward
-// kinematics and draws every equilibrium (taut cables solid, slack dotted), the sheet in
-// its own frame, a 3D view of the lowest stable state and a table. IK mode: click a
-// target. Simulate mode: record a drag path and play it through the quasi-static model.
+// kinematics and draws every equilibrium (taut cables solid; the selected state also its
+// slack cables, dotted), the sheet in its own frame, a 3D view of the lowest stable
+// state and a table. IK mode: click a target. Simulate mode: record a drag path and
+// play it through the quasi-static model.
 "use strict";
 
 const STATUS_COLOR = {stable: "#1a8a2a", saddle: "#d08020", not_equilibrium: "#999"};
@@ -92,9 +93,9 @@ const SheetView = {
       this.fk = r.data; this.fkFormation = f;
       this.sel = r.data.feasible ? (r.data.lowest !== null ? r.data.lowest : 0) : null;
       this.draw();
-      const tDom = performance.now(), n = f.length, server = r.data.server_ms;
+      const tDom = performance.now(), n = f.length, server = r.data.server_ms, feasible = r.data.feasible;
       requestAnimationFrame(() => {
-        this.latency.push({n, ms: performance.now() - t0, dom: tDom - t0, server,
+        this.latency.push({n, feasible, ms: performance.now() - t0, dom: tDom - t0, server,
                            wait: tSend - t0, net: tResp - tSend, draw: tDom - tResp});
         if (this.latency.length > 5000) this.latency.shift();
       });

@@ -42,6 +42,7 @@ Object.assign(SheetView, {
       const [ox, oy] = fr.pt(e.object);
       for (let i = 0; i < F.length; i++) {
         const [x, y] = fr.pt(F[i]), t = taut.has(i);
+        if (!t && !sel) continue;              // slack cables: of the selected state only
         el("line", {x1: x, y1: y, x2: ox, y2: oy, stroke: t ? col : "#aaa",
                     "stroke-width": sel ? (t ? 2.2 : 1.2) : 0.8, opacity: sel ? 1 : 0.35,
                     "stroke-dasharray": t ? "" : "3 4"}, g);
