@@ -201,3 +201,52 @@ def test_cable_robot_out_of_the_workspace_is_flagged(page):
     flag = by_id(d, "cdpr-flag")
     assert flag.get_attribute("data-feasible") == "0"
     assert flag.text.startswith("NOT wrench-feasible")
+
+
+def test_ik_click_moves_the_robots_to_the_library_formation(page):
+    d = page
+    load_example2(d)
+    f0, _ = settled_sheet(d)
+    d.execute_script("document.querySelector('input[value=ik]').click();"
+                     "document.getElementById('ik-height').value = 420;")
+    from selenium.webdriver.common.action_chains import ActionChains
+    ActionChains(d).move_to_element_with_offset(by_id(d, "sheet-top"), 15, -10).click().perform()
+    wait_for(d, "document.getElementById('message').textContent.startsWith('IK:')")
+    f, rows = settled_sheet(d)
+    d.execute_script("document.querySelector('input[value=drag]').click()")
+    target = d.execute_script("return SheetView.lastTarget")
+    sc = load_sheet_scenario(EX2)
+    from taut.sheet import inverse_kinematics
+    want = inverse_kinematics(sc.sheet, target, sc.hold_height, reference=f0)
+    np.testing.assert_allclose(f, want.formation, atol=1e-9)
+    assert target[2] == 420
+    stable = [r for r in rows if r[5] == "stable"]
+    assert any(abs(float(r[4]) - 420) < 0.006 and abs(float(r[2]) - target[0]) < 0.006
+               for r in stable)
+
+
+def test_simulate_plays_the_path_and_marks_the_jump(page):
+    d = page
+    by_id(d, "tab-sheet").click()
+    traj = ROOT / "examples" / "sheet" / "trajectories"
+    d.execute_script("SheetView.sc = null; SheetView.load({text: arguments[0], filename: 'square4.yaml'})",
+                     (traj / "square4.yaml").read_text())
+    wait_for(d, "SheetView.sc && SheetView.sc.units === 'm' && SheetView.fk && !SheetView.inflight")
+    from taut.io.trajectory import load_trajectory
+    from taut.sheet import simulate
+    path = load_trajectory(traj / "square4_jump.csv").formations
+    # The recorded path is set directly (a recorded drag gives the same list of formations).
+    d.execute_script("document.getElementById('sim-events').textContent = '';"
+                     "document.querySelector('input[value=simulate]').click();"
+                     "SheetView.formation = arguments[0][0]; SheetView.path = arguments[0];"
+                     "SheetView.play()", path.tolist())
+    text = wait_for(d, "document.getElementById('sim-events').textContent", timeout=60)
+    wait_for(d, "!SheetView.playing", timeout=60)
+    d.execute_script("document.querySelector('input[value=drag]').click()")
+    dense = np.array(d.execute_script("return SheetView.densePath()"))
+    want = simulate(load_sheet_scenario(traj / "square4.yaml").sheet, dense, 1.5, mass=0.5)
+    assert want.jumps
+    j = want.jumps[0]
+    assert text.startswith(f"jump at step {j.step}/{len(dense) - 1}: taut "
+                           f"{{{','.join(str(i + 1) for i in j.taut_before)}}} -> "
+                           f"{{{','.join(str(i + 1) for i in j.taut_after)}}}, drop {j.drop:.2f}")

@@ -8,6 +8,7 @@ reshapes their results for drawing. Lengths m, times s.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import threading
 import time
@@ -80,7 +81,9 @@ def plan_series(sc: Scenario, r: PlanResult) -> dict[str, list[float | None]]:
 
 def _summary(sc: Scenario, r: PlanResult) -> dict[str, Any]:
     out = plan_to_dict(r)
-    out.update(plan_series(sc, r), planner=r.planner, message=r.reason or "plan verified",
+    names = {f.name for f in dataclasses.fields(r)}
+    why = getattr(r, "message") if "message" in names else r.reason   # convention, or older
+    out.update(plan_series(sc, r), planner=r.planner, message=why or "plan verified",
                object_height=(None if r.formation is None
                               else float(r.formation.object_height)))
     return out

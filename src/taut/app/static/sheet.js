@@ -138,6 +138,7 @@ const SheetView = {
     const h = Number(document.getElementById("ik-height").value);
     const r = await api("/api/sheet/ik", this.body({target: [p[0], p[1], h], reference: this.formation}));
     if (!r.ok) return;
+    this.lastTarget = [p[0], p[1], h];
     this.formation = r.data.ik.formation;
     showMessage(`IK: every cable taut, object at (${p[0].toFixed(1)}, ${p[1].toFixed(1)}, ${h})`, "info");
     this.requestFK(performance.now());
