@@ -250,3 +250,23 @@ def test_simulate_plays_the_path_and_marks_the_jump(page):
     assert text.startswith(f"jump at step {j.step}/{len(dense) - 1}: taut "
                            f"{{{','.join(str(i + 1) for i in j.taut_before)}}} -> "
                            f"{{{','.join(str(i + 1) for i in j.taut_after)}}}, drop {j.drop:.2f}")
+
+
+def test_cable_robot_link_reproduces_the_pose(page):
+    d = page
+    by_id(d, "tab-cdpr").click()
+    select(d, "cdpr-example", "ipanema")
+    wait_for(d, "CdprView.geo && CdprView.geo.name !== 'fastkit' && CdprView.st && !CdprView.inflight")
+    drag(d, "#cdpr-top .platform", [(3, 2)] * 8)
+    wait_for(d, "!CdprView.inflight && !CdprView.pending")
+    pose = d.execute_script("return CdprView.st.pose")
+    flag = by_id(d, "cdpr-flag").text
+    url = d.current_url
+    d.get("about:blank")
+    d.get(url)
+    wait_for(d, "document.body.dataset.ready && CdprView.st && !CdprView.inflight")
+    np.testing.assert_allclose(d.execute_script("return CdprView.st.pose"), pose, atol=1e-12)
+    assert by_id(d, "cdpr-flag").text == flag
+    robot = load_cdpr_model("ipanema")
+    ok = distribute_tensions(robot, pose, "qp_min_norm", tipping=True).feasible[0]
+    assert flag.startswith("wrench-feasible" if ok else "NOT wrench-feasible")
