@@ -62,6 +62,11 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
 for _module in (fk, motion, plan, cdpr, physics, sweep):
     _module.register(app)
 
+# `taut app` (module webapp: a submodule named `app` would shadow the Typer object above).
+from . import webapp  # noqa: E402
+
+webapp.register(app)
+
 EXIT_NO = 1
 EXIT_USAGE = 2
 

@@ -1,0 +1,179 @@
+"""JSON endpoints of the cable-robot explorer: load a preset or model file, evaluate a
+platform pose (tensions against their limits, tipping margins of the mobile bases,
+wrench feasibility with and without tipping) and a slice of the wrench-feasible
+workspace.
+
+The statics are :func:`taut.cdpr.distribute_tensions` (tipping passed explicitly both
+ways), :func:`taut.cdpr.tipping_moments`, :func:`taut.cdpr.cable_state` and
+:func:`taut.cdpr.wrench_feasible_workspace`. SI units: m, rad, N, N m.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..cdpr import (CableRobot, cable_state, distribute_tensions, grid_points,
+                    tipping_moments, wrench_feasible_workspace, with_stabilisers)
+from ..cdpr import METHODS as TENSION_METHODS
+from ..errors import InfeasiblePoseError, InvalidInputError
+from ..io import cdpr_model_from_mapping
+from .catalog import Catalog
+from .payload import ModelCache, field, mapping_from_upload
+
+__all__ = ["CdprAPI", "succeeded"]
+
+#: Most grid points of one workspace slice (keeps a slice under about a second).
+MAX_SLICE_POINTS = 4000
+
+
+def succeeded(result: Any) -> np.ndarray:
+    """The per-pose success flags of a tension or feasibility result (``success`` in the
+    result convention; ``feasible`` in results that predate it)."""
+    names = {f.name for f in dataclasses.fields(result)}
+    return np.asarray(result.success if "success" in names else result.feasible)
+
+
+def _build(key: dict[str, Any]) -> CableRobot:
+    robot = cdpr_model_from_mapping(key["model"])
+    return with_stabilisers(robot, True) if key["stabilisers"] else robot
+
+
+def _finite(a: np.ndarray) -> list[float | None]:
+    return [float(x) if np.isfinite(x) else None for x in np.ravel(a)]
+
+
+def geometry(robot: CableRobot) -> dict[str, Any]:
+    """Fixed parts for drawing: frame box, desired workspace, exit points, bases with
+    their support polygons in the world frame, cable names and tension limits."""
+    bases = []
+    for b in robot.bases:
+        poly = b.support_polygon
+        world = None if poly is None else \
+            b.to_world(np.column_stack([poly, np.zeros(len(poly))]))[:, :2].tolist()
+        bases.append({"name": b.name, "mobile": bool(b.mobile), "support": world,
+                      "exits": b.to_world(b.exit_local).tolist()})
+    dw = robot.desired_workspace
+    r: Any = robot            # exits_world, cable_base, t_min, t_max: set when validated
+    return {"name": robot.name, "bounds": np.asarray(robot.bounds).tolist(),
+            "desired_workspace": None if dw is None else np.asarray(dw).tolist(),
+            "exits": r.exits_world.tolist(), "bases": bases,
+            "cables": [c.name for c in robot.cables], "cable_base": r.cable_base.tolist(),
+            "t_min": r.t_min.tolist(), "t_max": r.t_max.tolist(),
+            "has_tipping": bool(robot.has_tipping), "methods": list(TENSION_METHODS)}
+
+
+class CdprAPI:
+    """The cable-robot explorer's endpoints (models cached by their mapping)."""
+
+    def __init__(self, catalog: Catalog) -> None:
+        self.catalog = catalog
+        self.models = ModelCache(_build)
+
+    def _robot(self, body: dict[str, Any]) -> CableRobot:
+        return self.models.get({"model": field(body, "model", dict),
+                                "stabilisers": field(body, "stabilisers", bool, default=False)})
+
+    def load(self, body: dict[str, Any]) -> dict[str, Any]:
+        """``{"example": preset or file name}``, an upload ``{"text", "filename"}`` or
+        ``{"model": mapping}`` -> the model mapping and its drawing geometry."""
+        if "example" in body:
+            data = self.catalog.mapping("cdpr", field(body, "example", str))
+        elif "text" in body:
+            data = mapping_from_upload(field(body, "text", str),
+                                       field(body, "filename", str, default="upload.yaml"))
+        else:
+            data = field(body, "model", dict)
+        robot = self.models.get({"model": data, "stabilisers": False})
+        return {"model": data, "geometry": geometry(robot)}
+
+    def yaml(self, body: dict[str, Any]) -> dict[str, Any]:
+        """The model file, headed by the ``taut cdpr tensions`` command for the pose."""
+        robot = self._robot(body)
+        pose = np.asarray(field(body, "pose", list), dtype=float)
+        cmd = (f"taut cdpr tensions FILE --pose {pose[0]:g} {pose[1]:g} {pose[2]:g} "
+               f"--rpy {pose[3]:g} {pose[4]:g} {pose[5]:g} --tipping")
+        if field(body, "stabilisers", bool, default=False):
+            cmd += " --stabilisers"
+        text = (f"# cable-robot model '{robot.name}' saved by `taut app`; the pose shown:\n"
+                f"#   {cmd}\n" + yaml.safe_dump(field(body, "model", dict), sort_keys=False,
+                                               default_flow_style=None))
+        return {"yaml": text, "filename": "cdpr_model.yaml"}
+
+    def state(self, body: dict[str, Any]) -> dict[str, Any]:
+        """Statics at ``pose`` [x, y, z, roll, pitch, yaw]: tensions, limits, tipping
+        margins, feasibility; a pose outside the frame box is flagged, not an error."""
+        robot = self._robot(body)
+        pose = np.asarray(field(body, "pose", list), dtype=float)
+        if pose.shape != (6,) or not np.all(np.isfinite(pose)):
+            raise InvalidInputError("pose", "must be 6 finite numbers x y z roll pitch yaw")
+        method = field(body, "method", str, default="qp_min_norm")
+        st = cable_state(robot, pose[None], validated=True)
+        attach = (pose[:3] + st.r[0]).tolist()
+        out: dict[str, Any] = {"pose": pose.tolist(), "attachments": attach,
+                               "in_frame": True}
+        try:
+            with_tip = distribute_tensions(robot, pose, method, tipping=True)
+        except InfeasiblePoseError as exc:
+            return dict(out, in_frame=False, feasible=False, feasible_limits=False,
+                        message=str(exc), tensions=None, shown="none", margins=[])
+        limits = distribute_tensions(robot, pose, method, tipping=False)
+        ok_tip, ok_lim = bool(succeeded(with_tip)[0]), bool(succeeded(limits)[0])
+        shown, label = (with_tip, "with tipping") if ok_tip else (limits, "limits only")
+        if not ok_lim and not np.all(np.isfinite(limits.tensions[0])):
+            # No solution at all: show the closed form's best attempt and its violations.
+            shown = distribute_tensions(robot, pose, "closed_form", tipping=False)
+            label = "closed-form attempt (violates the limits)"
+        t = shown.tensions[0]
+        margins = []
+        if robot.has_tipping and (ok_tip or ok_lim):   # margins of a valid distribution
+            tm = tipping_moments(robot, pose, t)
+            for k, b in enumerate(robot.bases):
+                sel = tm.edge_base == k
+                if np.any(sel):
+                    worst = float(tm.moments[0, sel].max())
+                    margins.append({"base": b.name, "margin": -worst,
+                                    "stable": worst <= 0.0 or bool(tm.stable[0])})
+        if ok_tip:
+            msg = "wrench-feasible: tensions within limits and no base tips"
+        elif ok_lim:
+            msg = "NOT wrench-feasible with tipping: a mobile base tips over"
+        else:
+            msg = "NOT wrench-feasible: no tensions within the cable limits hold the platform"
+        return dict(out, feasible=ok_tip, feasible_limits=ok_lim, message=msg,
+                    tensions=_finite(t), shown=label,
+                    margins=margins, method=method)
+
+    def workspace(self, body: dict[str, Any]) -> dict[str, Any]:
+        """Wrench-feasible slice: ``plane`` "xz" (at y = ``offset``) or "xy" (at z =
+        ``offset``) over the frame box, ``n`` = [columns, rows], orientation ``rpy``."""
+        robot = self._robot(body)
+        plane = field(body, "plane", str, default="xz")
+        if plane not in ("xz", "xy"):
+            raise InvalidInputError("plane", "must be xz or xy")
+        n = field(body, "n", list, default=[41, 21])
+        if (len(n) != 2 or not all(isinstance(k, int) and k >= 2 for k in n)
+                or n[0] * n[1] > MAX_SLICE_POINTS):
+            raise InvalidInputError("n", f"must be two integers >= 2 with at most "
+                                         f"{MAX_SLICE_POINTS} points in all")
+        rpy = field(body, "rpy", list, default=[0.0, 0.0, 0.0])
+        box = np.array(robot.bounds, dtype=float)
+        flat = 1 if plane == "xz" else 2
+        offset = float(field(body, "offset", (int, float), default=0.0))
+        box[:, flat] = np.clip(offset, box[0, flat], box[1, flat])
+        shape = [n[0], 1, n[1]] if plane == "xz" else [n[0], n[1], 1]
+        pts, eff = grid_points(box, shape)
+        ws = wrench_feasible_workspace(robot, pts, orientations=[rpy], shape=eff)
+        cols = 2 if plane == "xz" else 1
+        grid = (n[0], n[1])
+
+        def rows(flags: np.ndarray | None) -> list[list[bool]] | None:
+            return None if flags is None else flags.reshape(grid).T.tolist()
+
+        return {"plane": plane, "offset": float(box[0, flat]),
+                "a": np.unique(pts[:, 0]).tolist(), "b": np.unique(pts[:, cols]).tolist(),
+                "feasible": rows(ws.feasible), "feasible_tipping": rows(ws.feasible_tipping),
+                "coverage": ws.coverage, "coverage_tipping": ws.coverage_tipping}

@@ -1,0 +1,134 @@
+"""JSON endpoints of the sheet explorer: load a scenario, forward kinematics on every
+drag, inverse kinematics for a clicked target, quasi-static simulation of a drag path,
+and the scenario as a YAML file ``taut fk`` reads back.
+
+Every function takes the decoded JSON body (a dict) and returns a JSON-ready dict; bad
+input raises :class:`taut.errors.TautError`. All physics is the library's:
+:func:`taut.sheet.forward_kinematics`, :func:`taut.sheet.inverse_kinematics`,
+:func:`taut.sheet.simulate`. Lengths are in the scenario's unit, masses kg, tensions N.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..io.serialize import ik_to_dict, simulation_to_dict
+from ..errors import InfeasibleFormationError, InvalidInputError
+from ..io import SheetScenario, sheet_scenario_from_mapping
+from ..io.serialize import equilibrium_to_dict
+from ..sheet import Sheet, forward_kinematics, inverse_kinematics, simulate
+from .catalog import Catalog, regular_team
+from .payload import ModelCache, field, mapping_from_upload
+
+__all__ = ["SheetAPI"]
+
+#: Keys of a sheet scenario file, in the order they are written.
+_KEYS = ("name", "units", "hold_height", "mass", "sheet", "formation")
+
+
+def _points(a: np.ndarray) -> list[list[float]]:
+    return [[float(x), float(y)] for x, y in np.asarray(a, dtype=float)]
+
+
+def _default_formation(sc: SheetScenario) -> np.ndarray:
+    """A formation for a scenario that has none: inverse kinematics (all cables taut) for
+    the object under the sheet's centroid at half the shortest cable's depth."""
+    vo = sc.sheet.vertices.mean(axis=0)
+    depth = min(0.5 * float(np.linalg.norm(sc.sheet.vertices - vo, axis=1).min()),
+                0.5 * sc.hold_height)
+    ik = inverse_kinematics(sc.sheet, (*vo, sc.hold_height - depth), sc.hold_height)
+    return ik.formation
+
+
+def scenario_mapping(sc: SheetScenario) -> dict[str, Any]:
+    """The file mapping of a validated scenario (inverse of
+    :func:`taut.io.sheet_scenario_from_mapping`); a missing formation is filled in."""
+    formation = sc.formation if sc.formation is not None else _default_formation(sc)
+    out = {"name": sc.name, "units": sc.units, "hold_height": float(sc.hold_height),
+           "mass": sc.mass, "sheet": _points(sc.sheet.vertices),
+           "formation": _points(formation)}
+    return {k: out[k] for k in _KEYS if out[k] is not None}
+
+
+def _sheet(vertices: Any) -> Sheet:
+    return Sheet(np.asarray(vertices, dtype=float) if isinstance(vertices, list) else vertices)
+
+
+class SheetAPI:
+    """The sheet explorer's endpoints (one instance per server: it caches sheets so the
+    solver's per-sheet precomputation is reused from drag to drag)."""
+
+    def __init__(self, catalog: Catalog) -> None:
+        self.catalog = catalog
+        self.sheets = ModelCache(_sheet)
+
+    def load(self, body: dict[str, Any]) -> dict[str, Any]:
+        """``{"example": name}``, ``{"text": ..., "filename": ...}`` (an upload),
+        ``{"regular": n}`` or ``{"scenario": mapping}`` -> ``{"scenario": mapping}``,
+        validated by the CLI's loader."""
+        if "example" in body:
+            data = self.catalog.mapping("sheet", field(body, "example", str))
+        elif "text" in body:
+            data = mapping_from_upload(field(body, "text", str),
+                                       field(body, "filename", str, default="upload.yaml"))
+        elif "regular" in body:
+            data = regular_team(field(body, "regular", int))
+        else:
+            data = field(body, "scenario", dict)
+        return {"scenario": scenario_mapping(sheet_scenario_from_mapping(data))}
+
+    def _inputs(self, body: dict[str, Any]) -> tuple[Sheet, float, float | None]:
+        sheet = self.sheets.get(field(body, "sheet", list))
+        hold = field(body, "hold_height", (int, float))
+        mass = field(body, "mass", (int, float), default=None)
+        return sheet, float(hold), None if mass is None else float(mass)
+
+    def fk(self, body: dict[str, Any]) -> dict[str, Any]:
+        """Every equilibrium of ``formation``; an infeasible formation is an answer
+        (``feasible: false`` with the pair), not an error."""
+        sheet, hold, mass = self._inputs(body)
+        formation = field(body, "formation", list)
+        t0 = time.perf_counter()
+        try:
+            res = forward_kinematics(sheet, formation, hold, mass=mass)
+        except InfeasibleFormationError as exc:
+            return {"feasible": False, "pair": list(exc.pair), "message": str(exc),
+                    "server_ms": 1e3 * (time.perf_counter() - t0)}
+        eqs = [dict(equilibrium_to_dict(e), height=e.height) for e in res.equilibria]
+        low = res.lowest
+        return {"feasible": True, "equilibria": eqs,
+                "lowest": None if low is None else res.equilibria.index(low),
+                "stable_count": len(res.stable),
+                "server_ms": 1e3 * (time.perf_counter() - t0)}
+
+    def ik(self, body: dict[str, Any]) -> dict[str, Any]:
+        """Formation holding the object stably at ``target`` ([x, y, z]) with every cable
+        taut, staying close to ``reference`` (the current formation) when given."""
+        sheet, hold, mass = self._inputs(body)
+        res = inverse_kinematics(sheet, field(body, "target", list), hold, mass=mass,
+                                 reference=field(body, "reference", list, default=None))
+        return {"ik": ik_to_dict(res)}
+
+    def simulate(self, body: dict[str, Any]) -> dict[str, Any]:
+        """Quasi-static simulation along ``formations`` (T x N x 2, one row per step)."""
+        sheet, hold, mass = self._inputs(body)
+        formations = field(body, "formations", list)
+        if len(formations) > 20000:
+            raise InvalidInputError("formations", "at most 20000 steps")
+        res = simulate(sheet, formations, hold, mass=mass,
+                       start=field(body, "start", list, default=None))
+        return {"simulation": simulation_to_dict(res, np.arange(len(res), dtype=float))}
+
+    def yaml(self, body: dict[str, Any]) -> dict[str, Any]:
+        """The scenario (with the current formation and mass) as a YAML file ``taut fk``
+        reads; validated first, so only loadable files are offered."""
+        data = field(body, "scenario", dict)
+        mapping = scenario_mapping(sheet_scenario_from_mapping(data))
+        text = ("# sheet scenario saved by `taut app`; read it back with: taut fk FILE\n"
+                + yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None))
+        return {"yaml": text, "filename": "sheet_scenario.yaml"}
+

@@ -1,0 +1,123 @@
+"""Planner and cable-robot endpoints (no web server needed), checked against the library."""
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from taut.app.catalog import Catalog
+from taut.app.cdpr_api import CdprAPI
+from taut.app.plan_api import PlanAPI
+from taut.cdpr import distribute_tensions, tipping_moments, wrench_feasible_workspace
+from taut.errors import TautError
+from taut.io import load_cdpr_model, load_plan_scenario, plan_scenario_from_mapping
+from taut.plan import plan
+
+ROOT = Path(__file__).parents[2]
+CORRIDOR = ROOT / "examples" / "plan" / "paper_corridor.yaml"
+
+
+@pytest.fixture(scope="module")
+def cdpr():
+    api = CdprAPI(Catalog(ROOT / "examples"))
+    return api, api.load({"example": "fastkit"})["model"]
+
+
+def test_planner_job_reports_progress_and_the_library_plan(tmp_path):
+    api = PlanAPI(Catalog(ROOT / "examples"))
+    try:
+        sc = api.load({"example": CORRIDOR.name})["scenario"]
+        jid = api.run({"scenario": sc})["job"]
+        seen = set()
+        for _ in range(600):
+            s = api.job(jid)
+            seen.add(s["stage"])
+            if s["state"] != "running":
+                break
+            time.sleep(0.05)
+    finally:
+        api.close()
+    assert s["state"] == "done" and s["steps"] == 2
+    assert "planner with obstacle crossing" in seen or "bypass-only baseline" in seen
+    want = plan(load_plan_scenario(CORRIDOR))
+    got = s["plan"]
+    assert got["success"] and got["crossed"] == list(want.crossed)
+    assert got["duration"] == pytest.approx(want.duration, rel=1e-12)
+    np.testing.assert_allclose(got["object"], want.object, atol=1e-12)
+    assert s["baseline"]["success"] is False and "no route" in s["baseline"]["message"]
+    # Plots: the object clears every obstacle beneath by the height safety; the sheet
+    # never tears (margin >= 0) and the margin is the pair slack of the first sample.
+    over = [h for h in got["height_over_obstacle"] if h is not None]
+    assert over and min(over) >= 0.05 - 1e-6
+    V = load_plan_scenario(CORRIDOR).team.sheet.vertices
+    R = want.robots[0]
+    slack = min(np.linalg.norm(V[i] - V[j]) - np.linalg.norm(R[i] - R[j])
+                for i in range(3) for j in range(i + 1, 3))
+    assert got["sheet_margin"][0] == pytest.approx(slack, abs=1e-12)
+    assert min(got["sheet_margin"]) >= -1e-9
+    # The YAML download is a scenario `taut plan` reads back as the same problem.
+    back = plan_scenario_from_mapping(yaml.safe_load(api.yaml({"scenario": sc})["yaml"]))
+    assert back.team.hold_height == 0.5 and len(back.world.obstacles) == 2
+
+
+def test_unknown_job_and_bad_scenario_are_one_line_errors():
+    api = PlanAPI(Catalog(ROOT / "examples"))
+    try:
+        with pytest.raises(TautError, match="^job: "):
+            api.job("999")
+        with pytest.raises(TautError, match=r"^team\.hold_height: "):
+            bad = yaml.safe_load(CORRIDOR.read_text())
+            bad["team"]["hold_height"] = -1
+            api.load({"scenario": bad})
+    finally:
+        api.close()
+
+
+def test_feasible_pose_tensions_and_margins_are_the_library_s(cdpr):
+    api, model = cdpr
+    robot = load_cdpr_model("fastkit")
+    pose = [0.3, 0.0, 0.8, 0.0, 0.0, 0.0]
+    got = api.state({"model": model, "pose": pose})
+    want = distribute_tensions(robot, pose, "qp_min_norm", tipping=True)
+    assert got["feasible"] is bool(want.feasible[0]) is True
+    np.testing.assert_allclose(got["tensions"], want.tensions[0], rtol=1e-12)
+    moments = tipping_moments(robot, pose, want.tensions[0]).moments[0]
+    for k, m in enumerate(got["margins"]):
+        assert m["margin"] == pytest.approx(-moments[robot.edge_base == k].max(), abs=1e-9)
+
+
+def test_pose_out_of_the_workspace_is_flagged(cdpr):
+    api, model = cdpr
+    robot = load_cdpr_model("fastkit")
+    high = [0.0, 0.0, 2.3, 0.0, 0.0, 0.0]          # cables nearly horizontal
+    got = api.state({"model": model, "pose": high})
+    assert not distribute_tensions(robot, high, "qp_min_norm", tipping=False).feasible[0]
+    assert got["feasible"] is False and got["feasible_limits"] is False
+    assert got["message"].startswith("NOT wrench-feasible")
+    assert got["tensions"] is not None              # the closed form's attempt is shown
+    outside = api.state({"model": model, "pose": [2.9, 0, 0.3, 0, 0, 0]})
+    assert outside["in_frame"] is False and "outside the frame box" in outside["message"]
+
+
+def test_workspace_slice_is_the_library_s(cdpr):
+    api, model = cdpr
+    robot = load_cdpr_model("fastkit")
+    got = api.workspace({"model": model, "plane": "xz", "offset": 0.0, "n": [9, 5]})
+    pts = np.array([[x, 0.0, z] for z in got["b"] for x in got["a"]])
+    want = wrench_feasible_workspace(robot, pts)
+    np.testing.assert_array_equal(np.ravel(got["feasible"]), want.feasible)
+    np.testing.assert_array_equal(np.ravel(got["feasible_tipping"]), want.feasible_tipping)
+    assert any(np.ravel(got["feasible"])) and not all(np.ravel(got["feasible"]))
+
+
+def test_stabilisers_and_model_yaml(cdpr):
+    api, model = cdpr
+    pose = [0.0, 0.0, 0.8, 0.0, 0.0, 0.0]
+    out = api.yaml({"model": model, "pose": pose, "stabilisers": True})
+    assert "--pose 0 0 0.8" in out["yaml"] and "--stabilisers" in out["yaml"]
+    back = yaml.safe_load(out["yaml"])
+    assert back == model
+    with pytest.raises(TautError, match="^n: "):
+        api.workspace({"model": model, "n": [1000, 1000]})
