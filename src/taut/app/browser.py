@@ -94,9 +94,20 @@ def drag(driver: Any, css: str, moves: list[tuple[int, int]], step_ms: int = 16)
     from selenium.webdriver.common.actions.action_builder import ActionBuilder
     from selenium.webdriver.common.by import By
 
-    ab = ActionBuilder(driver, duration=step_ms)
-    ab.pointer_action.move_to(driver.find_element(By.CSS_SELECTOR, css)).pointer_down()
-    for dx, dy in moves:
-        ab.pointer_action.move_by(dx, dy)
-    ab.pointer_action.pointer_up()
-    ab.perform()
+    from selenium.common.exceptions import StaleElementReferenceException
+
+    for attempt in range(3):
+        # The page may redraw the element between finding it and pressing on it (an
+        # answer to an earlier request arriving): find it again and retry the press.
+        ab = ActionBuilder(driver, duration=step_ms)
+        ab.pointer_action.move_to(driver.find_element(By.CSS_SELECTOR, css)).pointer_down()
+        for dx, dy in moves:
+            ab.pointer_action.move_by(dx, dy)
+        ab.pointer_action.pointer_up()
+        try:
+            ab.perform()
+            return
+        except StaleElementReferenceException:
+            if attempt == 2:
+                raise
+            driver.execute_script("return 0")        # let the page finish its redraw
