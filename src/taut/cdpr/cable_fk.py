@@ -160,8 +160,9 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     initial_guess : array_like (6,) or (B, 6), optional
         Start pose(s); default the centre of the desired workspace, level.
     restarts : int
-        Seeded random restarts (in the frame box, |angles| < 0.3 rad) for samples that did
-        not converge (or, with ``all_solutions``, for every sample).
+        Seeded random restarts for samples that did not converge, alternately near the best
+        pose so far (0.05 m, 0.1 rad) and anywhere in the frame box (|angles| < 0.3 rad);
+        with ``all_solutions``, frame-box restarts for every sample.
     seed : int
     all_solutions : bool
         Run every restart and count distinct solutions in ``n_solutions``.
@@ -202,12 +203,16 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     sols = [(p, R, res)]
     rng = np.random.default_rng(seed)
     lo, hi = robot.bounds
-    for _ in range(int(restarts)):
+    for j in range(int(restarts)):
         todo = np.arange(B) if all_solutions else np.nonzero(res > FK_RESIDUAL_TOL)[0]
         if todo.size == 0:
             break
-        ps = rng.uniform(lo, hi, (todo.size, 3))
-        Rs = rotation_matrices(rng.uniform(-0.3, 0.3, (todo.size, 3)))
+        if j % 2 == 0 and not all_solutions:     # near the best pose: escapes a shallow trap
+            ps = p[todo] + rng.normal(0.0, 0.05, (todo.size, 3))
+            Rs = so3_exp(rng.normal(0.0, 0.1, (todo.size, 3))) @ R[todo]
+        else:                                    # anywhere in the frame box
+            ps = rng.uniform(lo, hi, (todo.size, 3))
+            Rs = rotation_matrices(rng.uniform(-0.3, 0.3, (todo.size, 3)))
         p2, R2, r2, i2 = _solve(exits[todo], robot.attach_local, lengths_arr[todo], ps, Rs)
         if all_solutions:
             pf, Rf = np.full_like(p, np.nan), np.full_like(R, np.nan)

@@ -77,8 +77,8 @@ class DynamicsModel:
         rad/s at the motor (*assumed* 5 rad/s).
     drive_speed_gain, drive_integral_gain : float
         Proportional (N m s/rad) and integral (N m/rad) gains of the servo drive's speed loop,
-        used when a controller sends speed set-points (*assumed* 9e-3 and 0.45: a ~200 rad/s
-        speed-loop bandwidth for the rotor inertia above).
+        used when a controller sends speed set-points (*assumed* 0.027 and 4: a ~420 rad/s
+        speed-loop bandwidth ``eta K / J`` for the rotor inertia above).
     """
 
     cable_stiffness: float = 2.0e4
@@ -93,8 +93,8 @@ class DynamicsModel:
     friction_coulomb: float = 0.015
     friction_viscous: float = 2.0e-5
     stribeck_speed: float = 5.0
-    drive_speed_gain: float = 9.0e-3
-    drive_integral_gain: float = 0.45
+    drive_speed_gain: float = 0.027
+    drive_integral_gain: float = 4.0
 
     def __post_init__(self) -> None:
         positive = ("cable_stiffness", "drum_diameter", "gear_ratio", "efficiency",

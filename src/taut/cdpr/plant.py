@@ -15,6 +15,12 @@ without losses its energy error stays bounded (no drift), which the tests check 
 is stable while ``omega_max h < 2`` for the stiffest mode ``omega_max`` of the linearised
 platform-cable-rotor system; :func:`stiffest_mode` computes it, and a step with
 ``omega_max h > taut.cdpr._dyn_tol.STABILITY_OMEGA_H`` is refused before the run.
+
+Energy: with no damping, friction or efficiency loss and constant motor torques the model is
+conservative up to one term: the strain energy ``EA (L - L0)^2 / (2 L0)`` of a cable whose
+unstretched length changes pulls the drum with ``T + T^2 / (2 EA)`` while the model (like
+the real drum) feels ``T``; for FASTKIT ``T / EA ~ 1e-3``, so total energy is conserved to
+~2e-5 relative over 2 s (tests/cdpr/test_dynamics_sim.py).
 """
 
 from __future__ import annotations
@@ -216,7 +222,8 @@ def stiffest_mode(plant: Plant, state: PlantState, exits: np.ndarray) -> float:
 def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.ndarray
                   ) -> PlantState:
     """Every plant at rest in elastic static equilibrium with unstretched lengths ``L0``
-    (B, m), found by Newton's method on the force and moment balance from the pose ``guess``
+    (B, m) under gravity (the external wrench, a disturbance, starts acting at the first
+    step), found by Newton's method on the force and moment balance from the pose ``guess``
     (6,) of P; drives initialised to hold the tensions."""
     B = plant.B
     R0 = np.repeat(rotation_matrices(guess[None, 3:]), B, axis=0)
@@ -228,8 +235,8 @@ def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.nda
     def residual(st: PlantState) -> np.ndarray:
         T, u, r = plant.cables(st, exits, zero_v)
         Tu = u * T[:, None, :]
-        F = Tu.sum(axis=2) + plant.mass[:, None] * plant.g + plant.f_ext
-        M = np.cross(r, Tu, axis=1).sum(axis=2) + plant.m_ext
+        F = Tu.sum(axis=2) + plant.mass[:, None] * plant.g
+        M = np.cross(r, Tu, axis=1).sum(axis=2)
         return np.hstack([F, M])
 
     eps = 1e-7
@@ -242,7 +249,7 @@ def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.nda
             dx = np.zeros((B, 6))
             dx[:, j] = eps
             Jac[:, :, j] = (residual(_moved(s, dx)) - res) / eps
-        step = -np.linalg.solve(Jac, res[..., None])[..., 0]
+        step = -np.einsum("bij,bj->bi", np.linalg.pinv(Jac), res)   # robust if singular
         s = _moved(s, step)
     T, _, _ = plant.cables(s, exits, zero_v)
     d = plant.dyn

@@ -85,6 +85,8 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
                           ctx.ref_poses[0])
     h = dt / int(substeps)
     w_max = stiffest_mode(plant, state, ex0)
+    w_drive = dyn.efficiency * dyn.drive_speed_gain / dyn.rotor_inertia   # speed-loop pole
+    w_max = max(w_max, w_drive) if controller.mode == "speed" else w_max
     if w_max * h > STABILITY_OMEGA_H:
         need = w_max / STABILITY_OMEGA_H / int(substeps)
         raise InvalidInputError("control_rate", f"{rate:g} Hz with {int(substeps)} substep(s) "
