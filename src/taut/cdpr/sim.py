@@ -81,8 +81,7 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
         external_wrench = as_array(external_wrench, "external_wrench", shape=(6,))
     plant = Plant(robot, dyn, perts, external_wrench)
     ex0 = geo.exits[0].T
-    state = initial_state(plant, ex0, ctx.L0[0][None] - plant.length_offsets,
-                          ctx.ref_poses[0])
+    state = initial_state(plant, ex0, _parked_lengths(plant, ex0, ctx), ctx.ref_poses[0])
     h = dt / int(substeps)
     w_max = stiffest_mode(plant, state, ex0)
     w_drive = dyn.efficiency * dyn.drive_speed_gain / dyn.rotor_inertia   # speed-loop pole
@@ -94,6 +93,19 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
                                 f"stiffest mode ({w_max:.0f} rad/s) needs a rate of at least "
                                 f"{need:.0f} Hz (or more substeps)")
     return _Setup(robot, dyn, times, ctx, geo, plant, state, h, int(substeps), k0)
+
+
+def _parked_lengths(plant: Plant, exits: np.ndarray, ctx: ControlContext) -> np.ndarray:
+    """Unstretched lengths (B, m) of each plant parked at the reference start pose with the
+    reference tensions on its *actual* geometry (tension-based homing): the run starts near
+    equilibrium whatever the exit errors, and the geometry errors act through the control
+    law (the velocity law drives the encoder lengths to its nominal set-points)."""
+    from .kinematics import rotation_matrices
+    R0 = rotation_matrices(ctx.ref_poses[:1, 3:])[0]
+    att = ctx.ref_poses[0, :3, None] + R0 @ plant.robot.attach_local.T      # (3, m)
+    L = np.linalg.norm(exits[None] + plant.exit_offsets - att[None], axis=1)  # (B, m)
+    EA = plant.dyn.cable_stiffness
+    return EA * L / (EA + ctx.tensions[0])
 
 
 def _measure(setup: _Setup) -> Measurement:

@@ -22,6 +22,7 @@ from ..cdpr import (available_wrench_set, axis_capacities, capacity_margin,
 from ..errors import InvalidInputError
 from ._cdpr_common import Vec3, load_robot
 from .cdpr_motion import add_commands
+from .cdpr_sim import add_simulate
 
 __all__ = ["register"]
 
@@ -283,4 +284,5 @@ def register(app: typer.Typer) -> None:
         _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep)
 
     add_commands(sub)
+    add_simulate(sub)
     app.add_typer(sub, name="cdpr")
