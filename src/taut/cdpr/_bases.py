@@ -52,8 +52,9 @@ def _transforms(robot: CableRobot, base_poses: np.ndarray) -> tuple[np.ndarray, 
 def moved_exits(robot: CableRobot, base_poses: np.ndarray) -> np.ndarray:
     """World exit points (B, m, 3), m, with the bases at ``base_poses`` (B, K, 3)."""
     Rz, t = _transforms(robot, base_poses)
-    Rc = Rz[:, robot.cable_base]                       # (B, m, 3, 3)
-    return np.einsum("bmij,mj->bmi", Rc, robot.exits_world) + t[:, robot.cable_base]
+    cb = np.asarray(robot.cable_base, dtype=np.intp)
+    Rc = Rz[:, cb]                                     # (B, m, 3, 3)
+    return np.einsum("bmij,mj->bmi", Rc, robot.exits_world) + t[:, cb]
 
 
 def moved_edges(robot: CableRobot, base_poses: np.ndarray
@@ -65,7 +66,7 @@ def moved_edges(robot: CableRobot, base_poses: np.ndarray
     vertical, so the weight moments do not change; they are returned broadcast for clarity.
     """
     Rz, t = _transforms(robot, base_poses)
-    eb = robot.edge_base
+    eb = np.asarray(robot.edge_base, dtype=np.intp)
     pts = np.einsum("beij,ej->bei", Rz[:, eb], robot.edge_points) + t[:, eb]
     dirs = np.einsum("beij,ej->bei", Rz[:, eb], robot.edge_dirs)
     m0 = np.broadcast_to(robot.edge_weight_moment, (base_poses.shape[0], robot.n_edges))

@@ -90,7 +90,7 @@ class ModelErrors:
         """Draw this plant's errors for ``robot`` (deterministic in ``seed``)."""
         rng = np.random.default_rng(int(self.seed))
         ex = rng.normal(0.0, 1.0, (robot.m, 3)) * self.exit_offset
-        ln = rng.normal(0.0, 1.0, robot.m) * self.length_offset
+        ln = np.asarray(rng.normal(0.0, 1.0, robot.m)) * self.length_offset
         return PlantPerturbation(ex, ln, self.friction_scale, self.mass_scale)
 
 

@@ -268,8 +268,8 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
     Examples
     --------
     >>> from taut.io.cdpr_model import load_cdpr_model
-    >>> from taut.cdpr import pick_and_place, VelocityController
-    >>> robot = load_cdpr_model("fastkit")
+    >>> from taut.cdpr import pick_and_place, VelocityController, with_stabilisers
+    >>> robot = with_stabilisers(load_cdpr_model("fastkit"))  # task mode: stabilisers down
     >>> ref = pick_and_place(robot, [[-0.5, 0, 1.0], [0.5, 0, 1.0]], dwell=0.1)
     >>> run = simulate(robot, ref, VelocityController())
     >>> run.success, bool(run.tracking_error.max() < 1e-3)

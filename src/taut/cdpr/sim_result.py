@@ -118,10 +118,11 @@ class MonteCarloResult:
 
 
 def _edge_names(robot: Any) -> tuple[str, ...]:
-    out, count = [], {}
+    out: list[str] = []
+    count: dict[int, int] = {}
     for b in robot.edge_base:
-        count[b] = count.get(b, 0) + 1
-        out.append(f"{robot.bases[int(b)].name} edge {count[b]}")
+        count[int(b)] = count.get(int(b), 0) + 1
+        out.append(f"{robot.bases[int(b)].name} edge {count[int(b)]}")
     return tuple(out)
 
 
