@@ -19,6 +19,7 @@ import numpy as np
 
 from taut.cdpr import (ModelErrors, TorqueController, VelocityController, monte_carlo,
                        pick_and_place, simulate, with_stabilisers)
+from taut.cdpr.sim import _loop_numba, _prepare
 from taut.io.cdpr_model import load_cdpr_model
 
 WAYPOINTS = [[-1.5, 0.0, 0.6], [-1.5, 0.0, 1.1], [1.5, 0.0, 1.1], [1.5, 0.0, 0.6]]
@@ -46,26 +47,27 @@ def main() -> None:
     ctls = {"velocity": VelocityController(), "torque": TorqueController()}
     for c in ctls.values():                                    # compile / warm up
         simulate(robot, ref, c, model_errors=errs, engine="numba", duration=0.2)
-    # set-up alone: a run of one control step
-    setup_t = []
+    setup_t, loop_t = [], {name: [] for name in ctls}
     rates: dict[tuple[str, str], list[float]] = {}
     for _ in range(args.repeats):                              # interleaved
-        setup_t.append(timed(lambda: simulate(robot, ref, ctls["torque"], model_errors=errs,
-                                              engine="numba", duration=1e-3, settle=0.0))[0])
         for name, c in ctls.items():
+            dt_s, setup = timed(lambda: _prepare(robot, ref, c, errs, None, 1000.0, None, None,
+                                                 1, None, 1.0))
+            setup_t.append(dt_s)
+            loop_t[name].append(timed(lambda: _loop_numba(setup, c, 1, 1))[0])
             for eng in ("numba", "numpy"):
                 dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, engine=eng))
                 rates.setdefault((name, eng), []).append(sim_s / dt)
     print(f"FASTKIT pick-and-place, {ref.duration:.2f} s + 1 s pre-roll = {sim_s:.2f} s "
           "simulated at 1 kHz (median of", args.repeats, "interleaved runs)")
     print(f"  set-up of one run (reference tensions, context, equilibrium): "
-          f"{1e3 * statistics.median(setup_t):.0f} ms")
+          f"{1e3 * statistics.median(setup_t):.0f} ms [{1e3 * min(setup_t):.0f} .. "
+          f"{1e3 * max(setup_t):.0f}]")
     print("  real-time factor (simulated s per wall s, whole call):")
     for (name, eng), xs in rates.items():
         print(f"    {name:8s} {eng:6s} {fmt(xs)}")
     for name in ctls:
-        loop = [sim_s / (sim_s / r - statistics.median(setup_t)) for r in rates[(name, "numba")]]
-        print(f"    {name:8s} numba loop only {fmt(loop)}")
+        print(f"    {name:8s} numba loop only {fmt([sim_s / x for x in loop_t[name]])}")
     # Monte Carlo
     seeds = [ModelErrors(exit_offset=0.005, seed=s) for s in range(args.runs)]
     for name, c in ctls.items():

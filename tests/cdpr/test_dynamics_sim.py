@@ -204,3 +204,23 @@ def test_numba_and_numpy_engines_agree(fk_stab):
         assert np.abs(a.poses - b.poses).max() < 1e-9
         assert np.abs(a.tensions - b.tensions).max() < 1e-6
         assert np.abs(a.motor_torques - b.motor_torques).max() < 1e-9
+
+
+def test_tipping_monitor_moving_and_static_paths_agree(fk_stab):
+    from taut.cdpr import cable_state
+    from taut.cdpr.monitors import tipping_margins
+    g = np.random.default_rng(2)
+    P = np.column_stack([g.uniform(-1, 1, 30), np.zeros(30), g.uniform(0.7, 1.3, 30),
+                         g.uniform(-0.1, 0.1, (30, 3))])
+    st = cable_state(fk_stab, P)
+    t = g.uniform(5, 45, (30, fk_stab.m))
+    bp = np.repeat(np.array([b.pose for b in fk_stab.bases])[None], 30, axis=0)
+    ex = np.broadcast_to(fk_stab.exits_world, (30, fk_stab.m, 3)).copy()
+    static = tipping_margins(fk_stab, ex, st.unit, t, bp)
+    ex2 = ex.copy()
+    ex2[1:] += 0.0                                   # identical values, moving code path:
+    bp2 = bp.copy()
+    bp2[1:, 1, 2] += 2 * np.pi                       # same poses, not equal numbers
+    moving = tipping_margins(fk_stab, ex2, st.unit, t, bp2)
+    ref = -tipping_moments(fk_stab, P, t).moments
+    assert np.allclose(static, ref, atol=1e-9) and np.allclose(moving, ref, atol=1e-9)

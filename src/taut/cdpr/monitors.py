@@ -62,12 +62,23 @@ def tipping_margins(robot: CableRobot, exits: np.ndarray, unit: np.ndarray,
     """
     if robot.n_edges == 0:
         return np.zeros((tensions.shape[0], 0))
-    pts, dirs, m0 = moved_edges(robot, base_poses)                     # (T, E, 3)
-    same = robot.edge_base[:, None] == robot.cable_base[None, :]       # (E, m)
-    lever = pts[:, :, None, :] - exits[:, None, :, :]                  # (T, E, m, 3)
-    mom = np.einsum("tek,temk->tem", dirs,
-                    np.cross(lever, unit[:, None, :, :] * tensions[:, None, :, None]))
-    return -(np.einsum("tem,em->te", mom, same) + m0)
+    same = (robot.edge_base[:, None] == robot.cable_base[None, :]).astype(float)   # (E, m)
+    static = bool(np.all(base_poses == base_poses[:1]) and np.all(exits == exits[:1]))
+    if static:                       # u_Cj . ((c_j - b_i) x u_i) = u_i . (u_Cj x (c_j - b_i))
+        pts, dirs, m0 = moved_edges(robot, base_poses[:1])
+        V = np.cross(dirs[0][:, None, :], pts[0][:, None, :] - exits[0][None, :, :])
+        coef = np.einsum("emk,tmk->tem", V * same[:, :, None], unit)
+    else:
+        pts, dirs, m0 = moved_edges(robot, base_poses)                     # (T, E, 3)
+        lever = pts[:, :, None, :] - exits[:, None, :, :]                  # (T, E, m, 3)
+        d = dirs[:, :, None, :]
+        V0 = d[..., 1] * lever[..., 2] - d[..., 2] * lever[..., 1]
+        V1 = d[..., 2] * lever[..., 0] - d[..., 0] * lever[..., 2]
+        V2 = d[..., 0] * lever[..., 1] - d[..., 1] * lever[..., 0]
+        coef = (V0 * unit[:, None, :, 0] + V1 * unit[:, None, :, 1]
+                + V2 * unit[:, None, :, 2]) * same[None]
+    return -(np.einsum("tem,tm->te", coef, tensions) + m0[:1] if static else
+             np.einsum("tem,tm->te", coef, tensions) + m0)
 
 
 def episodes(times: np.ndarray, values: np.ndarray, bad: np.ndarray, kind: str,
