@@ -41,6 +41,10 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
          k_start: int, diverged: np.ndarray) -> None:
     """Run every plant through every control step (arrays as in the numpy engine).
 
+    Longer than 80 lines on purpose: measurement, both control laws and the monitors are
+    one compiled loop nest over (step, plant) that mirrors the numpy engine line by line;
+    the plant step is split out (:func:`_plant_step`).
+
     ``rec`` (T // rec_every, Brec, 12 + 3m) receives x_c, R (row-major), tensions, torques and
     speeds before every ``rec_every``-th step of the first Brec plants; ``summ`` (B, 6)
     accumulates per plant from step ``k_start`` on: max |p - p_ref|, sum |p - p_ref|^2, min and max tension, slack
@@ -159,7 +163,9 @@ def _plant_step(b: int, mode: int, cmd: np.ndarray, tau: np.ndarray, T: np.ndarr
                 vc: np.ndarray, R: np.ndarray, wb: np.ndarray, L0: np.ndarray,
                 speed: np.ndarray, integ: np.ndarray, h: float, rec: np.ndarray, k: int,
                 first: bool) -> None:
-    """One semi-implicit Euler step of plant ``b`` (see :meth:`taut.cdpr.plant.Plant.step`)."""
+    """One semi-implicit Euler step of plant ``b`` (see :meth:`taut.cdpr.plant.Plant.step`).
+    Long because it is written out in scalars for numba (cable forces, drive, rigid body,
+    winches); each block mirrors one line of the numpy version."""
     m = L0.shape[1]
     w = np.zeros(3)
     for i in range(3):
