@@ -98,3 +98,17 @@ def test_dynamics_section_of_the_presets():
         dynamics_from_mapping({"cable_stiffness": 0.0})
     with pytest.raises(ScenarioError, match="dynamics.typo"):
         dynamics_from_mapping({"typo": 1.0})
+
+
+def test_cli_simulate_from_a_reference_csv(capsys, tmp_path, fastkit):
+    ref = pick_and_place(with_stabilisers(fastkit), [[-0.2, 0, 0.9], [0.2, 0, 0.9]], dwell=0.1,
+                         rate=100.0)
+    path = tmp_path / "ref.csv"
+    write_reference_csv(ref, path)
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--reference", str(path), "--controller", "torque")
+    assert code == 0, err
+    assert "torque control over" in text
+    code, _, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--reference",
+                        str(tmp_path / "missing.csv"))
+    assert code == 2 and err.startswith("taut: error:")
