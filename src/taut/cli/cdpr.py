@@ -21,6 +21,7 @@ from ._cdpr_common import MODEL_HELP, Vec3, load_robot, pose_vector
 from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 from .cdpr_motion import add_commands
+from .cdpr_sim import add_simulate
 
 __all__ = ["register"]
 
@@ -263,4 +264,5 @@ def register(app: typer.Typer) -> None:
         _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep)
 
     add_commands(sub)
+    add_simulate(sub)
     app.add_typer(sub, name="cdpr")

@@ -89,6 +89,8 @@ class _ModelFile(_Strict):
     cables: list[_Cable] = Field(min_length=1)
     bounds: _Box | None = None
     desired_workspace: _Box | None = None
+    # Elastic cables and winches, read by taut.io.cdpr_dynamics (validated there).
+    dynamics: dict[str, Any] | None = None
 
 
 def _file_field(exc: TautError, raw: _ModelFile) -> str:

@@ -1,0 +1,149 @@
+"""`taut cdpr simulate`: a controller driving the cable robot along a pick-and-place or CSV
+reference (FASTKIT paper §2.2), with seeded exit-point errors; prints the tracking error,
+tension extremes, slack time and limit episodes; optional JSON, figure and 3D animation.
+
+Exit codes: 0 every monitor clean; 1 the run violated a limit or the plant diverged (one
+line on stderr says so); 2 bad input.
+"""
+
+from __future__ import annotations
+
+import sys
+from enum import Enum
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+
+from ..cdpr import ModelErrors, pick_and_place, simulate
+from ..cdpr.controllers import CONTROLLERS
+from ..errors import InvalidInputError
+from ..io.cdpr_dynamics import load_cdpr_dynamics
+from ..io.cdpr_reference import read_reference_csv
+from ..io.files import write_json
+from ..io.serialize_cdpr_sim import control_result_to_dict
+from ._cdpr_common import load_robot
+
+__all__ = ["add_simulate"]
+
+
+class Profile(str, Enum):
+    quintic = "quintic"
+    trapezoidal = "trapezoidal"
+
+
+def _waypoints(text: str) -> np.ndarray:
+    """``"x,y,z; x,y,z; ..."`` -> (W, 3)."""
+    try:
+        pts = [[float(v) for v in part.replace(" ", ",").split(",") if v != ""]
+               for part in text.split(";") if part.strip()]
+    except ValueError:
+        raise InvalidInputError("--waypoints", "must be 'x,y,z; x,y,z; ...' in m") from None
+    if len(pts) < 2 or any(len(p) != 3 for p in pts):
+        raise InvalidInputError("--waypoints", "needs at least two 'x,y,z' points in m, "
+                                               "separated by ';'")
+    arr = np.array(pts)
+    if not np.all(np.isfinite(arr)):
+        raise InvalidInputError("--waypoints", "contains NaN or infinite values")
+    return arr
+
+
+def _check_out(path: Optional[Path], opt: str, suffixes: tuple[str, ...]) -> None:
+    if path is None:
+        return
+    if path.suffix.lower() not in suffixes:
+        raise InvalidInputError(opt, f"{path}: must end in {' or '.join(suffixes)}")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise InvalidInputError(opt, f"{path}: directory {parent} does not exist")
+
+
+def add_simulate(sub: typer.Typer) -> None:
+    """Add ``simulate`` to the ``cdpr`` sub-application."""
+
+    @sub.command("simulate")
+    def simulate_cmd(
+        model: str = typer.Argument(..., help="Preset name (fastkit, ipanema) or model file."),
+        waypoints: Optional[str] = typer.Option(
+            None, "--waypoints", help="Pick-and-place waypoints 'x,y,z; x,y,z; ...' (m)."),
+        reference: Optional[Path] = typer.Option(
+            None, "--reference", help="CSV reference: time,x,y,z,roll,pitch,yaw (s, m, rad)."),
+        controller: str = typer.Option("torque", "--controller", help="velocity or torque."),
+        exit_error: float = typer.Option(0.0, "--exit-error",
+                                         help="Std. dev. of seeded exit-point errors, mm."),
+        seed: int = typer.Option(0, "--seed", help="Seed of the model errors."),
+        speed: float = typer.Option(1.0, "--speed", help="Pick-and-place speed, m/s."),
+        profile: Profile = typer.Option(Profile.quintic, "--profile"),
+        dwell: float = typer.Option(0.5, "--dwell", help="Rest at each waypoint, s."),
+        control_rate: float = typer.Option(1000.0, "--control-rate", help="Hz."),
+        stabilisers: bool = typer.Option(False, "--stabilisers",
+                                         help="Deploy the stabilisers of mobile bases."),
+        json_out: Optional[Path] = typer.Option(None, "--json", help="Write the result."),
+        plot: Optional[Path] = typer.Option(None, "--plot", help="Figure (PNG/PDF)."),
+        animate: Optional[Path] = typer.Option(None, "--animate", help="3D animation (GIF)."),
+    ) -> None:
+        """Simulate velocity or torque control of the cable robot (FASTKIT §2.2)."""
+        if controller not in CONTROLLERS:
+            raise InvalidInputError("--controller", f"unknown controller {controller!r}; "
+                                                    "choose velocity or torque")
+        if (waypoints is None) == (reference is None):
+            raise InvalidInputError("--waypoints", "give exactly one of --waypoints and "
+                                                   "--reference")
+        if not (np.isfinite(exit_error) and exit_error >= 0):
+            raise InvalidInputError("--exit-error", "must be a non-negative number of mm")
+        _check_out(json_out, "--json", (".json",))
+        _check_out(plot, "--plot", (".png", ".pdf", ".svg"))
+        _check_out(animate, "--animate", (".gif",))
+        robot = load_robot(model, stabilisers)
+        dyn = load_cdpr_dynamics(model)
+        if waypoints is not None:
+            ref = pick_and_place(robot, _waypoints(waypoints), speed, profile=profile.value,
+                                 dwell=dwell)
+        else:
+            ref = read_reference_csv(robot, reference)  # type: ignore[arg-type]
+        errs = ModelErrors(exit_offset=exit_error * 1e-3, seed=seed)
+        ctl = CONTROLLERS[controller]()
+        run = _run(robot, ref, ctl, errs, control_rate, dyn)
+        if json_out is not None:
+            write_json(control_result_to_dict(run), json_out)
+        if plot is not None:
+            from ..viz.cdpr_sim import plot_control
+            plot_control(run, plot)
+        if animate is not None:
+            from ..viz.cdpr_sim import animate_control
+            animate_control(robot, run, animate)
+        _report(run, json_out, plot, animate)
+        if not run.success:
+            print(f"taut: {run.status}: {run.message}", file=sys.stderr)
+            raise typer.Exit(1)
+
+
+def _run(robot, ref, ctl, errs, rate, dyn):
+    """simulate() with a progress bar on a terminal."""
+    if not sys.stderr.isatty():
+        return simulate(robot, ref, ctl, model_errors=errs, control_rate=rate, dynamics=dyn)
+    from rich.progress import Progress
+    with Progress(transient=True) as bar:
+        task = bar.add_task(f"{ctl.name} control", total=1)
+        return simulate(robot, ref, ctl, model_errors=errs, control_rate=rate, dynamics=dyn,
+                        progress=lambda d, t: bar.update(task, completed=d, total=t))
+
+
+def _report(run, json_out, plot, animate) -> None:
+    typer.echo(f"{run.controller['name']} control over {run.times[-1]:.2f} s: {run.status}")
+    typer.echo(f"  tracking error: max {1e3 * run.tracking_error.max():.3f} mm, rms "
+               f"{1e3 * np.sqrt(np.mean(run.tracking_error ** 2)):.3f} mm")
+    typer.echo(f"  tensions: {run.tensions.min():.2f} .. {run.tensions.max():.2f} N "
+               f"(limits {run.t_min.min():g} .. {run.t_max.max():g} N)")
+    typer.echo(f"  slack time {run.slack_time:.3f} s, worst over-tension "
+               f"{max(run.worst_over_tension, 0.0):.2f} N")
+    if run.tipping_margin.shape[1]:
+        typer.echo(f"  minimum tipping margin {run.tipping_margin.min():.2f} N m")
+    for e in run.events[:10]:
+        typer.echo(f"  event: {e.describe()}")
+    if len(run.events) > 10:
+        typer.echo(f"  ... {len(run.events) - 10} more events")
+    for label, p in (("result", json_out), ("figure", plot), ("animation", animate)):
+        if p is not None:
+            typer.echo(f"{label} written to {p}")

@@ -1,0 +1,114 @@
+"""`taut cdpr simulate`, reference CSV files and the dynamics section of model files."""
+
+import json
+
+import numpy as np
+import pytest
+
+from taut.cdpr import pick_and_place, with_stabilisers
+from taut.cli import main
+from taut.io.cdpr_dynamics import dynamics_from_mapping, load_cdpr_dynamics
+from taut.io.cdpr_reference import read_reference_csv, write_reference_csv
+from taut.errors import InvalidInputError, InvalidModelError, ScenarioError
+
+WP = "-0.3,0,1.0; 0.3,0,1.0"
+
+
+def _cli(capsys, *args):
+    code = main(list(args))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_cli_simulate_writes_the_result_fields(capsys, tmp_path):
+    out = tmp_path / "run.json"
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--waypoints", WP, "--controller", "torque", "--dwell", "0.1",
+                           "--json", str(out))
+    assert code == 0, err
+    assert "tracking error" in text and "written to" in text
+    data = json.loads(out.read_text())
+    for key in ("times", "poses", "reference", "tracking_error", "tensions", "motor_torques",
+                "tipping_margin", "events", "success", "status", "message"):
+        assert key in data
+    assert data["status"] == "ok" and len(data["poses"][0]) == 6
+    assert max(data["tracking_error"]) < 1e-3
+
+
+def test_cli_velocity_control_with_exit_errors_answers_no(capsys):
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--waypoints", WP, "--controller", "velocity", "--exit-error", "5",
+                           "--dwell", "0.1")
+    assert code == 1
+    assert "slack" in text or "over_tension" in text
+    assert len(err.strip().splitlines()) == 1 and err.startswith("taut: infeasible:")
+
+
+@pytest.mark.parametrize("args, field", [
+    (["--waypoints", WP, "--controller", "pid"], "--controller"),
+    (["--waypoints", "0,0,1.0; 9,0,1.0"], "waypoints[1]"),
+    (["--waypoints", "0,0,1.0"], "--waypoints"),
+    (["--waypoints", "0,0,nan; 1,0,1"], "--waypoints"),
+    (["--waypoints", WP, "--speed", "0"], "speed"),
+    (["--waypoints", WP, "--control-rate", "20"], "control_rate"),
+    (["--waypoints", WP, "--exit-error", "-1"], "--exit-error"),
+    (["--waypoints", WP, "--json", "/no/such/dir/x.json"], "--json"),
+    (["--waypoints", WP, "--animate", "x.png"], "--animate"),
+    ([], "--waypoints"),
+])
+def test_cli_bad_input_is_one_line_exit_2(capsys, args, field):
+    code, _, err = _cli(capsys, "cdpr", "simulate", "fastkit", *args)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"taut: error: {field}")
+
+
+def test_reference_csv_round_trip(fastkit, tmp_path):
+    robot = with_stabilisers(fastkit)
+    ref = pick_and_place(robot, [[-0.5, 0, 1.0], [0.5, 0.1, 1.2]], rate=200.0)
+    path = tmp_path / "ref.csv"
+    write_reference_csv(ref, path)
+    back = read_reference_csv(robot, path)
+    assert np.allclose(back.poses, ref.poses, atol=1e-8)
+    assert np.abs(back.velocities[5:-5] - ref.velocities[5:-5]).max() < 2e-3   # FD vs exact
+
+
+def test_reference_csv_errors(fastkit, tmp_path):
+    p = tmp_path / "bad.csv"
+    p.write_text("t,x,y,z\n0,0,0,1\n")
+    with pytest.raises(ScenarioError, match="header"):
+        read_reference_csv(fastkit, p)
+    p.write_text("time,x,y,z,roll,pitch,yaw\n0,0,0,1,0,0,0\n1,0,0,1,0,0,0\n1,0,0,1,0,0,0\n")
+    with pytest.raises(InvalidInputError, match="increasing"):
+        read_reference_csv(fastkit, p)
+    p.write_text("time,x,y,z,roll,pitch,yaw\n0,0,0,1,0,0,0\n0.01,500,0,1,0,0,0\n"
+                 "0.02,0,0,1,0,0,0\n")
+    with pytest.raises(Exception, match="frame box|speed"):
+        read_reference_csv(fastkit, p)
+
+
+def test_dynamics_section_of_the_presets():
+    d = load_cdpr_dynamics("fastkit")
+    # FASTKIT Table 1: 0.08 m drum, 5:1, 70 %, 0.6 N m holds 45 N with margin; 2 m/s
+    assert d.drum_diameter == 0.08 and d.gear_ratio == 5.0 and d.efficiency == 0.7
+    assert d.max_cable_tension >= 45.0
+    assert d.max_cable_speed == pytest.approx(2.0)
+    assert load_cdpr_dynamics("ipanema").cable_stiffness == 2e5
+    with pytest.raises(InvalidModelError, match="dynamics.cable_stiffness"):
+        dynamics_from_mapping({"cable_stiffness": 0.0})
+    with pytest.raises(ScenarioError, match="dynamics.typo"):
+        dynamics_from_mapping({"typo": 1.0})
+
+
+def test_cli_simulate_from_a_reference_csv(capsys, tmp_path, fastkit):
+    ref = pick_and_place(with_stabilisers(fastkit), [[-0.2, 0, 0.9], [0.2, 0, 0.9]], dwell=0.1,
+                         rate=100.0)
+    path = tmp_path / "ref.csv"
+    write_reference_csv(ref, path)
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--reference", str(path), "--controller", "torque")
+    assert code == 0, err
+    assert "torque control over" in text
+    code, _, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--reference",
+                        str(tmp_path / "missing.csv"))
+    assert code == 2 and err.startswith("taut: error:")
