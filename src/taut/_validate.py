@@ -99,6 +99,10 @@ MAX_SPEED = 1e3
 MAX_ROBOTS = 1000
 #: Largest number of poses / formations / grid points in one call.
 MAX_BATCH = 10_000_000
+#: Largest control or sampling rate, Hz (1 MHz; FASTKIT's controller runs at 1 kHz).
+MAX_RATE_HZ = 1e6
+#: Longest simulated or dwelt time, s (one day).
+MAX_DURATION_S = 86_400.0
 
 LIMITS: dict[str, tuple[float, str]] = {
     "sheet length": (MAX_SHEET_LENGTH, "sheet units"),
@@ -108,7 +112,28 @@ LIMITS: dict[str, tuple[float, str]] = {
     "speed": (MAX_SPEED, "m/s or rad/s"),
     "robots": (MAX_ROBOTS, "robots"),
     "batch": (MAX_BATCH, "items"),
+    "rate": (MAX_RATE_HZ, "Hz"),
+    "duration": (MAX_DURATION_S, "s"),
 }
+
+
+def as_bounded(value: Any, field: str, limit: float, unit: str, *,
+               positive: bool = True) -> float:
+    """A finite float in ``(0, limit]`` (``[0, limit]`` when ``positive`` is false).
+
+    Examples
+    --------
+    >>> as_bounded(2.0, "speed", MAX_SPEED, "m/s")
+    2.0
+    >>> as_bounded(1e308, "speed", MAX_SPEED, "m/s")
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: speed: 1e+308 exceeds the accepted range 1000 m/s
+    """
+    x = as_positive(value, field) if positive else as_nonnegative(value, field)
+    if x > limit:
+        raise InvalidInputError(field, f"{x:g} exceeds the accepted range {limit:g} {unit}")
+    return x
 
 
 def check_range(arr: Any, field: str, limit: float, unit: str) -> np.ndarray:

@@ -24,7 +24,7 @@ def test_cli_simulate_writes_the_result_fields(capsys, tmp_path):
     out = tmp_path / "run.json"
     code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
                            "--waypoints", WP, "--controller", "torque", "--dwell", "0.1",
-                           "--json", str(out))
+                           "--out", str(out))
     assert code == 0, err
     assert "tracking error" in text and "written to" in text
     data = json.loads(out.read_text())
@@ -52,7 +52,8 @@ def test_cli_velocity_control_with_exit_errors_answers_no(capsys):
     (["--waypoints", WP, "--speed", "0"], "speed"),
     (["--waypoints", WP, "--control-rate", "20"], "control_rate"),
     (["--waypoints", WP, "--exit-error", "-1"], "--exit-error"),
-    (["--waypoints", WP, "--json", "/no/such/dir/x.json"], "--json"),
+    (["--waypoints", WP, "--out", "/proc/no/x.json"], "--out"),
+    (["--waypoints", WP, "--out", "x.txt"], "--out"),
     (["--waypoints", WP, "--animate", "x.png"], "--animate"),
     ([], "--waypoints"),
 ])
@@ -61,6 +62,15 @@ def test_cli_bad_input_is_one_line_exit_2(capsys, args, field):
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"taut: error: {field}")
+
+
+def test_cli_json_flag_prints_valid_json(capsys):
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--waypoints", WP, "--controller", "torque", "--dwell", "0.1",
+                           "--json")
+    assert code == 0, err
+    data = json.loads(text)                       # strict: no NaN / Infinity
+    assert data["status"] == "ok" and data["success"] is True
 
 
 def test_reference_csv_round_trip(fastkit, tmp_path):

@@ -212,6 +212,20 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("cdpr deploy", ["cdpr", "deploy", "fastkit", "--workspace", *ws, "--plot", o])
               for o in outs]
     cases += _sweep_cases(tmp, files, outs)
+    # cdpr simulate: every check comes before the plant is built
+    wp = ["--waypoints", "-0.5,0,1.0; 0.5,0,1.0"]
+    cases += [("cdpr simulate", ["cdpr", "simulate", m, *wp]) for m in models]
+    cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", "--waypoints", w]) for w in
+              ("", "0,0,1", "a,b,c; 1,2,3", "0,0,nan; 1,0,1", "0,0,1;1e308,0,1", "0,0; 1,1")]
+    cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", *wp, opt, v])
+              for opt in ("--speed", "--exit-error", "--control-rate", "--dwell")
+              for v in BAD_NUMBERS + ["-1"]]
+    cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", *wp, "--controller", c])
+              for c in ("", "pid", "VELOCITY")]
+    cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", *wp, opt, o])
+              for opt in ("--plot", "--animate", "--out") for o in outs]
+    cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", "--reference", c])
+              for c in [str(p) for p in _bad_csvs(tmp)]]
     # physics (MuJoCo): every check comes before the model is built
     cases += [("physics", ["physics", f]) for f in files + sheets]
     cases += [("physics", ["physics", sheet, "--plot", o]) for o in outs]
@@ -291,7 +305,8 @@ def test_wrong_input_is_one_line_exit_2(capsys, command, argv):
 def test_every_command_is_fuzzed():
     commands = collections.Counter(c for c, _ in CASES)
     want = {"fk", "ik", "simulate", "plan", "cdpr tensions", "cdpr wrench-set",
-            "cdpr workspace", "cdpr twist-set", "cdpr deploy", "sweep", "physics"}
+            "cdpr workspace", "cdpr twist-set", "cdpr deploy", "sweep", "physics",
+            "cdpr simulate"}
     assert want <= set(commands)
     assert min(commands[c] for c in want) >= 20
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import as_finite_scalar
+from .._validate import as_bounded, as_finite_scalar
 from ..errors import InvalidInputError
 from .model import CableRobot
 
@@ -72,9 +72,9 @@ class ModelErrors:
 
     def __post_init__(self) -> None:
         for name in ("exit_offset", "length_offset"):
-            v = as_finite_scalar(getattr(self, name), f"model_errors.{name}")
-            if v < 0:
-                raise InvalidInputError(f"model_errors.{name}", f"must be >= 0 m, got {v:g}")
+            v = as_bounded(getattr(self, name), f"model_errors.{name}", 1.0, "m "
+                           "(a standard deviation; 1 m is already larger than FASTKIT)",
+                           positive=False)
             object.__setattr__(self, name, v)
         for name in ("friction_scale", "mass_scale"):
             v = as_finite_scalar(getattr(self, name), f"model_errors.{name}")

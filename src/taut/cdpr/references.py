@@ -13,7 +13,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validate import as_array, as_nonnegative, as_positive
+from .._validate import (MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded,
+                         as_nonnegative, as_positive)
 from ..errors import InvalidInputError, InvalidTrajectoryError
 from ._dyn_tol import MAX_REFERENCE_SPEED
 from .kinematics import as_poses
@@ -138,10 +139,10 @@ def pick_and_place(robot: CableRobot, waypoints: Any, speed: float = 1.0, *,
     >>> round(float(np.abs(ref.velocities[:, 0]).max()), 3), round(ref.duration, 3)
     (1.0, 4.35)
     """
-    speed = as_positive(speed, "speed")
-    acceleration = as_positive(acceleration, "acceleration")
-    rate = as_positive(rate, "rate")
-    dwell = as_nonnegative(dwell, "dwell")
+    speed = as_bounded(speed, "speed", MAX_SPEED, "m/s")
+    acceleration = as_bounded(acceleration, "acceleration", 1e3 * MAX_SPEED, "m/s^2")
+    rate = as_bounded(rate, "rate", MAX_RATE_HZ, "Hz")
+    dwell = as_bounded(dwell, "dwell", MAX_DURATION_S, "s", positive=False)
     if profile not in ("quintic", "trapezoidal"):
         raise InvalidInputError("profile", f"unknown profile {profile!r}; choose quintic or "
                                            "trapezoidal")

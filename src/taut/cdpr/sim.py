@@ -14,7 +14,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .._validate import as_array, as_nonnegative, as_positive
+from .._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
+                         as_nonnegative, as_positive)
 from ..errors import InvalidInputError
 from ._dyn_tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H
 from .cable_fk import rpy_from_matrices
@@ -65,10 +66,14 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
     dyn = DynamicsModel() if dynamics is None else dynamics
     if not isinstance(dyn, DynamicsModel):
         raise InvalidInputError("dynamics", "must be a taut.cdpr.DynamicsModel")
-    rate = as_positive(control_rate, "control_rate")
+    rate = as_bounded(control_rate, "control_rate", MAX_RATE_HZ, "Hz")
     if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
         raise InvalidInputError("substeps", f"must be a positive integer, got {substeps!r}")
-    dur = reference.duration if duration is None else as_positive(duration, "duration")
+    dur = reference.duration if duration is None else \
+        as_bounded(duration, "duration", MAX_DURATION_S, "s")
+    if dur * rate > MAX_BATCH:
+        raise InvalidInputError("duration", f"{dur:g} s at {rate:g} Hz is {dur * rate:.3g} "
+                                f"control steps, more than {MAX_BATCH}")
     settle_s = as_nonnegative(settle, "settle")
     dt = 1.0 / rate
     n = max(int(np.ceil(dur * rate - 1e-9)), 1)

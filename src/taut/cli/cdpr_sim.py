@@ -16,14 +16,13 @@ from typing import Optional
 import numpy as np
 import typer
 
-from ..cdpr import ModelErrors, pick_and_place, simulate
-from ..cdpr.controllers import CONTROLLERS
 from ..errors import InvalidInputError
-from ..io.cdpr_dynamics import load_cdpr_dynamics
-from ..io.cdpr_reference import read_reference_csv
-from ..io.files import write_json
-from ..io.serialize_cdpr_sim import control_result_to_dict
 from ._cdpr_common import load_robot
+from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
+from ._progress import working
+
+#: Controllers the command offers (taut.cdpr.controllers.CONTROLLERS, without importing it).
+_CONTROLLERS = ("velocity", "torque")
 
 __all__ = ["add_simulate"]
 
@@ -49,16 +48,6 @@ def _waypoints(text: str) -> np.ndarray:
     return arr
 
 
-def _check_out(path: Optional[Path], opt: str, suffixes: tuple[str, ...]) -> None:
-    if path is None:
-        return
-    if path.suffix.lower() not in suffixes:
-        raise InvalidInputError(opt, f"{path}: must end in {' or '.join(suffixes)}")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise InvalidInputError(opt, f"{path}: directory {parent} does not exist")
-
-
 def add_simulate(sub: typer.Typer) -> None:
     """Add ``simulate`` to the ``cdpr`` sub-application."""
 
@@ -74,27 +63,39 @@ def add_simulate(sub: typer.Typer) -> None:
                                          help="Std. dev. of seeded exit-point errors, mm."),
         seed: int = typer.Option(0, "--seed", help="Seed of the model errors."),
         speed: float = typer.Option(1.0, "--speed", help="Pick-and-place speed, m/s."),
-        profile: Profile = typer.Option(Profile.quintic, "--profile"),
+        profile: Profile = typer.Option(Profile.quintic, "--profile", help="Velocity "
+                                        "profile of each segment: quintic or trapezoidal."),
         dwell: float = typer.Option(0.5, "--dwell", help="Rest at each waypoint, s."),
         control_rate: float = typer.Option(1000.0, "--control-rate", help="Hz."),
         stabilisers: bool = typer.Option(False, "--stabilisers",
                                          help="Deploy the stabilisers of mobile bases."),
-        json_out: Optional[Path] = typer.Option(None, "--json", help="Write the result."),
+        as_json: bool = typer.Option(False, "--json", help="Print the result as JSON "
+                                     "(the result's fields under the same names)."),
+        json_out: Optional[Path] = typer.Option(None, "--out", help="Write the JSON result "
+                                                "to this file (.json)."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Figure (PNG/PDF)."),
         animate: Optional[Path] = typer.Option(None, "--animate", help="3D animation (GIF)."),
     ) -> None:
         """Simulate velocity or torque control of the cable robot (FASTKIT §2.2)."""
-        if controller not in CONTROLLERS:
+        if controller not in _CONTROLLERS:
             raise InvalidInputError("--controller", f"unknown controller {controller!r}; "
                                                     "choose velocity or torque")
         if (waypoints is None) == (reference is None):
             raise InvalidInputError("--waypoints", "give exactly one of --waypoints and "
                                                    "--reference")
-        if not (np.isfinite(exit_error) and exit_error >= 0):
-            raise InvalidInputError("--exit-error", "must be a non-negative number of mm")
-        _check_out(json_out, "--json", (".json",))
-        _check_out(plot, "--plot", (".png", ".pdf", ".svg"))
-        _check_out(animate, "--animate", (".gif",))
+        if not (np.isfinite(exit_error) and 0 <= exit_error <= 1000):
+            raise InvalidInputError("--exit-error", "must be a number of mm in [0, 1000]")
+        output_path(json_out, "--out", JSON_SUFFIXES)
+        output_path(plot, "--plot", FIGURE_SUFFIXES)
+        output_path(animate, "--animate", ANIMATION_SUFFIXES)
+        from ..cdpr import ModelErrors, pick_and_place
+        from ..cdpr.controllers import CONTROLLERS
+        from ..io.cdpr_dynamics import load_cdpr_dynamics
+        from ..io.cdpr_reference import read_reference_csv
+        from ..io.files import write_json
+        from ..io.serialize import to_json
+        from ..io.serialize_cdpr_sim import control_result_to_dict
+
         robot = load_robot(model, stabilisers)
         dyn = load_cdpr_dynamics(model)
         if waypoints is not None:
@@ -107,27 +108,28 @@ def add_simulate(sub: typer.Typer) -> None:
         run = _run(robot, ref, ctl, errs, control_rate, dyn)
         if json_out is not None:
             write_json(control_result_to_dict(run), json_out)
+        if as_json:
+            typer.echo(to_json(control_result_to_dict(run)))
         if plot is not None:
             from ..viz.cdpr_sim import plot_control
             plot_control(run, plot)
         if animate is not None:
             from ..viz.cdpr_sim import animate_control
             animate_control(robot, run, animate)
-        _report(run, json_out, plot, animate)
+        if not as_json:
+            _report(run, json_out, plot, animate)
         if not run.success:
             print(f"taut: {run.status}: {run.message}", file=sys.stderr)
             raise typer.Exit(1)
 
 
 def _run(robot, ref, ctl, errs, rate, dyn):
-    """simulate() with a progress bar on a terminal."""
-    if not sys.stderr.isatty():
-        return simulate(robot, ref, ctl, model_errors=errs, control_rate=rate, dynamics=dyn)
-    from rich.progress import Progress
-    with Progress(transient=True) as bar:
-        task = bar.add_task(f"{ctl.name} control", total=1)
+    """simulate() with progress on stderr (a bar on a terminal, else a line every 10 s)."""
+    from ..cdpr import simulate
+
+    with working(f"cdpr simulate ({ctl.name} control)") as update:
         return simulate(robot, ref, ctl, model_errors=errs, control_rate=rate, dynamics=dyn,
-                        progress=lambda d, t: bar.update(task, completed=d, total=t))
+                        progress=update)
 
 
 def _report(run, json_out, plot, animate) -> None:

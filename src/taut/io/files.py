@@ -155,5 +155,7 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
 
 
 def write_json(obj: Any, path: str | Path) -> None:
-    """Write ``obj`` as indented JSON."""
-    Path(path).write_text(json.dumps(obj, indent=2) + "\n", encoding="utf-8")
+    """Write ``obj`` as indented, valid JSON (non-finite numbers become ``null``)."""
+    from .serialize import to_json
+
+    Path(path).write_text(to_json(obj) + "\n", encoding="utf-8")
