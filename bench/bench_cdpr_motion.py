@@ -19,9 +19,9 @@ import time
 import numpy as np
 
 from taut.cdpr import with_stabilisers
-from taut.cdpr.deploy import plan_deployment
-from taut.cdpr.redundancy import resolve_redundancy
-from taut.cdpr.twist import available_twist_set, twist_capacities
+from taut.cdpr import plan_deployment
+from taut.cdpr import resolve_redundancy
+from taut.cdpr import available_twist_set, twist_capacities
 from taut.io.cdpr_model import load_cdpr_model
 
 

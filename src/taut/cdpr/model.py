@@ -188,6 +188,14 @@ class Base:
         """Map base-frame points ``(..., 3)`` to world coordinates, m."""
         return local @ self.rotation.T + np.array([self.pose[0], self.pose[1], 0.0])
 
+    def support_world(self) -> np.ndarray:
+        """(p, 3) support polygon in the world (z = 0), counter-clockwise; (0, 3) for a
+        fixed frame."""
+        poly = self.support_polygon
+        if poly is None:
+            return np.zeros((0, 3))
+        return self.to_world(np.column_stack([poly, np.zeros(len(poly))]))
+
     @property
     def support_polygon(self) -> np.ndarray | None:
         """(p, 2) counter-clockwise support polygon in the base frame (None when fixed)."""
@@ -325,6 +333,19 @@ class CableRobot:
     bounds: Any = None
     desired_workspace: Any = None
     name: str = "cable robot"
+    # Derived fields, filled by __post_init__ (declared so that type checkers see them).
+    m: int = field(init=False)
+    dof: int = field(init=False)
+    exits_world: np.ndarray = field(init=False, repr=False)
+    attach_local: np.ndarray = field(init=False, repr=False)
+    t_min: np.ndarray = field(init=False, repr=False)
+    t_max: np.ndarray = field(init=False, repr=False)
+    cable_base: np.ndarray = field(init=False, repr=False)
+    edge_points: np.ndarray = field(init=False, repr=False)
+    edge_dirs: np.ndarray = field(init=False, repr=False)
+    edge_base: np.ndarray = field(init=False, repr=False)
+    edge_weight_moment: np.ndarray = field(init=False, repr=False)
+    _tip_V: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         s = object.__setattr__

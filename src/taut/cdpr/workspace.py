@@ -7,16 +7,19 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array
 from ..errors import InvalidInputError
+from ._common import renamed_keyword
+from ._tol import BOX_REL
 from .model import CableRobot
 from .wrench_set import wrench_feasible
 
 __all__ = ["WorkspaceResult", "grid_points", "wrench_feasible_workspace"]
 
 
-def grid_points(box: Any, shape: Any) -> tuple[np.ndarray, tuple[int, int, int]]:
+def grid_points(box: ArrayLike, shape: ArrayLike) -> tuple[np.ndarray, tuple[int, int, int]]:
     """Regular grid over ``box`` ([[xmin, ymin, zmin], [xmax, ymax, zmax]], m) with ``shape``
     (nx, ny, nz) points per axis (a flat axis gets one point). Returns points (P, 3) in
     C order (x slowest) and the effective shape."""
@@ -24,7 +27,8 @@ def grid_points(box: Any, shape: Any) -> tuple[np.ndarray, tuple[int, int, int]]
     sh = np.asarray(shape, dtype=float)
     if sh.shape != (3,) or np.any(sh < 1) or np.any(sh != np.round(sh)):
         raise InvalidInputError("grid", "must be three positive integers nx ny nz")
-    eff = tuple(int(n) if b[1, k] > b[0, k] else 1 for k, n in enumerate(sh))
+    nx, ny, nz = (int(n) if b[1, k] > b[0, k] else 1 for k, n in enumerate(sh))
+    eff = (nx, ny, nz)
     axes = [np.linspace(b[0, k], b[1, k], eff[k]) if eff[k] > 1 else
             np.array([0.5 * (b[0, k] + b[1, k])]) for k in range(3)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
@@ -66,20 +70,23 @@ class WorkspaceResult:
     coverage_tipping: float | None
 
 
-def wrench_feasible_workspace(robot: CableRobot, points: Any, *, orientations: Any = None,
-                              disturbance: Any = None, shape: tuple[int, ...] | None = None,
-                              chunk: int = 2048,
-                              progress: Callable[[int, int], None] | None = None
-                              ) -> WorkspaceResult:
+def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
+                              orientations: ArrayLike | None = None,
+                              external_wrench: ArrayLike | None = None,
+                              shape: tuple[int, ...] | None = None, chunk: int = 2048,
+                              progress: Callable[[int, int], None] | None = None,
+                              disturbance: ArrayLike | None = None) -> WorkspaceResult:
     """Evaluate the wrench-feasible workspace at positions ``points`` (P, 3), m.
 
     A position belongs to the WFW when, at every orientation of ``orientations`` ((O, 3)
     roll-pitch-yaw, rad; default level), the cables can hold platform and payload weight
-    plus every wrench of ``disturbance`` ((V, n), N and N m) within their tension limits,
+    plus every wrench of ``external_wrench`` ((V, n), N and N m; ``disturbance`` is its
+    deprecated name) within their tension limits,
     and, for ``feasible_tipping``, without tipping a mobile base. Vectorised (see
     :func:`taut.cdpr.wrench_set.wrench_feasible`). ``progress(done, total)`` is called after
     each block of ``chunk`` poses. Positions outside the frame raise :class:`InfeasiblePoseError`.
     """
+    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     pts = as_array(points, "points", shape=(None, 3))
     ori = np.zeros((1, 3)) if orientations is None else \
         as_array(orientations, "orientations", shape=(None, 3))
@@ -94,16 +101,16 @@ def wrench_feasible_workspace(robot: CableRobot, points: Any, *, orientations: A
         for s0 in range(0, poses.shape[0], chunk):
             sl = slice(s0, s0 + chunk)
             out[sl] = wrench_feasible(robot, poses[sl], tipping=with_tip,
-                                      disturbance=disturbance)
+                                      external_wrench=ext)
             done += out[sl].size
             if progress is not None:
                 progress(done, total)
         res[with_tip] = out.reshape(Pn, On)
-    feas = res[False].all(axis=1)
-    feas_t = res[True].all(axis=1) if tip else None
+    feas: np.ndarray = np.asarray(res[False].all(axis=1))
+    feas_t: np.ndarray | None = np.asarray(res[True].all(axis=1)) if tip else None
     if robot.desired_workspace is not None:
         lo, hi = robot.desired_workspace
-        tol = 1e-9 * (1 + np.abs(robot.desired_workspace).max())
+        tol = BOX_REL * (1 + np.abs(robot.desired_workspace).max())
         inside = np.all((pts >= lo - tol) & (pts <= hi + tol), axis=1)
     else:
         inside = np.ones(Pn, dtype=bool)

@@ -77,7 +77,7 @@ def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers:
     if as_json:
         _echo_json({
             "model": robot.name, "pose": P.tolist(), "method": method.value,
-            "tipping": res.tipping, "feasible": bool(res.feasible[0]),
+            "tipping": res.tipping, "feasible": bool(res.success[0]),
             "residual": None if not np.isfinite(res.residual[0]) else float(res.residual[0]),
             "tensions": {n: (None if not np.isfinite(v) else float(v)) for n, v in zip(names, t)},
             "tipping_moments": (None if not np.all(np.isfinite(res.tipping_moments[0])) else
@@ -94,7 +94,7 @@ def _tensions(model: str, pose, rpy, method: Method, tipping: bool, stabilisers:
     rows = [[n, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if lo - 1e-6 <= v <= hi + 1e-6 else "!"]
             for n, v, lo, hi in zip(names, t, robot.t_min, robot.t_max)]
     typer.echo(_table(["cable", "tension [N]", "min", "max", ""], rows))
-    typer.echo(f"feasible: {'yes' if res.feasible[0] else 'no'}   "
+    typer.echo(f"feasible: {'yes' if res.success[0] else 'no'}   "
                f"residual max|W t + w_e| = {res.residual[0]:.2e}")
     if robot.has_tipping:
         M = res.tipping_moments[0]

@@ -90,17 +90,17 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
     box = workspace_box(np.array(ws, dtype=float))
     robot = load_robot(model, stabilisers)
     D = None if disturbance is None else disturbance_box(robot, disturbance[:robot.dof])
-    res = plan_deployment(robot, box, disturbance=D,
+    res = plan_deployment(robot, box, external_wrench=D,
                           required_twist=None if twist is None else twist[:robot.dof],
                           seed=seed, maxiter=maxiter)
     lb = res.lift_bound
-    out = {"model": robot.name, "workspace": box.tolist(), "feasible": res.feasible,
+    out = {"model": robot.name, "workspace": box.tolist(), "feasible": res.success,
            "refuted": res.refuted,
            "base_poses": {k: [round(float(x), 4) for x in v] for k, v in res.base_poses.items()},
            "margin": _r(res.margin),
            "twist_margin": None if res.twist_margin is None else _r(res.twist_margin),
            "points": int(len(res.points)), "feasible_points": int(res.point_feasible.sum()),
-           "evaluations": res.evaluations, "reason": res.reason,
+           "evaluations": res.evaluations, "reason": "" if res.success else res.message,
            "lift_bound": None if lb is None else {
                "height": _r(lb.height), "bound": _r(lb.bound), "required": _r(lb.required),
                "weight": _r(lb.weight), "refutes": lb.refutes,
@@ -116,14 +116,14 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
             from ..viz.cdpr_motion import plot_deployment
             plot_deployment(res, plot)
             out["plot"] = str(plot)
-    code = 0 if res.feasible else 1            # valid question, negative answer: exit 1
+    code = 0 if res.success else 1            # valid question, negative answer: exit 1
     if as_json:
         typer.echo(json.dumps(out, indent=2))
         return code
     typer.echo(f"{robot.name}: deployment for workspace {box.tolist()} m: "
-               + ("FEASIBLE" if res.feasible else "NOT FOUND"))
+               + ("FEASIBLE" if res.success else "NOT FOUND"))
     if res.refuted:
-        typer.echo("  " + res.reason)
+        typer.echo("  " + res.message)
         typer.echo("  upper bound per cable (N): " + ", ".join(
             f"{k} {v:.2f}" for k, v in out["lift_bound"]["per_cable"].items()))
         if note:
@@ -133,8 +133,8 @@ def _deploy(model, ws, disturbance, twist, stabilisers, seed, maxiter, plot,
         typer.echo(f"  {k}: x={v[0]} m  y={v[1]} m  theta={v[2]} rad")
     typer.echo(f"  worst capacity margin {out['margin']} over {out['points']} points "
                f"({out['feasible_points']} feasible with tipping)")
-    if res.reason:
-        typer.echo("  " + res.reason)
+    if not res.success:
+        typer.echo("  " + res.message)
     return code
 
 
