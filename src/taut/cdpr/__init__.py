@@ -60,3 +60,8 @@ __all__ += [
     "HPolytopeBatch", "lp_max_step", "QPSolver", "TensionMethod", "support",
     "external_wrench_box", "zonotope_hrep",
 ]
+
+from .model import with_friction  # noqa: E402
+from .sliding import sliding_rows  # noqa: E402
+
+__all__ += ["with_friction", "sliding_rows"]

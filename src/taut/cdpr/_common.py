@@ -15,6 +15,7 @@ from ..errors import InvalidInputError
 from .kinematics import CableState, gravity_wrench, tipping_matrix
 from ._tol import FEAS_REL, RANK_TOL
 from .model import CableRobot
+from .sliding import sliding_rows
 
 
 @lru_cache(maxsize=64)
@@ -51,10 +52,12 @@ def required_wrench(robot: CableRobot, state: CableState, external: Any = None,
     return -w
 
 
-def constraints(robot: CableRobot, state: CableState, tipping: bool
+def constraints(robot: CableRobot, state: CableState, tipping: bool, sliding: bool = False
                 ) -> tuple[np.ndarray, np.ndarray]:
-    """Linear constraints ``A t <= b`` on tensions: the bounds of FASTKIT eq. 20 and, when
-    ``tipping``, the edge moments of eqs. 21-23. Returns A (B, K, m) and b (B, K)."""
+    """Linear constraints ``A t <= b`` on tensions: the bounds of FASTKIT eq. 20, when
+    ``tipping`` the edge moments of eqs. 21-23, and when ``sliding`` the friction pyramids
+    of :mod:`taut.cdpr.sliding` (bases with a friction coefficient only). Returns A
+    (B, K, m) and b (B, K); rows in that order (bounds first: 2 m rows)."""
     B, m = state.lengths.shape
     eye = np.eye(m)
     rows = [eye, -eye]
@@ -66,6 +69,10 @@ def constraints(robot: CableRobot, state: CableState, tipping: bool
         A = np.concatenate([A, T], axis=1)
         b = np.concatenate([b, np.broadcast_to(-robot.edge_weight_moment, (B, robot.n_edges))],
                            axis=1)
+    if sliding and robot.has_sliding:
+        S, s, _ = sliding_rows(robot, state.unit)
+        A = np.concatenate([A, S], axis=1)
+        b = np.concatenate([b, np.broadcast_to(s, (B, len(s)))], axis=1)
     return A, b
 
 

@@ -73,6 +73,8 @@ class TensionResult:
     method : str
     tipping : bool
         Whether tipping constraints were imposed.
+    sliding : bool
+        Whether friction (sliding) constraints were imposed.
     """
 
     tensions: np.ndarray
@@ -83,6 +85,7 @@ class TensionResult:
     tipping_moments: np.ndarray
     method: str
     tipping: bool
+    sliding: bool = False
 
     feasible = deprecated_alias("success", "feasible")
 
@@ -90,7 +93,7 @@ class TensionResult:
 def distribute_tensions(robot: CableRobot, poses: ArrayLike,
                         method: TensionMethod = "closed_form", *,
                         external_wrench: ArrayLike | None = None, tipping: bool = True,
-                        qp_solver: QPSolver = "auto") -> TensionResult:
+                        qp_solver: QPSolver = "auto", sliding: bool = True) -> TensionResult:
     """Distribute cable tensions over a batch of poses.
 
     Parameters
@@ -109,6 +112,10 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
         distribution that tips a base over is not a physical answer. ``closed_form`` does
         not use them to choose tensions; it reports a pose feasible only when its tensions
         happen to satisfy them. Pass ``tipping=False`` for the tension limits alone.
+    sliding : bool, default True
+        Impose the friction condition of the mobile bases that have a friction
+        coefficient (:mod:`taut.cdpr.sliding`); no effect on a model without one.
+        ``closed_form`` only checks it, like tipping.
     qp_solver : {"auto", "enumeration", "scipy"}
         For ``qp_min_norm``: exact batched enumeration (needs m - n <= 2) or SciPy SLSQP.
 
@@ -135,7 +142,8 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     st = cable_state(robot, P, validated=True)
     w = required_wrench(robot, st, external_wrench)
     use_tip = bool(tipping and robot.has_tipping)
-    A, b = constraints(robot, st, use_tip)
+    use_slide = bool(sliding and robot.has_sliding)
+    A, b = constraints(robot, st, use_tip, use_slide)
     if method == "closed_form":
         pinv, ok = None, np.ones(P.shape[0], dtype=bool)    # rank judged by the residual
         t = _closed_form(robot, st.W, w, ok)
@@ -167,12 +175,14 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     if use_tip:
         feas &= np.all(tip_m <= tol, axis=1)
     t_out = np.where(found[:, None], tz, np.nan)
-    status, message = batch_outcome(feas, "infeasible", "poses balanced within the tension "
-                                    + ("and tipping limits" if use_tip else "limits"))
+    names = ["tension"] + (["tipping"] if use_tip else []) + (["sliding"] if use_slide else [])
+    what = " and ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
+    status, message = batch_outcome(feas, "infeasible", f"poses balanced within the {what} "
+                                    "limits")
     return TensionResult(tensions=t_out, success=feas, status=status, message=message,
                          residual=np.where(found, res, np.nan),
                          tipping_moments=np.where(found[:, None], tip_m, np.nan),
-                         method=method, tipping=use_tip)
+                         method=method, tipping=use_tip, sliding=use_slide)
 
 
 def _chunks(n: int, size: int) -> list[slice]:

@@ -4,7 +4,7 @@ without the tipping constraints of mobile bases, for one orientation or a sweep 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -58,6 +58,16 @@ class WorkspaceResult:
         feasible without tipping.
     coverage_tipping : float or None
         The same with tipping.
+    feasible_sliding : (P,) bool or None
+        Also without sliding a mobile base (tension limits, tipping and the friction
+        condition of :mod:`taut.cdpr.sliding`); None when no base has a friction
+        coefficient.
+    coverage_sliding : float or None
+        Coverage with all three conditions.
+    binding : (P,) str
+        Per position, the first condition (in the order ``"limits"``, ``"tipping"``,
+        ``"sliding"``) whose addition makes it infeasible; ``""`` where feasible with every
+        condition the model has.
     """
 
     points: np.ndarray
@@ -68,6 +78,9 @@ class WorkspaceResult:
     shape: tuple[int, ...] | None
     coverage: float
     coverage_tipping: float | None
+    feasible_sliding: np.ndarray | None = None
+    coverage_sliding: float | None = None
+    binding: np.ndarray | None = None
 
 
 def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
@@ -92,29 +105,55 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
         as_array(orientations, "orientations", shape=(None, 3))
     Pn, On = pts.shape[0], ori.shape[0]
     poses = np.hstack([np.repeat(pts, On, axis=0), np.tile(ori, (Pn, 1))])
-    tip = robot.has_tipping
-    total = poses.shape[0] * (2 if tip else 1)
-    done = 0
-    res = {}
-    for with_tip in ((False, True) if tip else (False,)):
-        out = np.empty(poses.shape[0], dtype=bool)
-        for s0 in range(0, poses.shape[0], chunk):
-            sl = slice(s0, s0 + chunk)
-            out[sl] = wrench_feasible(robot, poses[sl], tipping=with_tip,
-                                      external_wrench=ext)
-            done += out[sl].size
-            if progress is not None:
-                progress(done, total)
-        res[with_tip] = out.reshape(Pn, On)
-    feas: np.ndarray = np.asarray(res[False].all(axis=1))
-    feas_t: np.ndarray | None = np.asarray(res[True].all(axis=1)) if tip else None
-    if robot.desired_workspace is not None:
-        lo, hi = robot.desired_workspace
-        tol = BOX_REL * (1 + np.abs(robot.desired_workspace).max())
-        inside = np.all((pts >= lo - tol) & (pts <= hi + tol), axis=1)
-    else:
-        inside = np.ones(Pn, dtype=bool)
+    passes = [("limits", False, False)]
+    if robot.has_tipping:
+        passes.append(("tipping", True, False))
+    if robot.has_sliding:
+        passes.append(("sliding", True, True))
+    counter = _Progress(progress, poses.shape[0] * len(passes))
+    res = {name: _feasible_pass(robot, poses, tip, slide, ext, chunk, counter).reshape(Pn, On)
+           for name, tip, slide in passes}
+    feas = {name: np.asarray(r.all(axis=1)) for name, r in res.items()}
+    inside = _inside_desired(robot, pts)
     denom = max(int(inside.sum()), 1)
-    cov = float((feas & inside).sum() / denom)
-    cov_t = float((feas_t & inside).sum() / denom) if tip else None
-    return WorkspaceResult(pts, ori, feas, feas_t, res[tip], shape, cov, cov_t)
+    cov = {name: float((f & inside).sum() / denom) for name, f in feas.items()}
+    binding = np.full(Pn, "", dtype="<U7")
+    so_far = np.ones(Pn, dtype=bool)
+    for name, f in feas.items():               # the first condition that fails binds
+        binding[so_far & ~f] = name
+        so_far &= f
+    last = "tipping" if "tipping" in res else "limits"
+    return WorkspaceResult(pts, ori, feas["limits"], feas.get("tipping"), res[last], shape,
+                           cov["limits"], cov.get("tipping"), feas.get("sliding"),
+                           cov.get("sliding"), binding)
+
+
+class _Progress:
+    """Calls ``progress(done, total)`` as blocks of poses finish."""
+
+    def __init__(self, progress: Callable[[int, int], None] | None, total: int) -> None:
+        self.progress, self.total, self.done = progress, total, 0
+
+    def step(self, n: int) -> None:
+        self.done += n
+        if self.progress is not None:
+            self.progress(self.done, self.total)
+
+
+def _feasible_pass(robot: CableRobot, poses: np.ndarray, tipping: bool, sliding: bool,
+                   ext: ArrayLike | None, chunk: int, counter: _Progress) -> np.ndarray:
+    out = np.empty(poses.shape[0], dtype=bool)
+    for s0 in range(0, poses.shape[0], chunk):
+        sl = slice(s0, s0 + chunk)
+        out[sl] = wrench_feasible(robot, poses[sl], tipping=tipping, sliding=sliding,
+                                  external_wrench=ext)
+        counter.step(out[sl].size)
+    return out
+
+
+def _inside_desired(robot: CableRobot, pts: np.ndarray) -> np.ndarray:
+    if robot.desired_workspace is None:
+        return np.ones(pts.shape[0], dtype=bool)
+    lo, hi = robot.desired_workspace
+    tol = BOX_REL * (1 + np.abs(robot.desired_workspace).max())
+    return np.all((pts >= lo - tol) & (pts <= hi + tol), axis=1)

@@ -70,6 +70,8 @@ class AvailableWrenchSet(HPolytopeBatch):
     tipping : bool
     gravity_wrench : (B, n)
         ``w_e`` of platform and payload weight at each pose.
+    sliding : bool
+        Whether the friction rows of :mod:`taut.cdpr.sliding` are included.
     """
 
     poses: np.ndarray
@@ -77,6 +79,7 @@ class AvailableWrenchSet(HPolytopeBatch):
     nonempty: np.ndarray
     tipping: bool
     gravity_wrench: np.ndarray
+    sliding: bool = False
 
     def contains(self, wrench: ArrayLike, tol: float = CONTAINS_TOL) -> np.ndarray:
         """Whether cable wrenches ``wrench`` ((n,) or (B, n)) lie in the AWS -> (B,) bool."""
@@ -84,16 +87,17 @@ class AvailableWrenchSet(HPolytopeBatch):
         return super().contains(w, tol) & self.full_rank & self.nonempty
 
 
-def _prepare(robot: CableRobot, poses: Any, tipping: bool) -> tuple[Any, ...]:
+def _prepare(robot: CableRobot, poses: Any, tipping: bool, sliding: bool = False
+             ) -> tuple[Any, ...]:
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     pinv, N, ok = svd_split(st.W)
-    A, b = constraints(robot, st, bool(tipping and robot.has_tipping))
+    A, b = constraints(robot, st, bool(tipping and robot.has_tipping), sliding)
     return P, st, pinv, N, ok, A, b
 
 
-def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = True
-                         ) -> AvailableWrenchSet:
+def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = True, *,
+                         sliding: bool = True) -> AvailableWrenchSet:
     """Exact H-representation of the available wrench set (FASTKIT eq. 24) at poses.
 
     Parameters
@@ -104,6 +108,9 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = Tr
     tipping : bool
         Include the tipping constraints of the mobile bases (eqs. 21-23); ignored for
         fixed frames. Without them the set is the classical tension-limited AWS.
+    sliding : bool, default True
+        Include the friction rows of the mobile bases that have a friction coefficient
+        (:mod:`taut.cdpr.sliding`); no effect on a model without one.
 
     Returns
     -------
@@ -119,15 +126,19 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = Tr
     [True]
     """
     P = as_poses(robot, poses)
-    parts = [_aws_block(robot, P[i:i + 256], tipping) for i in range(0, P.shape[0], 256)]
+    slide = bool(sliding and robot.has_sliding)
+    parts = [_aws_block(robot, P[i:i + 256], tipping, slide)
+             for i in range(0, P.shape[0], 256)]
     H, h, ok, nonempty_, wg = (np.concatenate(x) for x in zip(*parts))
     return AvailableWrenchSet(H=H, h=h, E=np.zeros((P.shape[0], 0, robot.dof)), poses=P,
                               full_rank=ok, nonempty=nonempty_,
-                              tipping=bool(tipping and robot.has_tipping), gravity_wrench=wg)
+                              tipping=bool(tipping and robot.has_tipping), gravity_wrench=wg,
+                              sliding=slide)
 
 
-def _aws_block(robot: CableRobot, P: np.ndarray, tipping: bool) -> tuple[np.ndarray, ...]:
-    P, st, pinv, N, ok, A, b = _prepare(robot, P, tipping)
+def _aws_block(robot: CableRobot, P: np.ndarray, tipping: bool, sliding: bool
+               ) -> tuple[np.ndarray, ...]:
+    P, st, pinv, N, ok, A, b = _prepare(robot, P, tipping, sliding)
     G = np.einsum("bkm,bmr->bkr", A, N)
     idx, lam, valid = certificates(G)
     AW = np.einsum("bkm,bmn->bkn", A, pinv)                   # (B, K, n)
@@ -167,7 +178,8 @@ disturbance_box = external_wrench_box
 
 def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True,
                     external_wrench: ArrayLike | None = None, chunk: int = 256,
-                    disturbance: ArrayLike | None = None) -> np.ndarray:
+                    sliding: bool = True, disturbance: ArrayLike | None = None
+                    ) -> np.ndarray:
     """Wrench feasibility (FASTKIT §4) of a batch of poses: can the cables hold platform
     and payload weight plus every extra wrench of ``external_wrench`` within tension limits
     (eq. 20) and, if ``tipping``, without tipping a mobile base (eqs. 21-23)?
@@ -186,6 +198,9 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     chunk : int
         Poses per vectorised block (memory ~ chunk * 60 kB with tipping; 256 is
         fastest here).
+    sliding : bool, default True
+        Also require the friction condition of :mod:`taut.cdpr.sliding` (bases with a
+        friction coefficient only).
     disturbance
         Deprecated name of ``external_wrench``.
 
@@ -209,7 +224,7 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
         sl = slice(s0, s0 + chunk)
         st = cable_state(robot, P[sl], validated=True)
         pinv, N, ok = svd_split(st.W)
-        A, b = constraints(robot, st, bool(tipping and robot.has_tipping))
+        A, b = constraints(robot, st, bool(tipping and robot.has_tipping), sliding)
         G = np.einsum("bkm,bmr->bkr", A, N)
         cert = certificates(G) if N.shape[2] > 2 else None
         good = ok.copy()
@@ -246,7 +261,7 @@ class AxisCapacities:
 
 
 def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
-                    method: str = "hrep") -> AxisCapacities:
+                    method: str = "hrep", *, sliding: bool = True) -> AxisCapacities:
     """Axis capacities ``max s >= 0`` with ``W t + w_e + s e = 0`` (eq. 17) inside the tension
     limits (eq. 20) and, if ``tipping``, the tipping limits (eqs. 21-23), for ``e`` each of
     ``+-x, +-y, +-z`` forces and (6-DoF) moments about P.
@@ -267,8 +282,8 @@ def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
     n = robot.dof
     labels = AXIS_LABELS[:n]
     if method == "lp":
-        return _axis_lp(robot, poses, tipping, labels)
-    aws = available_wrench_set(robot, poses, tipping)
+        return _axis_lp(robot, poses, tipping, labels, sliding)
+    aws = available_wrench_set(robot, poses, tipping, sliding=sliding)
     pos, neg, reach = aws.axis_ray_lengths(-aws.gravity_wrench, tol=feas_tol(robot),
                                            sign=-1.0, zero=ZERO_ROW)
     ok = (aws.full_rank & aws.nonempty)[:, None]
@@ -278,8 +293,8 @@ def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
 
 
 def _axis_lp(robot: CableRobot, poses: ArrayLike, tipping: bool,
-             labels: tuple[str, ...]) -> AxisCapacities:
-    P, st, pinv, N, ok, A, b = _prepare(robot, poses, tipping)
+             labels: tuple[str, ...], sliding: bool) -> AxisCapacities:
+    P, st, pinv, N, ok, A, b = _prepare(robot, poses, tipping, sliding)
     B, n, m = st.W.shape
     wg = gravity_wrench(robot, st.R)
     pos = np.zeros((B, n))
@@ -303,7 +318,8 @@ def _axis_lp(robot: CableRobot, poses: ArrayLike, tipping: bool,
 
 def capacity_margin(robot: CableRobot, poses: ArrayLike,
                     external_wrench: ArrayLike | None = None, tipping: bool = True, *,
-                    disturbance: ArrayLike | None = None) -> np.ndarray:
+                    sliding: bool = True, disturbance: ArrayLike | None = None
+                    ) -> np.ndarray:
     """Capacity margin of the required wrench set at poses, (B,).
 
     The required set is platform and payload weight plus the extra external wrenches
@@ -316,7 +332,7 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     """
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
-    aws = available_wrench_set(robot, poses, tipping)
+    aws = available_wrench_set(robot, poses, tipping, sliding=sliding)
     D = wrench_vertices(robot, ext, field)
     w = -(aws.gravity_wrench[:, None, :] + D[None, :, :])        # required cable wrenches
     hw = np.einsum("bsn,bvn->bsv", aws.H, w).max(axis=2)

@@ -53,6 +53,7 @@ class _Base(_Strict):
     footprint: list[Vec2] | None = None
     stabilisers: _Stabilisers | None = None
     exit_points: dict[str, Vec3] = Field(min_length=1)
+    friction: float | None = None       # ground friction coefficient (sliding condition)
 
 
 class _Platform(_Strict):
@@ -122,7 +123,8 @@ def cdpr_model_from_mapping(data: dict[str, Any]) -> CableRobot:
                               mobile=b.mobile, mass=b.mass, com=b.com,
                               footprint=b.footprint,
                               stabilisers=None if st is None else st.footprint,
-                              stabilisers_deployed=bool(st is not None and st.deployed)))
+                              stabilisers_deployed=bool(st is not None and st.deployed),
+                              friction=b.friction))
         cables = []
         for i, c in enumerate(raw.cables):
             if c.exit.count(".") != 1:
