@@ -184,3 +184,22 @@ def test_friction_validation(fastkit):
         with_friction(fastkit, -0.1)
     with pytest.raises(InvalidModelError, match="friction_sides"):
         with_friction(fastkit, 0.3, sides=2)
+
+
+def test_friction_in_the_model_file(fastkit):
+    import yaml
+
+    from taut.errors import TautError
+    from taut.io.cdpr_model import cdpr_model_from_mapping, preset_path
+    data = yaml.safe_load(preset_path("fastkit").read_text())
+    for b in data["bases"]:
+        b["friction"] = 0.3
+    robot = cdpr_model_from_mapping(data)
+    assert [b.friction for b in robot.bases] == [0.3, 0.3] and robot.has_sliding
+    P = random_poses(fastkit, 50, seed=9)
+    np.testing.assert_array_equal(wrench_feasible(robot, P),
+                                  wrench_feasible(with_friction(fastkit, 0.3), P))
+    data["bases"][0]["friction"] = -1.0
+    with pytest.raises(TautError) as exc:
+        cdpr_model_from_mapping(data)
+    assert exc.value.field == "bases[0].friction"

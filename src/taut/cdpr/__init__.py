@@ -65,3 +65,7 @@ from .model import with_friction  # noqa: E402
 from .sliding import sliding_rows  # noqa: E402
 
 __all__ += ["with_friction", "sliding_rows"]
+
+from .closure import wrench_closure  # noqa: E402
+
+__all__ += ["wrench_closure"]

@@ -110,3 +110,9 @@ LIFT_RTOL = 1e-5
 #: The certificate refutes only when the bound falls short of the required force by more
 #: than REFUTE_REL times the weight (dimensionless): guards round-off at the boundary.
 REFUTE_REL = 1e-6
+
+# --- wrench closure -------------------------------------------------------------------
+#: A pose has wrench closure when the most balanced self-stress ``W t = 0`` with
+#: ``max t = 1`` has ``min t > CLOSURE_TOL`` (dimensionless): far above HiGHS's 1e-7
+#: feasibility tolerance, far below any usable pretension ratio.
+CLOSURE_TOL = 1e-6

@@ -29,7 +29,7 @@ from .files import read_mapping, validate_mapping
 
 __all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
 
-PRESETS = ("fastkit", "ipanema")
+PRESETS = ("fastkit", "ipanema", "fastkit_fc")
 
 Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]
