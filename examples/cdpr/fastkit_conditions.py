@@ -5,6 +5,7 @@
   fraction;
 * how much of the desired slice sliding of the bases removes at mu = 0.3 and 0.6 (and
   0.1, 0.2 for context), stabilisers retracted and deployed;
+* the interference-free fraction of the desired slice (level platform);
 * ``fastkit_binding_slice.png``: the binding condition per position (mu = 0.3, stabilisers
   deployed) and ``fastkit_binding_3d.png``: the same over a 3D grid (mu = 0.2, retracted).
 
@@ -18,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from taut.cdpr import (grid_points, with_friction, with_stabilisers, wrench_closure,
-                       wrench_feasible_workspace)
+from taut.cdpr import (cable_interference, grid_points, with_friction, with_stabilisers,
+                       wrench_closure, wrench_feasible_workspace)
 from taut.io.cdpr_model import load_cdpr_model
 from taut.viz.cdpr_binding import plot_binding
 
@@ -55,6 +56,11 @@ def main() -> None:
                                 gravity=robot.gravity, desired_workspace=robot.desired_workspace,
                                 name=robot.name + " without payload")
         out[name]["no_payload"] = coverage(light)
+        itf = cable_interference(robot, pts)
+        out[name]["interference"] = {
+            "free_%": pct(float(itf.free.mean())),
+            "cable_cable_%": pct(float(itf.cable_cable.mean())),
+            "cable_platform_%": pct(float(itf.cable_platform.any(axis=1).mean()))}
     robot = load_cdpr_model("fastkit")
     sliding = {}
     for stab in (False, True):

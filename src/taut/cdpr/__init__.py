@@ -69,3 +69,7 @@ __all__ += ["with_friction", "sliding_rows"]
 from .closure import wrench_closure  # noqa: E402
 
 __all__ += ["wrench_closure"]
+
+from .interference import Interference, cable_interference, segment_distance  # noqa: E402
+
+__all__ += ["Interference", "cable_interference", "segment_distance"]
