@@ -357,7 +357,13 @@ class CableRobot:
         if m < self.dof:
             raise InvalidModelError("cables", f"{m} cables cannot balance a {self.dof}-DoF "
                                               "platform")
-        # Frame bounds and desired workspace.
+        self._set_boxes(exits)
+        self._build_tipping()
+
+    def _set_boxes(self, exits: np.ndarray) -> None:
+        """Frame bounds (default: the exits' bounding box from the ground up) and the
+        desired workspace, validated."""
+        s = object.__setattr__
         if self.bounds is None:
             lo = exits.min(axis=0)
             hi = exits.max(axis=0)
@@ -373,7 +379,6 @@ class CableRobot:
             if np.any(dw[1] < dw[0]):
                 raise InvalidModelError("desired_workspace", "lower corner above upper corner")
             s(self, "desired_workspace", dw)
-        self._build_tipping()
 
     def _build_tipping(self) -> None:
         pts, dirs, eb, m0 = [], [], [], []
