@@ -167,7 +167,6 @@ def test_gravity_in_aws_iff_tensions_exist(fastkit, x, z, yaw, tip):
     assert bool(wrench_feasible(fastkit, pose, tipping=tip)[0]) == lp
 
 
-@pytest.mark.slow
 @settings(max_examples=15, deadline=None)
 @given(half=st.floats(0.5, 3.0), height=st.floats(1.0, 4.0), z=st.floats(0.05, 0.9),
        x=st.floats(-0.9, 0.9), tmin=st.floats(0.0, 5.0), span=st.floats(20.0, 200.0),
