@@ -19,9 +19,9 @@ import time
 import numpy as np
 
 from taut.cdpr import with_stabilisers
-from taut.cdpr.deploy import plan_deployment
-from taut.cdpr.redundancy import resolve_redundancy
-from taut.cdpr.twist import available_twist_set, twist_capacities
+from taut.cdpr import plan_deployment
+from taut.cdpr import resolve_redundancy
+from taut.cdpr import available_twist_set, twist_capacities
 from taut.io.cdpr_model import load_cdpr_model
 
 
@@ -56,7 +56,7 @@ def main() -> None:
     T = g.normal(size=(200, 6)) * [0.5, 0.5, 0.5, 0.3, 0.3, 0.3]
     t_rr, res = timed(lambda: [resolve_redundancy(robot, P[i % len(P)], t)
                                for i, t in enumerate(T)])
-    feas = np.mean([r.feasible for r in res])
+    feas = np.mean([r.success for r in res])
     box = [[-2.5, -0.05, 0.2], [2.5, 0.05, 1.0]]
     t_dep, dep = timed(lambda: plan_deployment(with_stabilisers(robot, True), box,
                                                required_twist=[1.0, 0, 0, 0, 0, 0],
@@ -70,7 +70,7 @@ def main() -> None:
     print(f"  redundancy resolution        {len(T):>6} twists: {len(T) / t_rr:10,.0f} twists/s"
           f"   ({feas:.0%} feasible)")
     print(f"  deployment plan (5 x 0.1 x 0.8 m box): {t_dep:.1f} s, {dep.evaluations} "
-          f"placements, feasible={dep.feasible}, margin {dep.margin:.3f}")
+          f"placements, feasible={dep.success}, margin {dep.margin:.3f}")
 
 
 if __name__ == "__main__":

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from taut.cdpr.redundancy import resolve_redundancy
-from taut.cdpr.twist import MotionLimits, first_order_model, twist_capacities
+from taut.cdpr import resolve_redundancy
+from taut.cdpr import MotionLimits, first_order_model, twist_capacities
 from taut.errors import InvalidInputError
 
 POSE = np.array([0.3, 0.0, 1.0, 0.0, 0.0, 0.05])
@@ -25,7 +25,7 @@ def test_feasible_twists_are_reproduced_within_limits(fastkit, objective):
     for _ in range(6):
         t = g.normal(size=6) * [0.3, 0.3, 0.3, 0.2, 0.2, 0.2]
         res = resolve_redundancy(fastkit, POSE, t, objective=objective)
-        assert res.feasible and res.scale == 1.0 and res.reason == ""
+        assert res.success and res.scale == 1.0 and res.status == "ok"
         _check(fastkit, res, t)
 
 
@@ -46,20 +46,21 @@ def test_twist_needing_the_base(fastkit):
     assert mv > fx
     t = np.array([0.5 * (mv + fx), 0, 0, 0, 0, 0])
     res = resolve_redundancy(fastkit, POSE, t, objective="least_base")
-    assert res.feasible
+    assert res.success
     assert np.abs(res.base_rates).max() > 1e-4
     _check(fastkit, res, t)
     fixed = resolve_redundancy(fastkit, POSE, t, moving=())
-    assert not fixed.feasible and fixed.scale == pytest.approx(fx / t[0], rel=1e-6)
+    assert not fixed.success and fixed.scale == pytest.approx(fx / t[0], rel=1e-6)
 
 
 def test_infeasible_twist_reports_largest_fraction(fastkit):
     cap = twist_capacities(fastkit, POSE).positive[0, 2]
     t = np.array([0, 0, 1.25 * cap, 0, 0, 0])
     res = resolve_redundancy(fastkit, POSE, t)
-    assert not res.feasible
+    assert not res.success
     assert res.scale == pytest.approx(0.8, rel=1e-6)
-    assert "outside the available twist set" in res.reason
+    assert "outside the available twist set" in res.message
+    assert res.status == "infeasible"
     _check(fastkit, res, t, scale=res.scale)
 
 
@@ -68,17 +69,17 @@ def test_limits_excluding_rest():
     robot = load_cdpr_model("fastkit")
     lim = MotionLimits(cable_min=0.5, cable_max=1.0)
     res = resolve_redundancy(robot, POSE, np.zeros(6), lim)
-    assert not res.feasible and "standing still" in res.reason
+    assert not res.success and "standing still" in res.message
 
 
 def test_navigation_mode(fastkit):
     ok = resolve_redundancy(fastkit, POSE, [0.1, -0.1, 0, 0, 0, 0.01], mode="navigation")
-    assert ok.feasible and np.allclose(ok.cable_speeds, 0.0)
+    assert ok.success and np.allclose(ok.cable_speeds, 0.0)
     assert ok.q_dot.shape == (3,) and np.all(np.abs(ok.q_dot) <= 0.2 + 1e-12)
     lift = resolve_redundancy(fastkit, POSE, [0, 0, 0.1, 0, 0, 0], mode="navigation")
-    assert not lift.feasible and "planar" in lift.reason
+    assert not lift.success and "planar" in lift.message
     fast = resolve_redundancy(fastkit, POSE, [0.4, 0, 0, 0, 0, 0], mode="navigation")
-    assert not fast.feasible and fast.scale == pytest.approx(0.5)
+    assert not fast.success and fast.scale == pytest.approx(0.5)
 
 
 def test_bad_input(fastkit):

@@ -10,7 +10,7 @@ from taut.errors import InvalidInputError
 
 from cdpr_helpers import A, H, MASS, point_mass_robot, random_poses
 
-N_POSES = 2000
+N_POSES = 600          # per preset; LP and SLSQP loops make this the costly fixture
 G = 9.81
 
 
@@ -20,7 +20,7 @@ def solved(fastkit, ipanema):
     out = {}
     for name, robot in (("fastkit", fastkit), ("ipanema", ipanema)):
         P = random_poses(robot, N_POSES, seed=1 if name == "fastkit" else 2)
-        out[name] = (robot, P, {m: distribute_tensions(robot, P, m) for m in
+        out[name] = (robot, P, {m: distribute_tensions(robot, P, m, tipping=False) for m in
                                 ("closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm")})
     return out
 
@@ -31,7 +31,7 @@ def test_equilibrium_to_machine_precision(solved, name):
     st = cable_state(robot, P)
     we = gravity_wrench(robot, st.R)
     for method, r in res.items():
-        f = r.feasible
+        f = r.success
         assert f.sum() > 100, (method, f.sum())
         resid = np.einsum("bij,bj->bi", st.W[f], r.tensions[f]) + we[f]
         # |W t + w_e| relative to the weight held: a few ulps of ~100 N.
@@ -43,12 +43,12 @@ def test_equilibrium_to_machine_precision(solved, name):
 @pytest.mark.parametrize("name", ["fastkit", "ipanema"])
 def test_methods_agree_on_feasibility(solved, name):
     robot, P, res = solved[name]
-    lp = res["lp_min_sum"].feasible
-    np.testing.assert_array_equal(res["lp_min_max"].feasible, lp)
-    np.testing.assert_array_equal(res["qp_min_norm"].feasible, lp)
+    lp = res["lp_min_sum"].success
+    np.testing.assert_array_equal(res["lp_min_max"].success, lp)
+    np.testing.assert_array_equal(res["qp_min_norm"].success, lp)
     # Exact vectorised test (Helly/Farkas H-representation) agrees with the LPs.
     np.testing.assert_array_equal(wrench_feasible(robot, P, tipping=False), lp)
-    cf = res["closed_form"].feasible
+    cf = res["closed_form"].success
     # Pott's closed form is conservative by design: closed-form feasible => LP feasible.
     assert not np.any(cf & ~lp)
     rate = (cf == lp).mean()
@@ -60,11 +60,11 @@ def test_methods_agree_on_feasibility(solved, name):
 @pytest.mark.parametrize("name", ["fastkit", "ipanema"])
 def test_optimality_of_each_method(solved, name):
     robot, P, res = solved[name]
-    f = res["lp_min_sum"].feasible
+    f = res["lp_min_sum"].success
     sums = {m: r.tensions[f].sum(axis=1) for m, r in res.items()}
     maxs = {m: r.tensions[f].max(axis=1) for m, r in res.items()}
     norms = {m: np.linalg.norm(r.tensions[f], axis=1) for m, r in res.items()}
-    fc = res["closed_form"].feasible[f]
+    fc = res["closed_form"].success[f]
     for m in res:
         ok = fc if m == "closed_form" else np.ones_like(fc)
         assert np.all(sums["lp_min_sum"][ok] <= sums[m][ok] + 1e-6)
@@ -74,13 +74,13 @@ def test_optimality_of_each_method(solved, name):
 
 def test_qp_enumeration_matches_scipy(fastkit):
     P = random_poses(fastkit, 400, seed=5)
-    f = distribute_tensions(fastkit, P, "lp_min_sum").feasible
+    f = distribute_tensions(fastkit, P, "lp_min_sum").success
     P = P[f][:25]
     for tip in (False, True):
         a = distribute_tensions(fastkit, P, "qp_min_norm", tipping=tip)
         b = distribute_tensions(fastkit, P, "qp_min_norm", tipping=tip, qp_solver="scipy")
-        np.testing.assert_array_equal(a.feasible, b.feasible)
-        np.testing.assert_allclose(a.tensions[a.feasible], b.tensions[a.feasible], atol=1e-4)
+        np.testing.assert_array_equal(a.success, b.success)
+        np.testing.assert_allclose(a.tensions[a.success], b.tensions[a.success], atol=1e-4)
 
 
 def test_tipping_constrained_methods_agree(fastkit):
@@ -88,13 +88,13 @@ def test_tipping_constrained_methods_agree(fastkit):
     lp = distribute_tensions(fastkit, P, "lp_min_sum", tipping=True)
     qp = distribute_tensions(fastkit, P, "qp_min_norm", tipping=True)
     free = distribute_tensions(fastkit, P, "lp_min_sum", tipping=False)
-    np.testing.assert_array_equal(lp.feasible, qp.feasible)
-    np.testing.assert_array_equal(wrench_feasible(fastkit, P, tipping=True), lp.feasible)
-    assert not np.any(lp.feasible & ~free.feasible)          # tipping only removes poses
-    assert np.any(free.feasible & ~lp.feasible)               # ...and here it does
-    assert np.all(lp.tipping_moments[lp.feasible] <= 1e-6)
+    np.testing.assert_array_equal(lp.success, qp.success)
+    np.testing.assert_array_equal(wrench_feasible(fastkit, P, tipping=True), lp.success)
+    assert not np.any(lp.success & ~free.success)          # tipping only removes poses
+    assert np.any(free.success & ~lp.success)               # ...and here it does
+    assert np.all(lp.tipping_moments[lp.success] <= 1e-6)
     cf = distribute_tensions(fastkit, P, "closed_form", tipping=True)
-    assert not np.any(cf.feasible & ~lp.feasible)
+    assert not np.any(cf.success & ~lp.success)
 
 
 def test_unequal_limits_closed_form(fastkit):
@@ -104,11 +104,11 @@ def test_unequal_limits_closed_form(fastkit):
                    for i, c in enumerate(fastkit.cables))
     robot = replace(fastkit, cables=cables)
     P = random_poses(robot, 600, seed=11)
-    cf = distribute_tensions(robot, P, "closed_form")
-    lp = distribute_tensions(robot, P, "lp_min_sum")
-    assert cf.feasible.sum() > 50
-    assert not np.any(cf.feasible & ~lp.feasible)
-    t = cf.tensions[cf.feasible]
+    cf = distribute_tensions(robot, P, "closed_form", tipping=False)
+    lp = distribute_tensions(robot, P, "lp_min_sum", tipping=False)
+    assert cf.success.sum() > 50
+    assert not np.any(cf.success & ~lp.success)
+    t = cf.tensions[cf.success]
     assert np.all(t >= robot.t_min - 1e-8) and np.all(t <= robot.t_max + 1e-8)
 
 
@@ -120,14 +120,14 @@ def test_point_mass_equal_tensions(point_mass, z0, method):
     dh = H - z0
     L = np.sqrt(2 * A * A + dh * dh)
     r = distribute_tensions(point_mass, [0.0, 0.0, z0], method)
-    assert r.feasible[0]
+    assert r.success[0]
     np.testing.assert_allclose(r.tensions[0], MASS * G * L / (4 * dh), rtol=1e-12)
 
 
 def test_point_mass_infeasible_when_limits_too_low():
     robot = point_mass_robot(t_min=1.0, t_max=5.0)      # 4 x 5 N < 39 N weight
     for m in ("closed_form", "lp_min_sum", "qp_min_norm"):
-        assert not distribute_tensions(robot, [0, 0, 1.0], m).feasible[0]
+        assert not distribute_tensions(robot, [0, 0, 1.0], m).success[0]
 
 
 def test_bad_method(point_mass):

@@ -8,7 +8,7 @@ from scipy.optimize import linprog
 from scipy.spatial.transform import Rotation
 
 from taut.cdpr import Base, Cable, CableRobot, Payload, Platform, cable_state
-from taut.cdpr.twist import (MotionLimits, available_twist_set, fastkit_motion_limits,
+from taut.cdpr import (MotionLimits, available_twist_set, fastkit_motion_limits,
                              first_order_model, parallel_jacobian, resolve_mode, support,
                              twist_capacities, zonotope_hrep)
 from taut.errors import InvalidInputError, TautError
@@ -259,11 +259,12 @@ def test_mode_errors(fastkit, point_mass):
         available_twist_set(fastkit, [0.0, 0.0, 1.0]).contains([1.0, 2.0])
 
 
-@pytest.mark.parametrize("moving", [None, (), ("active", "passive")])
+@pytest.mark.parametrize("moving", [None, (), pytest.param(("active", "passive"),
+                                                            marks=pytest.mark.slow)])
 def test_structured_facets_equal_generic(fastkit, moving):
     """The task-mode fast path (base columns + cable identity columns) yields exactly the
     facets of the generic zonotope enumeration."""
-    from taut.cdpr.twist import joint_bounds
+    from taut.cdpr import joint_bounds
     ats = available_twist_set(fastkit, POSES, moving=moving)
     fom = ats.model
     lo, hi = joint_bounds(fastkit, fastkit_motion_limits(), fom.mode)

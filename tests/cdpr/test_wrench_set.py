@@ -8,7 +8,7 @@ from scipy.optimize import linprog
 
 from taut.cdpr import (available_wrench_set, axis_capacities, capacity_margin, cable_state,
                        disturbance_box, with_stabilisers, wrench_feasible)
-from taut.cdpr._common import constraints
+from taut.cdpr._common import constraints  # private: the constraint rows under test
 
 from cdpr_helpers import A, H, MASS, random_poses
 
@@ -144,7 +144,7 @@ def test_capacity_margin_sign_matches_feasibility(fastkit):
     assert D.shape == (64, 6)
     for tip in (False, True):
         margin = capacity_margin(fastkit, poses, D, tipping=tip)
-        feas = wrench_feasible(fastkit, poses, tipping=tip, disturbance=D)
+        feas = wrench_feasible(fastkit, poses, tipping=tip, external_wrench=D)
         sure = np.abs(margin) > 1e-6
         np.testing.assert_array_equal((margin > 0)[sure], feas[sure])
         assert feas.any() and (~feas).any()
@@ -162,7 +162,7 @@ def test_gravity_in_aws_iff_tensions_exist(fastkit, x, z, yaw, tip):
     from taut.cdpr import distribute_tensions
     pose = [x, 0.0, z, 0.0, 0.0, yaw]
     aws = available_wrench_set(fastkit, pose, tip)
-    lp = distribute_tensions(fastkit, pose, "lp_min_sum", tipping=tip).feasible[0]
+    lp = distribute_tensions(fastkit, pose, "lp_min_sum", tipping=tip).success[0]
     assert bool(aws.contains(-aws.gravity_wrench, tol=1e-7)[0]) == lp
     assert bool(wrench_feasible(fastkit, pose, tipping=tip)[0]) == lp
 
@@ -185,10 +185,10 @@ def test_random_point_mass_robots(half, height, z, x, tmin, span, seed):
                              for i in range(5)))
     lo, hi = robot.bounds
     pose = [lo[0] + 0.5 * (x + 1) * (hi[0] - lo[0]), 0.5 * (lo[1] + hi[1]), z * hi[2]]
-    lp = distribute_tensions(robot, pose, "lp_min_sum").feasible[0]
+    lp = distribute_tensions(robot, pose, "lp_min_sum").success[0]
     assert bool(wrench_feasible(robot, pose, tipping=False)[0]) == lp
-    assert distribute_tensions(robot, pose, "qp_min_norm").feasible[0] == lp
-    if distribute_tensions(robot, pose, "closed_form").feasible[0]:
+    assert distribute_tensions(robot, pose, "qp_min_norm").success[0] == lp
+    if distribute_tensions(robot, pose, "closed_form").success[0]:
         assert lp
     a = axis_capacities(robot, pose, tipping=False)
     b = axis_capacities(robot, pose, tipping=False, method="lp")
@@ -209,10 +209,10 @@ def test_three_redundant_cables_generic():
                              for i in range(6)))
     lo, hi = robot.bounds
     P = np.column_stack([g.uniform(lo, hi, (150, 3))])
-    lp = distribute_tensions(robot, P, "lp_min_sum").feasible
+    lp = distribute_tensions(robot, P, "lp_min_sum").success
     assert 0 < lp.sum() < len(P)
     np.testing.assert_array_equal(wrench_feasible(robot, P, tipping=False), lp)
-    np.testing.assert_array_equal(distribute_tensions(robot, P, "qp_min_norm").feasible, lp)
+    np.testing.assert_array_equal(distribute_tensions(robot, P, "qp_min_norm").success, lp)
     a = axis_capacities(robot, P[:10], tipping=False)
     b = axis_capacities(robot, P[:10], tipping=False, method="lp")
     np.testing.assert_allclose(a.positive, b.positive, atol=1e-6)

@@ -14,12 +14,14 @@ from .kinematics import (CableState, as_poses, cable_state, gravity_wrench,
 from .model import Base, Cable, CableRobot, Payload, Platform, check_footprint, with_stabilisers
 from .tension import METHODS, TensionResult, distribute_tensions
 from .tipping import TippingResult, tipping_moments
-from .deploy import (DeploymentResult, LiftBound, TallestWorkspace, lift_bound, place_bases,
-                     plan_deployment, tallest_workspace, upward_force_bound, workspace_box)
+from .deploy import DeploymentResult, plan_deployment
+from .lift import LiftBound, lift_bound, upward_force_bound
+from .placement import place_bases, workspace_box
+from .tallest import TallestWorkspace, tallest_workspace
 from .redundancy import OBJECTIVES, RedundancyResult, resolve_redundancy
-from .twist import (MODES, TWIST_LABELS, AvailableTwistSet, FirstOrderModel, MotionLimits,
-                    TwistCapacities, available_twist_set, fastkit_motion_limits,
-                    first_order_model, twist_capacities)
+from .twist import AvailableTwistSet, TwistCapacities, available_twist_set, twist_capacities
+from .first_order import FirstOrderModel, first_order_model
+from .motion_modes import MODES, TWIST_LABELS, MotionLimits, fastkit_motion_limits
 from .workspace import WorkspaceResult, grid_points, wrench_feasible_workspace
 from .wrench_set import (AXIS_LABELS, AvailableWrenchSet, AxisCapacities, available_wrench_set,
                          axis_capacities, capacity_margin, disturbance_box, wrench_feasible)
@@ -40,6 +42,38 @@ __all__ = [
     "DeploymentResult", "place_bases", "plan_deployment", "workspace_box",
     "LiftBound", "lift_bound", "upward_force_bound", "TallestWorkspace", "tallest_workspace",
 ]
+
+# Re-exports of every name the submodules' __all__ list (one public import path: taut.cdpr).
+from .deploy import DeploymentOptions, evaluate_deployment  # noqa: E402
+from .first_order import base_jacobians, parallel_jacobian  # noqa: E402
+from .motion_modes import BASE_JOINTS, Mode, ModeName, joint_bounds, resolve_mode  # noqa: E402
+from .placement import footprint_overlap  # noqa: E402
+from .polytope import HPolytopeBatch, lp_max_step  # noqa: E402
+from .tension import QPSolver, TensionMethod  # noqa: E402
+from .twist import support  # noqa: E402
+from .wrench_set import external_wrench_box  # noqa: E402
+from .zonotope import zonotope_hrep  # noqa: E402
+
+__all__ += [
+    "DeploymentOptions", "evaluate_deployment", "base_jacobians", "parallel_jacobian",
+    "BASE_JOINTS", "Mode", "ModeName", "joint_bounds", "resolve_mode", "footprint_overlap",
+    "HPolytopeBatch", "lp_max_step", "QPSolver", "TensionMethod", "support",
+    "external_wrench_box", "zonotope_hrep",
+]
+
+from .model import with_friction  # noqa: E402
+from .sliding import sliding_rows  # noqa: E402
+
+__all__ += ["with_friction", "sliding_rows"]
+
+from .closure import wrench_closure  # noqa: E402
+
+__all__ += ["wrench_closure"]
+
+from .interference import Interference, cable_interference, segment_distance  # noqa: E402
+
+__all__ += ["Interference", "cable_interference", "segment_distance"]
+
 # Moving robot: forward kinematics, elastic cables and winches, control simulation (issue 13).
 from .cable_fk import CableFKResult, cable_forward_kinematics
 from .dynamics_model import DynamicsModel

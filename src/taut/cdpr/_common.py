@@ -2,16 +2,29 @@
 
 from __future__ import annotations
 
+import warnings
+from functools import lru_cache
+from itertools import combinations
 from typing import Any
 
 import numpy as np
 
+from .._outcome import check_status
 from .._validate import as_array
 from ..errors import InvalidInputError
 from .kinematics import CableState, gravity_wrench, tipping_matrix
+from ._tol import FEAS_REL, RANK_TOL
 from .model import CableRobot
+from .sliding import sliding_rows
 
-RANK_TOL = 1e-9
+
+@lru_cache(maxsize=64)
+def subsets(K: int, s: int) -> np.ndarray:
+    """Every ``s``-subset of ``range(K)`` in lexicographic order, as an (C, s) index array
+    (one row, zero columns for ``s = 0``). Cached: the tables are reused for every batch."""
+    if s == 0:
+        return np.zeros((1, 0), dtype=np.intp)
+    return np.array(list(combinations(range(K), s)), dtype=np.intp).reshape(-1, s)
 
 
 def svd_split(W: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -39,10 +52,12 @@ def required_wrench(robot: CableRobot, state: CableState, external: Any = None,
     return -w
 
 
-def constraints(robot: CableRobot, state: CableState, tipping: bool
+def constraints(robot: CableRobot, state: CableState, tipping: bool, sliding: bool = False
                 ) -> tuple[np.ndarray, np.ndarray]:
-    """Linear constraints ``A t <= b`` on tensions: the bounds of FASTKIT eq. 20 and, when
-    ``tipping``, the edge moments of eqs. 21-23. Returns A (B, K, m) and b (B, K)."""
+    """Linear constraints ``A t <= b`` on tensions: the bounds of FASTKIT eq. 20, when
+    ``tipping`` the edge moments of eqs. 21-23, and when ``sliding`` the friction pyramids
+    of :mod:`taut.cdpr.sliding` (bases with a friction coefficient only). Returns A
+    (B, K, m) and b (B, K); rows in that order (bounds first: 2 m rows)."""
     B, m = state.lengths.shape
     eye = np.eye(m)
     rows = [eye, -eye]
@@ -54,9 +69,49 @@ def constraints(robot: CableRobot, state: CableState, tipping: bool
         A = np.concatenate([A, T], axis=1)
         b = np.concatenate([b, np.broadcast_to(-robot.edge_weight_moment, (B, robot.n_edges))],
                            axis=1)
+    if sliding and robot.has_sliding:
+        S, s, _ = sliding_rows(robot, state.unit)
+        A = np.concatenate([A, S], axis=1)
+        b = np.concatenate([b, np.broadcast_to(s, (B, len(s)))], axis=1)
     return A, b
 
 
 def feas_tol(robot: CableRobot) -> float:
     """Absolute tolerance on tensions and moments, scaled by the largest tension limit."""
-    return 1e-9 * float(np.max(robot.t_max))
+    return FEAS_REL * float(np.max(robot.t_max))
+
+
+def batch_outcome(success: np.ndarray, failure: str, what: str) -> tuple[np.ndarray, str]:
+    """Status array (B,) (``"ok"`` where ``success`` else ``failure``, a value of
+    :data:`taut._outcome.STATUSES`) and a one-line message ``"k of B <what>"``."""
+    check_status(failure)
+    ok = np.asarray(success, dtype=bool)
+    status = np.where(ok, "ok", failure)
+    return status, f"{int(ok.sum())} of {ok.size} {what}"
+
+
+
+def renamed_keyword(new_value: Any, old_value: Any, new: str, old: str) -> Any:
+    """Accept a deprecated keyword ``old`` for ``new`` (kept for one release): warns with a
+    :class:`DeprecationWarning` and returns the value given; both at once is an error."""
+    if old_value is None:
+        return new_value
+    warnings.warn(f"keyword '{old}' is deprecated; use '{new}'", DeprecationWarning,
+                  stacklevel=3)
+    if new_value is not None:
+        raise InvalidInputError(new, f"give '{new}' or the deprecated '{old}', not both")
+    return old_value
+
+
+def wrench_vertices(robot: CableRobot, external_wrench: Any, field: str = "external_wrench"
+                    ) -> np.ndarray:
+    """Extra external wrenches as vertices (V, n) (default one zero wrench); one wrench
+    (n,) is one vertex."""
+    if external_wrench is None:
+        return np.zeros((1, robot.dof))
+    D = as_array(external_wrench, field)
+    D = D[None, :] if D.ndim == 1 else D
+    if D.ndim != 2 or D.shape[1] != robot.dof:
+        raise InvalidInputError(field, f"must be (V, {robot.dof}) vertices of extra "
+                                       "external wrenches (N, N m)")
+    return D

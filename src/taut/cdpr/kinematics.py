@@ -15,6 +15,7 @@ import numpy as np
 
 from .._validate import as_array, require_instance
 from ..errors import InfeasiblePoseError, InvalidInputError
+from ._tol import BOX_REL, ZERO_LENGTH_REL
 from .model import CableRobot
 
 __all__ = ["as_poses", "rotation_matrices", "CableState", "cable_state", "wrench_matrix",
@@ -42,7 +43,7 @@ def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
         arr = np.hstack([arr, np.zeros((arr.shape[0], 3))])
     if check_bounds:
         lo, hi = robot.bounds
-        tol = 1e-9 * (1.0 + np.abs(robot.bounds).max())
+        tol = BOX_REL * (1.0 + np.abs(robot.bounds).max())
         bad = np.any((arr[:, :3] < lo - tol) | (arr[:, :3] > hi + tol), axis=1)
         if np.any(bad):
             i = int(np.argmax(bad))
@@ -123,8 +124,11 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
     r = np.einsum("bij,mj->bmi", R, robot.attach_local)
     vec = robot.exits_world[None, :, :] - (P[:, None, :3] + r)
     L = np.linalg.norm(vec, axis=2)
-    if np.any(L <= 1e-12 * (1.0 + np.abs(robot.exits_world).max())):
-        i = int(np.argmax(np.any(L <= 1e-12, axis=1)))
+    # One tolerance for the check and for the index it reports (they used to differ, so
+    # a near-zero length between the two thresholds named pose 0 instead of the culprit).
+    short = np.any(L <= ZERO_LENGTH_REL * (1.0 + np.abs(robot.exits_world).max()), axis=1)
+    if np.any(short):
+        i = int(np.argmax(short))
         raise InfeasiblePoseError("pose", f"pose {i} puts an attachment point on its exit "
                                           "point (zero cable length)")
     u = vec / L[:, :, None]

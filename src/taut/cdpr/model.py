@@ -22,9 +22,13 @@ import numpy as np
 
 from .._validate import MAX_TENSION_N, as_array, as_finite_scalar, as_points, check_range
 from ..errors import InvalidModelError
+from ._tol import INERTIA_REL
+from .footprint import check_footprint
+from .footprint import convex_hull_2d as _convex_hull_2d
+from .footprint import inside_convex as _inside_convex
 
 __all__ = ["Base", "Platform", "Payload", "Cable", "CableRobot", "check_footprint",
-           "with_stabilisers"]
+           "with_stabilisers", "with_friction"]
 
 
 def _rot_z(theta: float) -> np.ndarray:
@@ -38,81 +42,6 @@ def _named_points(points: Mapping[str, Any], fld: str) -> tuple[tuple[str, ...],
     names = tuple(str(k) for k in points)
     arr = np.stack([as_array(points[k], f"{fld}.{k}", shape=(3,)) for k in points])
     return names, arr
-
-
-def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-def check_footprint(vertices: Any, fld: str) -> np.ndarray:
-    """Validate a ground-contact footprint and return it counter-clockwise.
-
-    Parameters
-    ----------
-    vertices : array_like, shape (p, 2)
-        Contact points (m) in order around the polygon, either orientation.
-    fld : str
-        Field name used in error messages.
-
-    Returns
-    -------
-    ndarray, shape (p, 2)
-        The same polygon, counter-clockwise seen from above (the orientation for which the
-        FASTKIT tipping moments, eqs. 21-23, are <= 0 when the base is stable).
-
-    Raises
-    ------
-    InvalidModelError
-        Fewer than 3 vertices, repeated or collinear vertices, zero area, non-convex or
-        self-intersecting polygon.
-    """
-    pts = as_points(vertices, fld, dim=2, min_count=1)
-    if pts.shape[0] < 3:
-        raise InvalidModelError(fld, f"a footprint needs at least 3 contact points, got "
-                                     f"{pts.shape[0]}")
-    scale = float(np.max(np.ptp(pts, axis=0)))
-    if scale <= 0.0:
-        raise InvalidModelError(fld, "degenerate footprint: all contact points coincide")
-    edges = np.roll(pts, -1, axis=0) - pts
-    if np.any(np.linalg.norm(edges, axis=1) <= 1e-9 * scale):
-        raise InvalidModelError(fld, "degenerate footprint: repeated contact points")
-    area2 = float(np.sum(_cross2(pts, np.roll(pts, -1, axis=0))))
-    if abs(area2) <= 1e-9 * scale * scale:
-        raise InvalidModelError(fld, "degenerate footprint: zero area (collinear points)")
-    turn = _cross2(edges, np.roll(edges, -1, axis=0)) * np.sign(area2)
-    if np.any(turn <= 1e-12 * scale * scale):
-        if np.any(turn < -1e-12 * scale * scale):
-            raise InvalidModelError(fld, "footprint must be convex")
-        raise InvalidModelError(fld, "degenerate footprint: three collinear contact points")
-    # Convex turns everywhere; a star polygon would wind more than once.
-    ang = np.arctan2(_cross2(edges, np.roll(edges, -1, axis=0)),
-                     np.sum(edges * np.roll(edges, -1, axis=0), axis=1))
-    if abs(abs(float(np.sum(ang))) - 2 * np.pi) > 1e-6:
-        raise InvalidModelError(fld, "footprint must be a simple convex polygon "
-                                     "(it winds around more than once)")
-    return pts if area2 > 0 else pts[::-1].copy()
-
-
-def _convex_hull_2d(pts: np.ndarray) -> np.ndarray:
-    """Counter-clockwise convex hull (monotone chain), dropping collinear points."""
-    p = np.unique(pts, axis=0)
-    p = p[np.lexsort((p[:, 1], p[:, 0]))]
-
-    def half(seq: np.ndarray) -> list[np.ndarray]:
-        out: list[np.ndarray] = []
-        for q in seq:
-            while len(out) >= 2 and _cross2(out[-1] - out[-2], q - out[-2]) <= 0:
-                out.pop()
-            out.append(q)
-        return out
-
-    lower, upper = half(p), half(p[::-1])
-    return np.array(lower[:-1] + upper[:-1])
-
-
-def _inside_convex(poly: np.ndarray, pt: np.ndarray) -> bool:
-    edges = np.roll(poly, -1, axis=0) - poly
-    return bool(np.all(_cross2(edges, pt[None, :] - poly) > 0))
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,6 +68,13 @@ class Base:
         Contact points of the stabiliser feet in the base frame, m.
     stabilisers_deployed : bool
         When True the support polygon is the convex hull of the wheels and stabilisers.
+    friction : float or None
+        Coulomb friction coefficient (dimensionless, >= 0) between the ground and the
+        wheels / stabiliser feet of a mobile base; None (default) does not model sliding.
+        See :mod:`taut.cdpr.sliding`.
+    friction_sides : int
+        Number of faces (>= 3) of the linearised friction pyramid (inscribed in the cone,
+        so conservative by at most ``1 - cos(pi / friction_sides)``; default 8: 7.6 %).
     """
 
     name: str
@@ -150,6 +86,8 @@ class Base:
     footprint: Any = None
     stabilisers: Any = None
     stabilisers_deployed: bool = False
+    friction: float | None = None
+    friction_sides: int = 8
     exit_names: tuple[str, ...] = field(init=False)
     exit_local: np.ndarray = field(init=False, repr=False)
 
@@ -162,6 +100,14 @@ class Base:
         object.__setattr__(self, "pose", as_array(self.pose, f"{f}.pose", shape=(3,)))
         object.__setattr__(self, "com", as_array(self.com, f"{f}.com", shape=(3,)))
         object.__setattr__(self, "mass", as_finite_scalar(self.mass, f"{f}.mass"))
+        if self.friction is not None:
+            mu = as_finite_scalar(self.friction, f"{f}.friction")
+            if mu < 0:
+                raise InvalidModelError(f"{f}.friction", f"must be non-negative, got {mu:g}")
+            object.__setattr__(self, "friction", mu)
+        sides = self.friction_sides
+        if isinstance(sides, bool) or not isinstance(sides, (int, np.integer)) or sides < 3:
+            raise InvalidModelError(f"{f}.friction_sides", "must be an integer >= 3")
         if not self.mobile:
             return
         if not self.mass > 0:
@@ -187,6 +133,14 @@ class Base:
     def to_world(self, local: np.ndarray) -> np.ndarray:
         """Map base-frame points ``(..., 3)`` to world coordinates, m."""
         return local @ self.rotation.T + np.array([self.pose[0], self.pose[1], 0.0])
+
+    def support_world(self) -> np.ndarray:
+        """(p, 3) support polygon in the world (z = 0), counter-clockwise; (0, 3) for a
+        fixed frame."""
+        poly = self.support_polygon
+        if poly is None:
+            return np.zeros((0, 3))
+        return self.to_world(np.column_stack([poly, np.zeros(len(poly))]))
 
     @property
     def support_polygon(self) -> np.ndarray | None:
@@ -239,9 +193,9 @@ class Platform:
             inertia = np.diag(inertia)
         if inertia.shape != (3, 3):
             raise InvalidModelError("platform.inertia", "must be 3 numbers or a 3x3 matrix")
-        if not np.allclose(inertia, inertia.T, atol=1e-12 * (1 + np.abs(inertia).max())):
+        if not np.allclose(inertia, inertia.T, atol=INERTIA_REL * (1 + np.abs(inertia).max())):
             raise InvalidModelError("platform.inertia", "must be symmetric")
-        if np.linalg.eigvalsh(inertia).min() < -1e-12 * (1 + np.abs(inertia).max()):
+        if np.linalg.eigvalsh(inertia).min() < -INERTIA_REL * (1 + np.abs(inertia).max()):
             raise InvalidModelError("platform.inertia", "must be positive semi-definite")
         object.__setattr__(self, "inertia", inertia)
 
@@ -325,6 +279,19 @@ class CableRobot:
     bounds: Any = None
     desired_workspace: Any = None
     name: str = "cable robot"
+    # Derived fields, filled by __post_init__ (declared so that type checkers see them).
+    m: int = field(init=False)
+    dof: int = field(init=False)
+    exits_world: np.ndarray = field(init=False, repr=False)
+    attach_local: np.ndarray = field(init=False, repr=False)
+    t_min: np.ndarray = field(init=False, repr=False)
+    t_max: np.ndarray = field(init=False, repr=False)
+    cable_base: np.ndarray = field(init=False, repr=False)
+    edge_points: np.ndarray = field(init=False, repr=False)
+    edge_dirs: np.ndarray = field(init=False, repr=False)
+    edge_base: np.ndarray = field(init=False, repr=False)
+    edge_weight_moment: np.ndarray = field(init=False, repr=False)
+    _tip_V: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         s = object.__setattr__
@@ -391,7 +358,13 @@ class CableRobot:
         if m < self.dof:
             raise InvalidModelError("cables", f"{m} cables cannot balance a {self.dof}-DoF "
                                               "platform")
-        # Frame bounds and desired workspace.
+        self._set_boxes(exits)
+        self._build_tipping()
+
+    def _set_boxes(self, exits: np.ndarray) -> None:
+        """Frame bounds (default: the exits' bounding box from the ground up) and the
+        desired workspace, validated."""
+        s = object.__setattr__
         if self.bounds is None:
             lo = exits.min(axis=0)
             hi = exits.max(axis=0)
@@ -407,7 +380,6 @@ class CableRobot:
             if np.any(dw[1] < dw[0]):
                 raise InvalidModelError("desired_workspace", "lower corner above upper corner")
             s(self, "desired_workspace", dw)
-        self._build_tipping()
 
     def _build_tipping(self) -> None:
         pts, dirs, eb, m0 = [], [], [], []
@@ -454,6 +426,11 @@ class CableRobot:
         return self.n_edges > 0
 
     @property
+    def has_sliding(self) -> bool:
+        """True when at least one mobile base has a friction coefficient."""
+        return any(b.mobile and b.friction is not None for b in self.bases)
+
+    @property
     def total_mass(self) -> float:
         """Platform plus payload mass, kg."""
         return self.platform.mass + self.payload.mass
@@ -465,6 +442,25 @@ class CableRobot:
                            "stabilisers_deployed": b.stabilisers_deployed}
                           for b in self.bases],
                 "moving_mass_kg": self.total_mass}
+
+
+def with_friction(robot: CableRobot, friction: float | None,
+                  sides: int | None = None) -> CableRobot:
+    """The same robot with ground friction coefficient ``friction`` (dimensionless) on every
+    mobile base (None: sliding not modelled), and optionally ``sides`` faces of the
+    linearised friction pyramid.
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> [b.friction for b in with_friction(load_cdpr_model("fastkit"), 0.3).bases]
+    [0.3, 0.3]
+    """
+    from dataclasses import replace
+    bases = tuple(replace(b, exit_points=dict(b.exit_points), friction=friction,
+                          friction_sides=b.friction_sides if sides is None else sides)
+                  if b.mobile else b for b in robot.bases)
+    return replace(robot, bases=bases)
 
 
 def with_stabilisers(robot: CableRobot, deployed: bool = True) -> CableRobot:

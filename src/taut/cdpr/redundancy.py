@@ -21,19 +21,28 @@ point and its result is re-checked against the limits.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Literal, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import linprog, minimize
 
+from .._outcome import deprecated_alias
 from .._validate import as_array
 from ..errors import InvalidInputError
+from ._tol import RATE_FLOOR, SCALE_ONE
+from .first_order import FirstOrderModel, first_order_model
 from .model import CableRobot
-from .twist import MotionLimits, fastkit_motion_limits, first_order_model, joint_bounds
+from .motion_modes import ModeName, MotionLimits, fastkit_motion_limits, joint_bounds
 
 __all__ = ["OBJECTIVES", "RedundancyResult", "resolve_redundancy"]
 
 OBJECTIVES = ("min_norm", "least_base")
+Objective = Literal["min_norm", "least_base"]
+
+
+def _no_reason(self: Any, message: str) -> str:
+    return "" if self.success else message
 
 
 @dataclass(frozen=True)
@@ -42,8 +51,15 @@ class RedundancyResult:
 
     Attributes
     ----------
-    feasible : bool
+    success : bool
         The twist is available (inside the ATS) and ``q_dot`` reproduces it within limits.
+        (``feasible`` is its deprecated alias.)
+    status : str
+        ``"ok"``, or ``"infeasible"`` when only a fraction ``scale`` of the twist is
+        available within the joint limits.
+    message : str
+        One line: what was found, or why not (``reason``, its deprecated alias, is empty
+        on success).
     q_dot : (3k + m,) or (3,)
         Joint rates in ``joint_names`` order (base rates rad/s, m/s; cable speeds m/s).
         When infeasible: the rates of the largest feasible fraction ``scale`` of the twist.
@@ -56,11 +72,11 @@ class RedundancyResult:
         ``max |A t - B q_dot|`` for the returned rates at ``scale``, m/s.
     objective : str
     joint_names : tuple of str
-    reason : str
-        Empty when feasible; otherwise a one-line explanation.
     """
 
-    feasible: bool
+    success: bool
+    status: str
+    message: str
     q_dot: np.ndarray
     base_rates: np.ndarray
     cable_speeds: np.ndarray
@@ -68,7 +84,9 @@ class RedundancyResult:
     residual: float
     objective: str
     joint_names: tuple[str, ...]
-    reason: str
+
+    feasible = deprecated_alias("success", "feasible")
+    reason = deprecated_alias("message", "reason", transform=_no_reason)
 
 
 def _lp_scale(C: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray, nb: int
@@ -88,9 +106,9 @@ def _lp_scale(C: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray, nb: 
     return float(sol.x[-1]), sol.x[:nb]
 
 
-def resolve_redundancy(robot: CableRobot, pose: Any, twist: Any,
-                       limits: MotionLimits | None = None, *, mode: str = "task",
-                       moving: Sequence[str] | None = None, objective: str = "min_norm",
+def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
+                       limits: MotionLimits | None = None, *, mode: ModeName = "task",
+                       moving: Sequence[str] | None = None, objective: Objective = "min_norm",
                        tol: float = 1e-9) -> RedundancyResult:
     """Joint rates producing a desired platform twist within joint limits.
 
@@ -134,13 +152,13 @@ def resolve_redundancy(robot: CableRobot, pose: Any, twist: Any,
     scale, x0 = _lp_scale(C, d, lo, hi, nb)
     if scale < 0:
         q = np.concatenate([np.zeros(nb), np.zeros(robot.m)])
-        return RedundancyResult(False, q, q[:nb], q[nb:], 0.0, float(np.abs(d).max()),
-                                objective, names, "even standing still violates the joint "
-                                                  "limits (every limit interval must contain 0)")
-    feasible = scale >= 1.0 - 1e-9
+        return RedundancyResult(False, "infeasible", "even standing still violates the joint "
+                                "limits (every limit interval must contain 0)", q, q[:nb],
+                                q[nb:], 0.0, float(np.abs(d).max()), objective, names)
+    feasible = scale >= 1.0 - SCALE_ONE
     s_use = 1.0 if feasible else scale
     dd = d * s_use
-    w = 1.0 / np.maximum(np.maximum(np.abs(lo), np.abs(hi)), 1e-12)
+    w = 1.0 / np.maximum(np.maximum(np.abs(lo), np.abs(hi)), RATE_FLOOR)
     wb, wc = w[:nb], w[nb:]
     cable_w = 1.0 if objective == "min_norm" else 1e-3
     x = x0
@@ -166,29 +184,34 @@ def resolve_redundancy(robot: CableRobot, pose: Any, twist: Any,
     cables = dd - C @ x
     q = np.concatenate([x, cables])
     resid = float(np.abs(fom.A[0] @ (t * s_use) - fom.B[0] @ q).max())
-    reason = "" if feasible else (f"the twist is outside the available twist set; only "
-                                  f"{scale:.3f} of it is reachable within the joint limits")
-    return RedundancyResult(bool(feasible), q, x, cables, float(s_use), resid, objective,
-                            names, reason)
+    message = ("the twist is available within the joint limits" if feasible else
+               f"the twist is outside the available twist set; only {scale:.3f} of it is "
+               "reachable within the joint limits")
+    return RedundancyResult(bool(feasible), "ok" if feasible else "infeasible", message, q, x,
+                            cables, float(s_use), resid, objective, names)
 
 
-def _navigation(fom, t, lo, hi, objective, names, tol, m) -> RedundancyResult:
+def _navigation(fom: FirstOrderModel, t: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                objective: str, names: tuple[str, ...], tol: float, m: int
+                ) -> RedundancyResult:
     M = fom.base_twists[0, fom.mode.moving[0]]                 # (n, 3)
     x, *_ = np.linalg.lstsq(M, t, rcond=None)
     resid = float(np.abs(M @ x - t).max())
     if resid > tol * (1 + np.abs(t).max()):
         q = np.zeros(3)
-        return RedundancyResult(False, q, q, np.zeros(m), 0.0, resid, objective, names,
-                                "in navigation mode the platform only moves like the driver "
-                                "base (planar twists vx, vy, wz)")
+        return RedundancyResult(False, "infeasible", "in navigation mode the platform only "
+                                "moves like the driver base (planar twists vx, vy, wz)", q, q,
+                                np.zeros(m), 0.0, resid, objective, names)
     # scale so that x stays inside [lo, hi]
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(x > 0, hi / x, np.where(x < 0, lo / x, np.inf))
     scale = float(min(1.0, r.min())) if np.all(lo <= 0) and np.all(hi >= 0) else 0.0
-    feasible = scale >= 1.0 - 1e-9
+    feasible = scale >= 1.0 - SCALE_ONE
     xs = x * (1.0 if feasible else scale)
-    return RedundancyResult(bool(feasible), xs, xs, np.zeros(m), 1.0 if feasible else scale,
+    message = ("the driver base produces the twist within its limits" if feasible else
+               f"the driver base would exceed its limits; only {scale:.3f} of the twist is "
+               "reachable")
+    return RedundancyResult(bool(feasible), "ok" if feasible else "infeasible", message, xs,
+                            xs, np.zeros(m), 1.0 if feasible else scale,
                             float(np.abs(M @ xs - t * (1.0 if feasible else scale)).max()),
-                            objective, names, "" if feasible else
-                            f"the driver base would exceed its limits; only {scale:.3f} of "
-                            "the twist is reachable")
+                            objective, names)

@@ -29,19 +29,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import combinations
-from typing import Any
+from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import linprog, minimize
 
+from .._outcome import deprecated_alias
 from ..errors import InvalidInputError
-from ._common import constraints, feas_tol, required_wrench, svd_split
+from ._common import batch_outcome, constraints, feas_tol, required_wrench, svd_split
+from ._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_REL
 from .kinematics import as_poses, cable_state, tipping_matrix
 from .model import CableRobot
 
 __all__ = ["TensionResult", "distribute_tensions", "METHODS"]
 
 METHODS = ("closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm")
+TensionMethod = Literal["closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm"]
+QPSolver = Literal["auto", "enumeration", "scipy"]
 
 
 @dataclass(frozen=True)
@@ -52,9 +57,14 @@ class TensionResult:
     ----------
     tensions : ndarray (B, m)
         Cable tensions, N. For infeasible poses: the method's best attempt (closed form),
-        or NaN where the solver found none (LP/QP); never use them without ``feasible``.
-    feasible : ndarray (B,) of bool
+        or NaN where the solver found none (LP/QP); never use them without ``success``.
+    success : ndarray (B,) of bool
         True when the tensions satisfy eqs. 17 and 20 (and 21-23 when ``tipping``).
+        (``feasible`` is its deprecated alias.)
+    status : ndarray (B,) of str
+        ``"ok"`` where ``success``, else ``"infeasible"`` (see :mod:`taut._outcome`).
+    message : str
+        One line: how many poses are balanced within the limits.
     residual : ndarray (B,)
         ``max |W t + w_e|`` (N, N m); NaN where no tensions were found.
     tipping_moments : ndarray (B, E)
@@ -63,19 +73,27 @@ class TensionResult:
     method : str
     tipping : bool
         Whether tipping constraints were imposed.
+    sliding : bool
+        Whether friction (sliding) constraints were imposed.
     """
 
     tensions: np.ndarray
-    feasible: np.ndarray
+    success: np.ndarray
+    status: np.ndarray
+    message: str
     residual: np.ndarray
     tipping_moments: np.ndarray
     method: str
     tipping: bool
+    sliding: bool = False
+
+    feasible = deprecated_alias("success", "feasible")
 
 
-def distribute_tensions(robot: CableRobot, poses: Any, method: str = "closed_form", *,
-                        external_wrench: Any = None, tipping: bool = False,
-                        qp_solver: str = "auto") -> TensionResult:
+def distribute_tensions(robot: CableRobot, poses: ArrayLike,
+                        method: TensionMethod = "closed_form", *,
+                        external_wrench: ArrayLike | None = None, tipping: bool = True,
+                        qp_solver: QPSolver = "auto", sliding: bool = True) -> TensionResult:
     """Distribute cable tensions over a batch of poses.
 
     Parameters
@@ -88,16 +106,32 @@ def distribute_tensions(robot: CableRobot, poses: Any, method: str = "closed_for
     external_wrench : array_like (n,) or (B, n), optional
         Extra wrench applied to the platform on top of platform and payload weight
         (forces N, then moments N m about P, world frame).
-    tipping : bool
-        Impose the tipping constraints of the mobile bases (FASTKIT eqs. 21-23).
-        ``closed_form`` does not use them to choose tensions; it reports a pose feasible
-        only when its tensions happen to satisfy them.
+    tipping : bool, default True
+        Impose the tipping constraints of the mobile bases (FASTKIT eqs. 21-23); ignored
+        for fixed frames. True by default, like every other analysis of this package: a
+        distribution that tips a base over is not a physical answer. ``closed_form`` does
+        not use them to choose tensions; it reports a pose feasible only when its tensions
+        happen to satisfy them. Pass ``tipping=False`` for the tension limits alone.
+    sliding : bool, default True
+        Impose the friction condition of the mobile bases that have a friction
+        coefficient (:mod:`taut.cdpr.sliding`); no effect on a model without one.
+        ``closed_form`` only checks it, like tipping.
     qp_solver : {"auto", "enumeration", "scipy"}
         For ``qp_min_norm``: exact batched enumeration (needs m - n <= 2) or SciPy SLSQP.
 
     Returns
     -------
     TensionResult
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> res = distribute_tensions(robot, [[0, 0, 0.6], [0, 0, 2.2]], "qp_min_norm")
+    >>> res.success.tolist(), res.status.tolist()
+    ([True, False], ['ok', 'infeasible'])
+    >>> bool((robot.t_min <= res.tensions[0]).all()), bool(res.residual[0] < 1e-9)
+    (True, True)
     """
     if method not in METHODS:
         raise InvalidInputError("method", f"unknown method {method!r}; choose one of "
@@ -108,7 +142,8 @@ def distribute_tensions(robot: CableRobot, poses: Any, method: str = "closed_for
     st = cable_state(robot, P, validated=True)
     w = required_wrench(robot, st, external_wrench)
     use_tip = bool(tipping and robot.has_tipping)
-    A, b = constraints(robot, st, use_tip)
+    use_slide = bool(sliding and robot.has_sliding)
+    A, b = constraints(robot, st, use_tip, use_slide)
     if method == "closed_form":
         pinv, ok = None, np.ones(P.shape[0], dtype=bool)    # rank judged by the residual
         t = _closed_form(robot, st.W, w, ok)
@@ -135,13 +170,19 @@ def distribute_tensions(robot: CableRobot, poses: Any, method: str = "closed_for
              + robot.edge_weight_moment)
     tol = feas_tol(robot)
     wscale = 1.0 + np.abs(w).max(axis=1)
-    feas = (found & ok & (res <= 1e-9 * wscale)
+    feas = (found & ok & (res <= RESIDUAL_REL * wscale)
             & np.all(np.einsum("bkm,bm->bk", A, tz) <= b + tol, axis=1))
     if use_tip:
         feas &= np.all(tip_m <= tol, axis=1)
     t_out = np.where(found[:, None], tz, np.nan)
-    return TensionResult(t_out, feas, np.where(found, res, np.nan),
-                         np.where(found[:, None], tip_m, np.nan), method, use_tip)
+    names = ["tension"] + (["tipping"] if use_tip else []) + (["sliding"] if use_slide else [])
+    what = " and ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
+    status, message = batch_outcome(feas, "infeasible", f"poses balanced within the {what} "
+                                    "limits")
+    return TensionResult(tensions=t_out, success=feas, status=status, message=message,
+                         residual=np.where(found, res, np.nan),
+                         tipping_moments=np.where(found[:, None], tip_m, np.nan),
+                         method=method, tipping=use_tip, sliding=use_slide)
 
 
 def _chunks(n: int, size: int) -> list[slice]:
@@ -222,7 +263,7 @@ def _lp(W: np.ndarray, w: np.ndarray, A: np.ndarray, b: np.ndarray, robot: Cable
         else:
             c = np.ones(m)
             Aeq = W[k]
-            Aub = extra[k] if extra.shape[1] else None
+            Aub = extra[k] if extra.shape[1] else None  # type: ignore[assignment]
             bub = b[k, 2 * m:] if extra.shape[1] else None
             bounds = bx
         sol = linprog(c, A_ub=Aub, b_ub=bub, A_eq=Aeq, b_eq=w[k], bounds=bounds,
@@ -243,13 +284,13 @@ def _qp_enum(pinv: np.ndarray, N: np.ndarray, w: np.ndarray, A: np.ndarray, b: n
     cands = [np.zeros((B, 1, r))]
     if r >= 1:
         gg = np.einsum("bkr,bkr->bk", G, G)
-        safe = np.where(gg > 1e-24, gg, np.inf)
+        safe = np.where(gg > QP_ROW_SQ, gg, np.inf)
         cands.append(G * (h / safe)[..., None])             # feet on each constraint line
     if r == 2:
         i, j = np.array(list(combinations(range(K), 2))).T
         gi, gj = G[:, i, :], G[:, j, :]
         det = gi[..., 0] * gj[..., 1] - gi[..., 1] * gj[..., 0]
-        sd = np.where(np.abs(det) > 1e-12, det, np.nan)
+        sd = np.where(np.abs(det) > QP_PARALLEL, det, np.nan)
         hi_, hj = h[:, i], h[:, j]
         z0 = (hi_ * gj[..., 1] - hj * gi[..., 1]) / sd
         z1 = (gi[..., 0] * hj - gj[..., 0] * hi_) / sd
@@ -281,6 +322,6 @@ def _qp_scipy(W: np.ndarray, w: np.ndarray, A: np.ndarray, b: np.ndarray,
                  "jac": lambda t, k=k: -A[k]}]
         sol = minimize(lambda t: 0.5 * t @ t, tm, jac=lambda t: t, constraints=cons,
                        method="SLSQP", options={"ftol": 1e-12, "maxiter": 200})
-        if sol.success and np.all(A[k] @ sol.x <= b[k] + 1e-6 * tol / 1e-9):
+        if sol.success and np.all(A[k] @ sol.x <= b[k] + SLSQP_REL * float(np.max(robot.t_max))):
             out[k] = sol.x
     return out

@@ -17,11 +17,11 @@ Any number of mobile bases and polygon sizes are handled; fixed frames have no e
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array
+from ..errors import InvalidInputError
 from ._common import feas_tol
 from .kinematics import as_poses, cable_state, tipping_matrix
 from .model import CableRobot
@@ -51,14 +51,13 @@ class TippingResult:
     edge_base: np.ndarray
 
 
-def tipping_moments(robot: CableRobot, poses: Any, tensions: Any) -> TippingResult:
+def tipping_moments(robot: CableRobot, poses: ArrayLike, tensions: ArrayLike) -> TippingResult:
     """Moments of base weight and cable forces about every support-polygon edge of every
     mobile base (FASTKIT eqs. 21-23) for poses (B, 6) (m, rad) and tensions (B, m) (N)."""
     P = as_poses(robot, poses)
     t = as_array(tensions, "tensions")
     t = np.broadcast_to(t, (P.shape[0], robot.m)) if t.ndim == 1 else t
     if t.shape != (P.shape[0], robot.m):
-        from ..errors import InvalidInputError
         raise InvalidInputError("tensions", f"must have shape ({P.shape[0]}, {robot.m})")
     st = cable_state(robot, P, validated=True)
     M = np.einsum("bji,bi->bj", tipping_matrix(robot, st.unit), t) + robot.edge_weight_moment

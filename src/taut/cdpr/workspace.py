@@ -4,19 +4,22 @@ without the tipping constraints of mobile bases, for one orientation or a sweep 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array
 from ..errors import InvalidInputError
+from ._common import renamed_keyword
+from ._tol import BOX_REL
 from .model import CableRobot
 from .wrench_set import wrench_feasible
 
 __all__ = ["WorkspaceResult", "grid_points", "wrench_feasible_workspace"]
 
 
-def grid_points(box: Any, shape: Any) -> tuple[np.ndarray, tuple[int, int, int]]:
+def grid_points(box: ArrayLike, shape: ArrayLike) -> tuple[np.ndarray, tuple[int, int, int]]:
     """Regular grid over ``box`` ([[xmin, ymin, zmin], [xmax, ymax, zmax]], m) with ``shape``
     (nx, ny, nz) points per axis (a flat axis gets one point). Returns points (P, 3) in
     C order (x slowest) and the effective shape."""
@@ -24,7 +27,8 @@ def grid_points(box: Any, shape: Any) -> tuple[np.ndarray, tuple[int, int, int]]
     sh = np.asarray(shape, dtype=float)
     if sh.shape != (3,) or np.any(sh < 1) or np.any(sh != np.round(sh)):
         raise InvalidInputError("grid", "must be three positive integers nx ny nz")
-    eff = tuple(int(n) if b[1, k] > b[0, k] else 1 for k, n in enumerate(sh))
+    nx, ny, nz = (int(n) if b[1, k] > b[0, k] else 1 for k, n in enumerate(sh))
+    eff = (nx, ny, nz)
     axes = [np.linspace(b[0, k], b[1, k], eff[k]) if eff[k] > 1 else
             np.array([0.5 * (b[0, k] + b[1, k])]) for k in range(3)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
@@ -54,6 +58,16 @@ class WorkspaceResult:
         feasible without tipping.
     coverage_tipping : float or None
         The same with tipping.
+    feasible_sliding : (P,) bool or None
+        Also without sliding a mobile base (tension limits, tipping and the friction
+        condition of :mod:`taut.cdpr.sliding`); None when no base has a friction
+        coefficient.
+    coverage_sliding : float or None
+        Coverage with all three conditions.
+    binding : (P,) str
+        Per position, the first condition (in the order ``"limits"``, ``"tipping"``,
+        ``"sliding"``) whose addition makes it infeasible; ``""`` where feasible with every
+        condition the model has.
     """
 
     points: np.ndarray
@@ -64,50 +78,82 @@ class WorkspaceResult:
     shape: tuple[int, ...] | None
     coverage: float
     coverage_tipping: float | None
+    feasible_sliding: np.ndarray | None = None
+    coverage_sliding: float | None = None
+    binding: np.ndarray | None = None
 
 
-def wrench_feasible_workspace(robot: CableRobot, points: Any, *, orientations: Any = None,
-                              disturbance: Any = None, shape: tuple[int, ...] | None = None,
-                              chunk: int = 2048,
-                              progress: Callable[[int, int], None] | None = None
-                              ) -> WorkspaceResult:
+def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
+                              orientations: ArrayLike | None = None,
+                              external_wrench: ArrayLike | None = None,
+                              shape: tuple[int, ...] | None = None, chunk: int = 2048,
+                              progress: Callable[[int, int], None] | None = None,
+                              disturbance: ArrayLike | None = None) -> WorkspaceResult:
     """Evaluate the wrench-feasible workspace at positions ``points`` (P, 3), m.
 
     A position belongs to the WFW when, at every orientation of ``orientations`` ((O, 3)
     roll-pitch-yaw, rad; default level), the cables can hold platform and payload weight
-    plus every wrench of ``disturbance`` ((V, n), N and N m) within their tension limits,
+    plus every wrench of ``external_wrench`` ((V, n), N and N m; ``disturbance`` is its
+    deprecated name) within their tension limits,
     and, for ``feasible_tipping``, without tipping a mobile base. Vectorised (see
     :func:`taut.cdpr.wrench_set.wrench_feasible`). ``progress(done, total)`` is called after
     each block of ``chunk`` poses. Positions outside the frame raise :class:`InfeasiblePoseError`.
     """
+    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     pts = as_array(points, "points", shape=(None, 3))
     ori = np.zeros((1, 3)) if orientations is None else \
         as_array(orientations, "orientations", shape=(None, 3))
     Pn, On = pts.shape[0], ori.shape[0]
     poses = np.hstack([np.repeat(pts, On, axis=0), np.tile(ori, (Pn, 1))])
-    tip = robot.has_tipping
-    total = poses.shape[0] * (2 if tip else 1)
-    done = 0
-    res = {}
-    for with_tip in ((False, True) if tip else (False,)):
-        out = np.empty(poses.shape[0], dtype=bool)
-        for s0 in range(0, poses.shape[0], chunk):
-            sl = slice(s0, s0 + chunk)
-            out[sl] = wrench_feasible(robot, poses[sl], tipping=with_tip,
-                                      disturbance=disturbance)
-            done += out[sl].size
-            if progress is not None:
-                progress(done, total)
-        res[with_tip] = out.reshape(Pn, On)
-    feas = res[False].all(axis=1)
-    feas_t = res[True].all(axis=1) if tip else None
-    if robot.desired_workspace is not None:
-        lo, hi = robot.desired_workspace
-        tol = 1e-9 * (1 + np.abs(robot.desired_workspace).max())
-        inside = np.all((pts >= lo - tol) & (pts <= hi + tol), axis=1)
-    else:
-        inside = np.ones(Pn, dtype=bool)
+    passes = [("limits", False, False)]
+    if robot.has_tipping:
+        passes.append(("tipping", True, False))
+    if robot.has_sliding:
+        passes.append(("sliding", True, True))
+    counter = _Progress(progress, poses.shape[0] * len(passes))
+    res = {name: _feasible_pass(robot, poses, tip, slide, ext, chunk, counter).reshape(Pn, On)
+           for name, tip, slide in passes}
+    feas = {name: np.asarray(r.all(axis=1)) for name, r in res.items()}
+    inside = _inside_desired(robot, pts)
     denom = max(int(inside.sum()), 1)
-    cov = float((feas & inside).sum() / denom)
-    cov_t = float((feas_t & inside).sum() / denom) if tip else None
-    return WorkspaceResult(pts, ori, feas, feas_t, res[tip], shape, cov, cov_t)
+    cov = {name: float((f & inside).sum() / denom) for name, f in feas.items()}
+    binding = np.full(Pn, "", dtype="<U7")
+    so_far = np.ones(Pn, dtype=bool)
+    for name, f in feas.items():               # the first condition that fails binds
+        binding[so_far & ~f] = name
+        so_far &= f
+    last = "tipping" if "tipping" in res else "limits"
+    return WorkspaceResult(pts, ori, feas["limits"], feas.get("tipping"), res[last], shape,
+                           cov["limits"], cov.get("tipping"), feas.get("sliding"),
+                           cov.get("sliding"), binding)
+
+
+class _Progress:
+    """Calls ``progress(done, total)`` as blocks of poses finish."""
+
+    def __init__(self, progress: Callable[[int, int], None] | None, total: int) -> None:
+        self.progress, self.total, self.done = progress, total, 0
+
+    def step(self, n: int) -> None:
+        self.done += n
+        if self.progress is not None:
+            self.progress(self.done, self.total)
+
+
+def _feasible_pass(robot: CableRobot, poses: np.ndarray, tipping: bool, sliding: bool,
+                   ext: ArrayLike | None, chunk: int, counter: _Progress) -> np.ndarray:
+    out = np.empty(poses.shape[0], dtype=bool)
+    for s0 in range(0, poses.shape[0], chunk):
+        sl = slice(s0, s0 + chunk)
+        out[sl] = wrench_feasible(robot, poses[sl], tipping=tipping, sliding=sliding,
+                                  external_wrench=ext)
+        counter.step(out[sl].size)
+    return out
+
+
+def _inside_desired(robot: CableRobot, pts: np.ndarray) -> np.ndarray:
+    if robot.desired_workspace is None:
+        return np.ones(pts.shape[0], dtype=bool)
+    lo, hi = robot.desired_workspace
+    tol = BOX_REL * (1 + np.abs(robot.desired_workspace).max())
+    return np.all((pts >= lo - tol) & (pts <= hi + tol), axis=1)

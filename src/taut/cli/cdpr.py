@@ -82,7 +82,7 @@ def _tensions(model: str, pose: Any, rpy: Any, method: Method, tipping: bool,
     rows = [[n, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if lo - 1e-6 <= v <= hi + 1e-6 else "!"]
             for n, v, lo, hi in zip(names, t, robot.t_min, robot.t_max)]
     typer.echo(_table(["cable", "tension [N]", "min", "max", ""], rows))
-    typer.echo(f"feasible: {'yes' if doc['feasible'] else 'no'}   "
+    typer.echo(f"feasible: {'yes' if res.success[0] else 'no'}   "
                f"residual max|W t + w_e| = {res.residual[0]:.2e}")
     if robot.has_tipping:
         M = res.tipping_moments[0]

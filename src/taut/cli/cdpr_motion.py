@@ -88,7 +88,7 @@ def _deploy(model: str, ws: Any, disturbance: Any, twist: Any, stabilisers: bool
     robot = load_robot(model, stabilisers)
     D = None if disturbance is None else disturbance_box(robot, disturbance[:robot.dof])
     with working("cdpr deploy"):
-        res = plan_deployment(robot, box, disturbance=D,
+        res = plan_deployment(robot, box, external_wrench=D,
                               required_twist=None if twist is None else twist[:robot.dof],
                               seed=seed, maxiter=maxiter)
     out = deployment_to_dict(robot, res)
@@ -103,14 +103,14 @@ def _deploy(model: str, ws: Any, disturbance: Any, twist: Any, stabilisers: bool
             from ..viz.cdpr_motion import plot_deployment
             plot_deployment(res, plot)
             out["plot"] = str(plot)
-    code = 0 if out["feasible"] else 1         # valid question, negative answer: exit 1
+    code = 0 if res.success else 1            # valid question, negative answer: exit 1
     if as_json:
         typer.echo(to_json(out))
         return code
     typer.echo(f"{robot.name}: deployment for workspace {box.tolist()} m: "
-               + ("FEASIBLE" if out["feasible"] else "NOT FOUND"))
+               + ("FEASIBLE" if res.success else "NOT FOUND"))
     if res.refuted:
-        typer.echo("  " + out["reason"])
+        typer.echo("  " + res.message)
         typer.echo("  upper bound per cable (N): " + ", ".join(
             f"{k} {v:.2f}" for k, v in out["lift_bound"]["per_cable"].items()))
         if note:
@@ -120,8 +120,8 @@ def _deploy(model: str, ws: Any, disturbance: Any, twist: Any, stabilisers: bool
         typer.echo(f"  {k}: x={v[0]} m  y={v[1]} m  theta={v[2]} rad")
     typer.echo(f"  worst capacity margin {out['margin']} over {out['points']} points "
                f"({out['feasible_points']} feasible with tipping)")
-    if out["reason"]:
-        typer.echo("  " + out["reason"])
+    if not res.success:
+        typer.echo("  " + res.message)
     return code
 
 

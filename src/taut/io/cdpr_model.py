@@ -29,7 +29,7 @@ from .files import read_mapping, validate_mapping
 
 __all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
 
-PRESETS = ("fastkit", "ipanema")
+PRESETS = ("fastkit", "ipanema", "fastkit_fc")
 
 Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]
@@ -53,6 +53,7 @@ class _Base(_Strict):
     footprint: list[Vec2] | None = None
     stabilisers: _Stabilisers | None = None
     exit_points: dict[str, Vec3] = Field(min_length=1)
+    friction: float | None = None       # ground friction coefficient (sliding condition)
 
 
 class _Platform(_Strict):
@@ -124,7 +125,8 @@ def cdpr_model_from_mapping(data: dict[str, Any]) -> CableRobot:
                               mobile=b.mobile, mass=b.mass, com=b.com,
                               footprint=b.footprint,
                               stabilisers=None if st is None else st.footprint,
-                              stabilisers_deployed=bool(st is not None and st.deployed)))
+                              stabilisers_deployed=bool(st is not None and st.deployed),
+                              friction=b.friction))
         cables = []
         for i, c in enumerate(raw.cables):
             if c.exit.count(".") != 1:

@@ -28,8 +28,7 @@ def draw_robot_outline(ax, robot: CableRobot, axes: tuple[int, int] = (0, 2)) ->
     for k, base in enumerate(robot.bases):
         sel = robot.cable_base == k
         if base.mobile:
-            poly = base.support_polygon
-            c = base.to_world(np.column_stack([poly, np.zeros(len(poly))]))
+            c = base.support_world()
             if j == 2:
                 lo, hi = c[:, i].min(), c[:, i].max()
                 ax.plot([lo, hi], [0, 0], color="0.3", lw=5, solid_capstyle="butt")
@@ -116,12 +115,12 @@ def plot_axis_capacities(without: AxisCapacities, with_tipping: AxisCapacities |
     fig, axes = plt.subplots(1, len(groups), figsize=(4.5 * len(groups), 3.6), squeeze=False)
     width = 0.8 / len(sets)
     for ax, (gname, ks) in zip(axes[0], groups):
-        ks = list(ks)
-        x = np.arange(len(ks))
+        kl = list(ks)
+        x = np.arange(len(kl))
         for s, (sname, cap) in enumerate(sets):
-            val = np.minimum(cap.positive[pose_index, ks], cap.negative[pose_index, ks])
+            val = np.minimum(cap.positive[pose_index, kl], cap.negative[pose_index, kl])
             ax.bar(x + (s - (len(sets) - 1) / 2) * width, val, width, label=sname)
-        ax.set_xticks(x, [without.labels[k] for k in ks])
+        ax.set_xticks(x, [without.labels[k] for k in kl])
         ax.set_ylabel(gname)
         ax.legend(fontsize=7)
     fig.suptitle(title or "wrench capability (min of + and - directions)", fontsize=10)

@@ -53,7 +53,8 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
     robot = result.robot
     fig, ax = plt.subplots(figsize=(7, 4.2))
     box = result.workspace
-    ax.add_patch(plt.Rectangle(box[0, :2], *(box[1, :2] - box[0, :2]), fill=False, lw=1.5,
+    ax.add_patch(plt.Rectangle((float(box[0, 0]), float(box[0, 1])),
+                               *(box[1, :2] - box[0, :2]), fill=False, lw=1.5,
                                ec="tab:blue", label="workspace"))
     ok = result.point_feasible
     ax.scatter(result.points[ok, 0], result.points[ok, 1], s=6, c="tab:green",
@@ -63,8 +64,7 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
                    label="infeasible")
     for base in robot.bases:
         if base.mobile:
-            poly = base.support_polygon
-            c = base.to_world(np.column_stack([poly, np.zeros(len(poly))]))
+            c = base.support_world()
             ax.fill(c[:, 0], c[:, 1], alpha=0.25, color="0.4")
             x, y, th = base.pose
             ax.annotate("", xy=(x + 0.4 * np.cos(th), y + 0.4 * np.sin(th)), xytext=(x, y),
@@ -80,7 +80,7 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=4,
               frameon=False)
     ax.set_title(title or (f"deployment: margin {result.margin:.3g}"
-                           + ("" if result.feasible else " (not feasible)")), fontsize=10)
+                           + ("" if result.success else " (not feasible)")), fontsize=10)
     fig.tight_layout()
     if path is not None:
         fig.savefig(path, dpi=130)

@@ -1,0 +1,92 @@
+"""Regenerate the numbers and figures of ``fastkit_conditions.md`` (issue 17):
+
+* suspended (`fastkit`) vs fully constrained (`fastkit_fc`) FASTKIT: wrench-feasible
+  coverage of the desired slice with tension limits, + tipping, and the wrench-closure
+  fraction;
+* how much of the desired slice sliding of the bases removes at mu = 0.3 and 0.6 (and
+  0.1, 0.2 for context), stabilisers retracted and deployed;
+* the interference-free fraction of the desired slice (level platform);
+* ``fastkit_binding_slice.png``: the binding condition per position (mu = 0.3, stabilisers
+  deployed) and ``fastkit_binding_3d.png``: the same over a 3D grid (mu = 0.2, retracted).
+
+Writes ``fastkit_conditions.json``. Run: ``python examples/cdpr/fastkit_conditions.py``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from taut.cdpr import (cable_interference, grid_points, with_friction, with_stabilisers,
+                       wrench_closure, wrench_feasible_workspace)
+from taut.io.cdpr_model import load_cdpr_model
+from taut.viz.cdpr_binding import plot_binding
+
+HERE = Path(__file__).resolve().parent
+GRID = (41, 1, 21)                       # the desired slice y = 0: 861 positions
+MUS = (0.1, 0.2, 0.3, 0.6)
+
+
+def pct(x: float | None) -> float | None:
+    return None if x is None else round(100.0 * x, 1)
+
+
+def coverage(robot) -> dict:
+    pts, shape = grid_points(robot.desired_workspace, GRID)
+    ws = wrench_feasible_workspace(robot, pts, shape=shape)
+    out = {"limits_%": pct(ws.coverage), "tipping_%": pct(ws.coverage_tipping)}
+    if ws.coverage_sliding is not None:
+        out["sliding_%"] = pct(ws.coverage_sliding)
+        out["binding_counts"] = {k or "feasible": int((ws.binding == k).sum())
+                                 for k in ("", "limits", "tipping", "sliding")}
+    return out
+
+
+def main() -> None:
+    out: dict = {"grid": list(GRID), "points": int(np.prod(GRID))}
+    for name in ("fastkit", "fastkit_fc"):
+        robot = load_cdpr_model(name)
+        pts, _ = grid_points(robot.desired_workspace, GRID)
+        out[name] = {"retracted": coverage(robot),
+                     "stabilisers": coverage(with_stabilisers(robot)),
+                     "closure_%": pct(float(wrench_closure(robot, pts).mean()))}
+        light = robot.__class__(robot.bases, robot.platform, robot.cables,
+                                gravity=robot.gravity, desired_workspace=robot.desired_workspace,
+                                name=robot.name + " without payload")
+        out[name]["no_payload"] = coverage(light)
+        itf = cable_interference(robot, pts)
+        out[name]["interference"] = {
+            "free_%": pct(float(itf.free.mean())),
+            "cable_cable_%": pct(float(itf.cable_cable.mean())),
+            "cable_platform_%": pct(float(itf.cable_platform.any(axis=1).mean()))}
+    robot = load_cdpr_model("fastkit")
+    sliding = {}
+    for stab in (False, True):
+        base = with_stabilisers(robot, stab)
+        ref = coverage(base)["tipping_%"]
+        for mu in MUS:
+            c = coverage(with_friction(base, mu))
+            sliding[f"{'stabilisers' if stab else 'retracted'} mu={mu}"] = {
+                **c, "removed_by_sliding_points_%": round(ref - c["sliding_%"], 1)}
+    out["sliding"] = sliding
+    fr = with_friction(with_stabilisers(robot), 0.3)
+    pts, shape = grid_points(fr.desired_workspace, GRID)
+    plot_binding(wrench_feasible_workspace(fr, pts, shape=shape), fr,
+                 HERE / "fastkit_binding_slice.png",
+                 title="FASTKIT, stabilisers deployed, mu = 0.3: binding condition (y = 0)")
+    f3 = with_friction(robot, 0.2)
+    pts3, shape3 = grid_points([[-2.5, -0.5, 0.2], [2.5, 0.5, 2.2]], (21, 5, 11))
+    ws3 = wrench_feasible_workspace(f3, pts3, shape=shape3)
+    plot_binding(ws3, f3, HERE / "fastkit_binding_3d.png", view="3d",
+                 title="FASTKIT, stabilisers retracted, mu = 0.2: binding condition")
+    out["grid_3d"] = {"box": [[-2.5, -0.5, 0.2], [2.5, 0.5, 2.2]], "shape": [21, 5, 11],
+                      "binding_counts": {k or "feasible": int((ws3.binding == k).sum())
+                                         for k in ("", "limits", "tipping", "sliding")}}
+    (HERE / "fastkit_conditions.json").write_text(json.dumps(out, indent=1) + "\n")
+    print(json.dumps(out, indent=1))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,118 @@
+"""Every numerical threshold of the cable-robot core, in one place (private).
+
+Each constant says its unit and why it has its value. *Relative* thresholds are
+dimensionless and multiply a scale named in the comment; *absolute* ones carry a unit.
+Thresholds that change answers a user sees (feasible or not) are also exposed as
+documented keyword arguments of the public functions; the constants here are their
+defaults.
+"""
+
+from __future__ import annotations
+
+# --- rank and degeneracy --------------------------------------------------------------
+#: Relative singular-value threshold (dimensionless, times the largest singular value)
+#: below which a wrench matrix W, a parallel Jacobian A or a driver twist map counts as
+#: rank deficient. 1e-9 keeps 7 digits of margin above float64 round-off (~1e-16 times the
+#: condition number of well-posed FASTKIT poses, <= 1e3) while flagging true singularities.
+RANK_TOL = 1e-9
+
+#: Relative threshold (times the largest generator entry) on the smallest |R| diagonal of
+#: a QR factorisation below which a generator subset does not span a hyperplane (zonotope
+#: facet enumeration) or a set of Farkas rows counts as degenerate. Smaller than RANK_TOL
+#: because these are products of several entries; 1e-10 was tuned to keep every facet of
+#: the FASTKIT twist and wrench sets and drop none (the tests compare against LPs).
+SUBSET_DEGENERACY = 1e-10
+
+#: Relative norm (times the largest row entry) below which a combined H-row is a zero
+#: row (a certificate with no wrench/twist dependence), and the threshold on direction
+#: components in ray shooting (capacities). Dimensionless; 1e-12 is ~1e4 ulp.
+ZERO_ROW = 1e-12
+
+#: Added to a scale before dividing by it so that an all-zero batch entry gives 0, not NaN
+#: (dimensionless; far below any physical scale).
+TINY = 1e-300
+
+#: Pairs of Farkas rows with ``cos(angle) <= -(1 - OPPOSITE_COS)`` are treated as
+#: opposite (parallel constraints facing each other). Dimensionless.
+OPPOSITE_COS = 1e-12
+
+#: Lower bound on Farkas multipliers after normalisation to max 1 (dimensionless): slightly
+#: negative values within this are round-off of a valid non-negative certificate.
+MULTIPLIER_SIGN = 1e-9
+
+#: Squared norm below which a constraint row of the exact QP enumeration is ignored
+#: (units of tension^2 per unit null-space coordinate; rows are O(1)). And the determinant
+#: below which two rows are parallel (no vertex).
+QP_ROW_SQ = 1e-24
+QP_PARALLEL = 1e-12
+
+# --- feasibility ----------------------------------------------------------------------
+#: Tension/moment feasibility slack, relative to the largest tension limit t_max (so in N,
+#: and N m per metre of lever arm). 1e-9 of t_max is far above LP/QP solver round-off and
+#: far below any physically meaningful tension.
+FEAS_REL = 1e-9
+
+#: Equilibrium residual ``|W t + w_e|`` accepted as balanced, relative to
+#: ``1 + max |w_e|`` (N, N m). Same reasoning as FEAS_REL.
+RESIDUAL_REL = 1e-9
+
+#: Multiplier of FEAS_REL used by the exact wrench-feasibility vertex test: the vertex
+#: candidate is computed from two constraint rows, so its error is a few times that of one
+#: row; 4 keeps the test agreeing with HiGHS on every bench pose.
+VERTEX_SLACK = 4.0
+
+#: SLSQP acceptance slack on inequality rows (relative to t_max): the SQP's own accuracy
+#: is ~1e-8, looser than the LP's; 1e-6 of t_max (e.g. 45 uN for FASTKIT).
+SLSQP_REL = 1e-6
+
+#: Default slack of ``contains`` tests of wrench and twist sets (absolute, in the set's
+#: units: N / N m or m/s / rad/s).
+CONTAINS_TOL = 1e-9
+
+#: Relative tolerance (times 1 + largest coordinate, m) of the frame-box and
+#: desired-workspace membership tests: a point on the box face is inside.
+BOX_REL = 1e-9
+
+#: Relative cable length (times 1 + largest exit coordinate, m) below which an attachment
+#: point sits on its exit point and the cable direction is undefined.
+ZERO_LENGTH_REL = 1e-12
+
+# --- model validation -----------------------------------------------------------------
+#: Footprint checks, relative to the polygon's extent (edge length) or its square (area,
+#: turn): repeated points and zero area at 1e-9, collinear turns at 1e-12; winding number
+#: within 1e-6 rad of 2 pi.
+FOOTPRINT_EDGE = 1e-9
+FOOTPRINT_TURN = 1e-12
+WINDING_RAD = 1e-6
+
+#: Symmetry and positive semi-definiteness of inertia matrices, relative to
+#: 1 + max |I| (kg m^2).
+INERTIA_REL = 1e-12
+
+# --- motion ---------------------------------------------------------------------------
+#: A redundancy-resolution scale ``s >= 1 - SCALE_ONE`` counts as the whole twist
+#: (dimensionless).
+SCALE_ONE = 1e-9
+
+#: Smallest joint-rate limit used to normalise rates (m/s or rad/s): guards a zero limit.
+RATE_FLOOR = 1e-12
+
+#: Equality-row component (dimensionless, rows are unit) below which a twist axis lies in
+#: the span of a navigation-mode twist set.
+SPAN_TOL = 1e-9
+
+# --- lift certificate -----------------------------------------------------------------
+#: Branch-and-bound stops refining a cell once its upper bound is within LIFT_RTOL * t_max
+#: of the incumbent (dimensionless): the certified bound is then at most that much above
+#: the true maximum per cable.
+LIFT_RTOL = 1e-5
+
+#: The certificate refutes only when the bound falls short of the required force by more
+#: than REFUTE_REL times the weight (dimensionless): guards round-off at the boundary.
+REFUTE_REL = 1e-6
+
+# --- wrench closure -------------------------------------------------------------------
+#: A pose has wrench closure when the most balanced self-stress ``W t = 0`` with
+#: ``max t = 1`` has ``min t > CLOSURE_TOL`` (dimensionless): far above HiGHS's 1e-7
+#: feasibility tolerance, far below any usable pretension ratio.
+CLOSURE_TOL = 1e-6

@@ -1,0 +1,124 @@
+"""Read CASPR robot definitions (a ``*_bodies.xml`` and a ``*_cables.xml`` file, as in the
+CASPR toolbox's ``data/model_config/models``) into a :class:`taut.cdpr.CableRobot`.
+
+Supported: one rigid moving link (``link_rigid num="1"``) with a spatial or translational
+joint, attached to the ground (link 0) by ideal cables (``cable_ideal``) with two
+attachments each (one on link 0: the exit point; one on link 1: the attachment point),
+``force_min`` / ``force_max`` tension limits (N), mass (kg), centre of mass and inertia.
+Locations with ``attachment_reference="com"`` are shifted to the link frame. The joint's
+``q_min`` / ``q_max`` position part becomes the frame ``bounds`` (m). Units are SI, as in
+CASPR. Multi-link (serial) bodies and other cable types raise
+:class:`taut.errors.ScenarioError` naming the element.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from ..cdpr.model import Base, Cable, CableRobot, Platform
+from ..errors import ScenarioError
+
+__all__ = ["load_caspr_model"]
+
+_JOINTS = ("SPATIAL_EULER_XYZ", "SPATIAL_QUATERNION", "SPATIAL", "TRANSLATIONAL_XYZ")
+
+
+def _parse(path: Path, field: str) -> ET.Element:
+    try:
+        return ET.parse(path).getroot()
+    except FileNotFoundError:
+        raise ScenarioError(field, f"file not found: {path}") from None
+    except ET.ParseError as exc:
+        raise ScenarioError(field, f"{path.name} is not valid XML: {exc}") from None
+
+
+def _vec(el: ET.Element | None, field: str, n: int = 3) -> np.ndarray:
+    if el is None or el.text is None:
+        raise ScenarioError(field, "missing")
+    try:
+        v = np.array([float(x) for x in el.text.split()])
+    except ValueError:
+        raise ScenarioError(field, f"not {n} numbers: {el.text!r}") from None
+    if v.shape != (n,) or not np.all(np.isfinite(v)):
+        raise ScenarioError(field, f"must be {n} finite numbers, got {el.text!r}")
+    return v
+
+
+def _link(bodies: ET.Element) -> tuple[ET.Element, ET.Element]:
+    links = bodies.findall("./links/link_rigid")
+    if len(links) != 1:
+        raise ScenarioError("bodies.links", f"one rigid link is supported, found {len(links)}")
+    joint = links[0].find("joint")
+    if joint is None or joint.get("type") not in _JOINTS:
+        raise ScenarioError("bodies.links.joint", "joint type must be one of "
+                                                  + ", ".join(_JOINTS))
+    return links[0], joint
+
+
+def load_caspr_model(bodies: str | Path, cables: str | Path, *, cable_set: str | None = None,
+                     name: str | None = None) -> CableRobot:
+    """Build a fixed-frame :class:`CableRobot` from CASPR's XML files.
+
+    Parameters
+    ----------
+    bodies, cables : path
+        The ``*_bodies.xml`` and ``*_cables.xml`` files.
+    cable_set : str, optional
+        Which ``cable_set`` to use (default: the file's ``default_cable_set``).
+    name : str, optional
+        Model name (default: the link's ``name`` attribute).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> d = Path("examples/cdpr/caspr")
+    >>> robot = load_caspr_model(d / "CoGiRo_bodies.xml", d / "CoGiRo_cables.xml")
+    >>> robot.m, robot.dof, float(robot.platform.mass), robot.t_max[0]
+    (8, 6, 91.058, np.float64(5000.0))
+    """
+    b_root = _parse(Path(bodies), "bodies")
+    c_root = _parse(Path(cables), "cables")
+    link, joint = _link(b_root)
+    phys = link.find("physical")
+    if phys is None:
+        raise ScenarioError("bodies.physical", "missing")
+    mass = float(_vec(phys.find("mass"), "bodies.physical.mass", 1)[0])
+    com = _vec(phys.find("com_location"), "bodies.physical.com_location")
+    I = phys.find("inertia")
+    names = ("Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
+    iv = [float(_vec(None if I is None else I.find(k), f"bodies.physical.inertia.{k}", 1)[0])
+          for k in names]
+    inertia = np.array([[iv[0], iv[3], iv[4]], [iv[3], iv[1], iv[5]], [iv[4], iv[5], iv[2]]])
+    wanted = cable_set or c_root.get("default_cable_set")
+    sets = {s.get("id"): s for s in c_root.findall("cable_set")}
+    if wanted not in sets:
+        raise ScenarioError("cables.cable_set", f"no cable set {wanted!r} (sets: "
+                                                + ", ".join(map(str, sets)) + ")")
+    exits, attach, cabs = {}, {}, []
+    for i, c in enumerate(sets[wanted]):
+        f = f"cables.cable_set[{wanted}][{i}]"
+        if c.tag != "cable_ideal":
+            raise ScenarioError(f, f"only cable_ideal is supported, got {c.tag}")
+        cname = c.get("name") or f"cable {i + 1}"
+        pts = c.findall("./attachments/attachment")
+        where = {int(_vec(a.find("link"), f"{f}.link", 1)[0]): _vec(a.find("location"),
+                                                                     f"{f}.location")
+                 for a in pts}
+        if len(pts) != 2 or set(where) != {0, 1}:
+            raise ScenarioError(f, "a cable needs one attachment on link 0 and one on link 1")
+        loc = where[1] + (com if c.get("attachment_reference") == "com" else 0.0)
+        exits[cname], attach[cname] = where[0], loc
+        props = c.find("properties")
+        lo = _vec(None if props is None else props.find("force_min"), f"{f}.force_min", 1)[0]
+        hi = _vec(None if props is None else props.find("force_max"), f"{f}.force_max", 1)[0]
+        cabs.append(Cable(cname, "frame", cname, cname, float(lo), float(hi)))
+    qmin = np.array([float(x) for x in (joint.get("q_min") or "").split()] or [np.nan])
+    qmax = np.array([float(x) for x in (joint.get("q_max") or "").split()] or [np.nan])
+    bounds = (np.stack([qmin[:3], qmax[:3]]) if qmin.size >= 3 and qmax.size >= 3
+              and np.all(np.isfinite(qmin[:3])) and np.all(np.isfinite(qmax[:3])) else None)
+    return CableRobot((Base("frame", exits),),
+                      Platform(attach, mass=mass, com=com, inertia=inertia),
+                      tuple(cabs), bounds=bounds, name=name or link.get("name") or "caspr")
