@@ -79,13 +79,13 @@ from .cable_fk import CableFKResult, cable_forward_kinematics
 from .dynamics_model import DynamicsModel
 from .model_errors import ModelErrors
 from .references import Reference, pick_and_place, reference_from_samples
-from .controllers import Controller, TorqueController, VelocityController
+from .controllers import CONTROLLERS, Controller, TorqueController, VelocityController
 from .monitors import ControlEvent
 from .sim import BaseMotion, ControlResult, MonteCarloResult, monte_carlo, simulate
 
 __all__ += [
     "CableFKResult", "cable_forward_kinematics", "DynamicsModel", "ModelErrors", "Reference",
-    "pick_and_place", "reference_from_samples", "Controller", "TorqueController",
+    "pick_and_place", "reference_from_samples", "CONTROLLERS", "Controller", "TorqueController",
     "VelocityController", "ControlEvent", "BaseMotion", "ControlResult", "MonteCarloResult",
     "monte_carlo", "simulate",
 ]

@@ -28,7 +28,7 @@ from ._dyn_tol import FK_MAX_ITER, FK_POLISH_TOL, FK_RESIDUAL_TOL, FK_SAME_SOLUT
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
 
-__all__ = ["CableFKResult", "cable_forward_kinematics", "rpy_from_matrices", "so3_exp"]
+__all__ = ["CableFKResult", "cable_forward_kinematics"]
 
 
 # phi @ _SKEW_GEN is the row-major flattening of [phi]x.

@@ -26,8 +26,7 @@ import numpy as np
 from .._validate import as_nonnegative, as_positive
 from .dynamics_model import DynamicsModel
 
-__all__ = ["Controller", "VelocityController", "TorqueController", "ControlContext",
-           "Measurement", "CONTROLLERS"]
+__all__ = ["Controller", "VelocityController", "TorqueController", "CONTROLLERS"]
 
 CommandMode = Literal["torque", "speed"]
 

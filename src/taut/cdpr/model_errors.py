@@ -16,7 +16,7 @@ from .._validate import as_bounded, as_finite_scalar
 from ..errors import InvalidInputError
 from .model import CableRobot
 
-__all__ = ["ModelErrors", "PlantPerturbation"]
+__all__ = ["ModelErrors"]
 
 
 @dataclass(frozen=True)

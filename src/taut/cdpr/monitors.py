@@ -13,7 +13,7 @@ import numpy as np
 from ._bases import moved_edges
 from .model import CableRobot
 
-__all__ = ["ControlEvent", "tipping_margins", "episodes"]
+__all__ = ["ControlEvent"]
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from ._dyn_tol import MAX_REFERENCE_SPEED
 from .kinematics import as_poses
 from .model import CableRobot
 
-__all__ = ["Reference", "pick_and_place", "reference_from_samples", "euler_rate_matrices"]
+__all__ = ["Reference", "pick_and_place", "reference_from_samples"]
 
 Profile = Literal["quintic", "trapezoidal"]
 

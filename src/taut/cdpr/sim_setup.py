@@ -20,7 +20,7 @@ from .model import CableRobot
 from .references import Reference
 from .tension import distribute_tensions
 
-__all__ = ["BaseMotion", "build_context", "RefGeometry"]
+__all__ = ["BaseMotion"]
 
 #: Base-motion runs distribute tensions on a robot rebuilt every this many control steps and
 #: interpolate in between (then restore the wrench balance exactly with W+): a base moving
@@ -138,14 +138,14 @@ def _tensions(robot: CableRobot, geo: RefGeometry, P: np.ndarray, w_ext: np.ndar
     if not geo.moving:
         res = distribute_tensions(robot, P[idx], "closed_form", external_wrench=w_ext[idx],
                                   tipping=False)
-        ts, ok_s = res.tensions, res.feasible
+        ts, ok_s = res.tensions, res.success
     else:
         t_s, o_s = [], []
         for i in idx:
             r1 = distribute_tensions(_robot_at(robot, geo.base_poses[i]), P[i], "closed_form",
                                      external_wrench=w_ext[i], tipping=False)
             t_s.append(r1.tensions[0])
-            o_s.append(bool(r1.feasible[0]))
+            o_s.append(bool(r1.success[0]))
         ts, ok_s = np.array(t_s), np.array(o_s)
     t = np.column_stack([np.interp(np.arange(T), idx, ts[:, j]) for j in range(robot.m)])
     ok = np.interp(np.arange(T), idx, ok_s.astype(float)) > 0.999
@@ -165,7 +165,7 @@ def _exact_where_needed(robot: CableRobot, geo: RefGeometry, P: np.ndarray,
     t = t.copy()
     t[bad] = res.tensions
     ok = ok.copy()
-    ok[bad] = res.feasible
+    ok[bad] = res.success
     return t, ok
 
 
@@ -184,7 +184,7 @@ def _check_feasible(robot: CableRobot, geo: RefGeometry, times: np.ndarray, P: n
         r = robot if not geo.moving else _robot_at(robot, geo.base_poses[i])
         res = distribute_tensions(r, P[i], "lp_min_max", external_wrench=w_ext[i],
                                   tipping=False)
-        if not res.feasible[0]:
+        if not res.success[0]:
             raise InfeasiblePoseError(
                 "reference", f"leaves the wrench-feasible workspace at t = {times[i]:.3f} s, "
                 f"pose {np.round(P[i], 4).tolist()}: no tensions in [t_min, t_max] balance "

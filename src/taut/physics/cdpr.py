@@ -267,7 +267,7 @@ def check_tipping_grid(robot: CableRobot, poses: Any, *, method: str = "lp_min_s
     success = np.zeros(B, dtype=bool)
     status = np.full(B, "infeasible", dtype=object)
     for b in range(B):
-        if dist.feasible[b]:
+        if dist.success[b]:
             r = check_tipping(robot, P[b], dist.tensions[b], friction=friction,
                               duration=duration)
             verdicts[b] = r.verdicts
@@ -275,8 +275,8 @@ def check_tipping_grid(robot: CableRobot, poses: Any, *, method: str = "lp_min_s
             success[b], status[b] = r.success, r.status
         if progress is not None:
             progress(b + 1, B)
-    n = int(dist.feasible.sum())
+    n = int(dist.success.sum())
     agree = int(success.sum())
     msg = f"{agree} of {n} pose(s) with tensions agree (taut vs physics); {B - n} without tensions"
-    return TippingGridCheck(P, verdicts, margin, taut_stays, phys, dist.feasible.copy(),
+    return TippingGridCheck(P, verdicts, margin, taut_stays, phys, dist.success.copy(),
                             success, status.astype(str), msg)
