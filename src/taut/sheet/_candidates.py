@@ -4,8 +4,8 @@ At any ``x`` the cables that are taut are the maximisers of the affine pieces
 :math:`g_i(x) = (\\mathbf{a}_i, b_i) \\cdot (x, 1)`, i.e. the lifted points
 :math:`P_i = (\\mathbf{a}_i, b_i) \\in \\mathbb{R}^5` on the face of their convex hull
 exposed by the direction ``(x, 1)``. Only faces of the *upper* hull (facets whose outward
-normal has a positive last component, and their sub-faces) can be taut sets (DESIGN.md
-Sec. 2). Every taut set ``T`` has an affinely independent subset of at most 5 points that
+normal has a positive last component, and their sub-faces) can be taut sets (docs/sheet_kinematics.md
+§2). Every taut set ``T`` has an affinely independent subset of at most 5 points that
 spans its face, and such a subset is a face of some simplex of Qhull's triangulated
 output (option ``Qt``); so all 3-, 4- and 5-subsets of the upper simplices (plus 2-subsets
 when three sheet vertices are collinear, the only way three lifted points can be
@@ -17,35 +17,17 @@ paper's Algorithm 1 without visiting its :math:`\\sum_k \\binom{N}{k}` subsets.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import combinations
 
 import numpy as np
 from scipy.linalg import qr
 from scipy.spatial import ConvexHull, QhullError
 
-#: Singular values of the centred lifted points below this (normalised units) are zero.
-RANK_TOL = 1e-9
-#: Relative thickness (smallest singular value of the centred lifted points over the
-#: largest) between which the points count as nearly flat: see :func:`hull_candidates`.
-EXACT_FLAT = 1e-13
-NEAR_FLAT = 1e-9
+from ._tol import (CLOSED_FORM_RTOL, EXACT_FLAT, FALLBACK_SIN, GRAM_SCHMIDT_RTOL2, NEAR_FLAT,
+                   RANK_TOL, TINY, UP_IN_HULL_TOL, UPPER_NORMAL_TOL)
+from ._util import Q_SIGNS, combo_table
+
 #: Nearly flat teams up to this size get every subset as a candidate.
 NEAR_FLAT_SUBSETS = 14
-
-
-def _combo_table(n: int, k: int) -> np.ndarray:
-    return np.array(list(combinations(range(n), k)), dtype=np.intp).reshape(-1, k)
-
-
-_COMBOS: dict[tuple[int, int], np.ndarray] = {}
-
-
-def combo_table(n: int, k: int) -> np.ndarray:
-    """All ``k``-subsets of ``range(n)`` in lexicographic order, shape (C(n, k), k)."""
-    key = (n, k)
-    if key not in _COMBOS:
-        _COMBOS[key] = _combo_table(n, k)
-    return _COMBOS[key]
 
 
 def sizes_for(N: int, pairs: bool) -> range:
@@ -99,7 +81,11 @@ def _every_subset(N: int, pairs: bool) -> "HullCandidates":
     return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
 
 
-def _facet_subsets(simplices: np.ndarray, N: int, pairs: bool) -> dict[int, np.ndarray]:
+def _facet_subsets(simplices: np.ndarray, N: int, pairs: bool, unique: bool = True
+                   ) -> dict[int, np.ndarray]:
+    """Every candidate-size subset of the simplices' vertex sets (size -> sorted rows),
+    without repeats unless ``unique`` is False (repeats cost the compiled kernel less
+    than removing them)."""
     out: dict[int, np.ndarray] = {}
     simplices = np.sort(simplices, axis=1)        # subsets of sorted rows come out sorted
     width = simplices.shape[1]
@@ -109,7 +95,8 @@ def _facet_subsets(simplices: np.ndarray, N: int, pairs: bool) -> dict[int, np.n
         if s == width:
             out[s] = simplices                    # Qhull's simplices are distinct
             continue
-        out[s] = _unique_sorted_rows(simplices[:, combo_table(width, s)].reshape(-1, s), N)
+        rows = simplices[:, combo_table(width, s)].reshape(-1, s)
+        out[s] = _unique_sorted_rows(rows, N) if unique else rows
     return out
 
 
@@ -146,13 +133,10 @@ class HullCandidates:
     stationary: Stationary | None = None
 
 
-_J = np.array([1.0, 1.0, -1.0, -1.0])
-#: Faces whose spanning directions have a relative size or mutual sine below this are
-#: solved by the Lagrange kernel rather than in closed form from the facet normals.
-FALLBACK_SIN = 1e-3
+_J = Q_SIGNS
 _ONES = np.ones(4)
 #: Positions of the 3-subsets of a 5-vertex simplex, and of the two vertices left out.
-_TRI_POS = np.array(list(combinations(range(5), 3)), dtype=np.intp)
+_TRI_POS = combo_table(5, 3)
 _TRI_REST = np.array([[i for i in range(5) if i not in c] for c in _TRI_POS], dtype=np.intp)
 _PROBE = np.array([0.6180339887, 0.7071067812, 0.5772156649, 0.3183098862, 0.2718281828,
                    0.1414213562])
@@ -184,7 +168,7 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     if np.any(probe[1:] == probe[:-1]):
         return None
     nP = eq[:, :5] @ basis.T         # outward unit normals in lifted coords (basis orthogonal)
-    upper = nP[:, 4] > 1e-12
+    upper = nP[:, 4] > UPPER_NORMAL_TOL
     N = len(P)
     uf = np.flatnonzero(upper)
     simp_u = hull.simplices[uf]                  # Qhull's vertex order: neighbours follow it
@@ -216,7 +200,7 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     u3 = nP[g3[:, 0], :4] - nP[g3[:, 0], 4:5] * x3               # |n_g| = 1
     v3 = nP[g3[:, 1], :4] - nP[g3[:, 1], 4:5] * x3
     uu3, vv3, uv3 = (u3 * u3) @ _ONES, (v3 * v3) @ _ONES, (u3 * v3) @ _ONES
-    sin2 = np.maximum(vv3 - uv3 * uv3 / np.maximum(uu3, 1e-300), 0.0) / np.maximum(vv3, 1e-300)
+    sin2 = np.maximum(vv3 - uv3 * uv3 / np.maximum(uu3, TINY), 0.0) / np.maximum(vv3, TINY)
     score = np.minimum(np.minimum(uu3, vv3), sin2)
     face_id = tri @ np.array([N * N, N, 1])
     if N ** 3 < 2 ** 40:
@@ -246,7 +230,7 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
         # solved by the general Lagrange kernel instead.
         size_u = np.sqrt(n1)                              # relative to |n_g| = 1
         if len(dirs) == 1:
-            ok = (np.abs(a11) > 1e-12 * n1) & (size_u > FALLBACK_SIN)
+            ok = (np.abs(a11) > CLOSED_FORM_RTOL * n1) & (size_u > FALLBACK_SIN)
             x = xf[ok] + (r1[ok] / a11[ok])[:, None] * u[ok]
             curvs.append(a11[ok] / n1[ok])
         else:
@@ -258,9 +242,9 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
             m2, g12 = vv @ _ONES, (u * v) @ _ONES
             n2 = n1 + m2
             size_v = np.sqrt(m2)
-            sin_uv = np.sqrt(np.maximum(m2 - g12 * g12 / np.maximum(n1, 1e-300), 0.0) /
-                             np.maximum(m2, 1e-300))
-            ok = ((np.abs(det) > 1e-12 * n2 * n2) & (size_u > FALLBACK_SIN)
+            sin_uv = np.sqrt(np.maximum(m2 - g12 * g12 / np.maximum(n1, TINY), 0.0) /
+                             np.maximum(m2, TINY))
+            ok = ((np.abs(det) > CLOSED_FORM_RTOL * n2 * n2) & (size_u > FALLBACK_SIN)
                   & (size_v > FALLBACK_SIN) & (sin_uv > FALLBACK_SIN))
             t1 = (a22 * r1 - a12 * r2)[ok] / det[ok]
             t2 = (a11 * r2 - a12 * r1)[ok] / det[ok]
@@ -271,7 +255,7 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
             n1, m2, g12, a11, a12, a22 = n1[ok], m2[ok], g12[ok], a11[ok], a12[ok], a22[ok]
             s1 = g12 / n1                                    # n1 > 0 where ok
             w2 = m2 - s1 * g12                               # |v - s1 u|^2
-            good = w2 > 1e-2 * m2
+            good = w2 > GRAM_SCHMIDT_RTOL2 * m2
             w2 = np.where(good, w2, 1.0)
             h11 = a11 / n1
             h12 = (a12 - s1 * a11) / np.sqrt(n1 * w2)
@@ -295,7 +279,8 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
                       np.concatenate(curvs)), {s: np.vstack(v) for s, v in fallback.items()}
 
 
-def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
+def hull_candidates(P: np.ndarray, pairs: bool, *, shortcut: bool = True,
+                    unique: bool = True) -> HullCandidates:
     """Candidate sets for one formation from the upper hull of its lifted points.
 
     Parameters
@@ -304,6 +289,11 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
         Lifted points in normalised units.
     pairs : bool
         Also emit 2-subsets (needed only when the sheet has collinear vertices).
+    shortcut : bool
+        Allow stationary points straight from the facet normals (else every candidate
+        comes back as a subset, for the compiled kernel).
+    unique : bool
+        Remove repeated subsets of generic hulls (False: the caller copes with repeats).
 
     Degenerate inputs (the lifted points span fewer than 5 dimensions, e.g. the FK
     paper's Lemma 2 and Table V where all of them lie on a 2-plane) are handled in the
@@ -337,11 +327,11 @@ def hull_candidates(P: np.ndarray, pairs: bool) -> HullCandidates:
         for size, rows in _facet_subsets(joggled, N, pairs).items():
             _add_rows(out, size, rows, N)
         return HullCandidates(out, False)
-    return _hull_faces(P, Pc, vt, d, pairs, shortcut=True)
+    return _hull_faces(P, Pc, vt, d, pairs, shortcut=shortcut, unique=unique)
 
 
 def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bool, *,
-                shortcut: bool) -> HullCandidates:
+                shortcut: bool, unique: bool = True) -> HullCandidates:
     """Candidates from the upper faces of the hull of the lifted points ``P`` (N, 5) in
     their ``d``-dimensional affine hull (``Pc`` centred, ``vt`` its right singular vectors);
     ``shortcut``: stationary points straight from the facet normals where it applies."""
@@ -349,7 +339,7 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
     basis = vt[:d].T                                   # (5, d)
     Y = Pc @ basis
     up = basis[4]                                      # e5 expressed in the hull's coordinates
-    up_in_hull = np.linalg.norm(up) > 1.0 - 1e-9
+    up_in_hull = np.linalg.norm(up) > 1.0 - UP_IN_HULL_TOL
     try:
         hull = ConvexHull(Y, qhull_options="Qt")
     except QhullError:
@@ -364,9 +354,9 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
             return HullCandidates(fallback, True, stationary)
     simplices = hull.simplices
     if up_in_hull:
-        upper = hull.equations[:, :d] @ up > -1e-12
+        upper = hull.equations[:, :d] @ up > -UPPER_NORMAL_TOL
         simplices = simplices[upper]
-    out = _facet_subsets(simplices, N, pairs)
+    out = _facet_subsets(simplices, N, pairs, unique)
     if not up_in_hull and d + 1 <= 5:
         # The whole point set is a face (exposed by a direction orthogonal to its hull):
         # add one affinely independent spanning subset of it.

@@ -8,11 +8,10 @@ import numpy as np
 
 from .._validate import as_array, as_points, as_positive
 from ..errors import InfeasibleFormationError, InvalidInputError, InvalidSheetError
+from ._tol import GEOMETRY_RTOL, WINDING_TOL
 
 __all__ = ["Sheet", "check_formation", "check_formations", "check_hold_height"]
 
-#: Relative tolerance (times the sheet size) for geometric equalities on input data.
-GEOMETRY_RTOL = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,7 +77,7 @@ class Sheet:
                                     "(vertices must go around a convex polygon in order)")
         # Consistent turn direction but winding more than once: self-intersecting (a star).
         angles = np.arctan2(cross, np.einsum("ij,ij->i", prev, edges))
-        if abs(abs(angles.sum()) - 2 * np.pi) > 1e-6:
+        if abs(abs(angles.sum()) - 2 * np.pi) > WINDING_TOL:
             raise InvalidSheetError("sheet", "polygon is self-intersecting (it winds around "
                                     "more than once)")
         v.setflags(write=False)

@@ -1,0 +1,507 @@
+"""Compiled forward kinematics for small teams: every taut-set candidate of at most five
+cables, solved and classified in one numba function per formation.
+
+The same decisions as the numpy path (``fk._solve_as_given`` with a subset table, then
+``_finalize.classify``), in the same order (docs/sheet_kinematics.md §1-§5):
+
+1. normalised frame (formation and sheet centred, lengths over the sheet size);
+2. per candidate ``S`` (table order): the bordered Lagrange system ``[G 1; 1' 0] [w; mu] =
+   [b_S; 1]`` by LU with partial pivoting; a small relative determinant sends it to the
+   condition-number test (``SINGULAR_RTOL``, ``MAX_CONDITION``);
+3. real depth below the hold height (FK paper eq. 15), no cable over-stretched and the
+   exact taut set (``TAUT_TOL``);
+4. one row per taut set (the candidate that *is* the taut set preferred), ordered by
+   taut-set size then taut set; the paper's projection test (``INSIDE_WEIGHT``,
+   ``ANGLE_TOL``); status from the weights' signs (``WEIGHT_TOL``) and the reduced
+   Hessian (``CURVATURE_TOL``).
+
+Rows whose taut set is larger than their candidate (a weight *family*, e.g. Lemma 2) get
+status ``PENDING``: their weights need an LP, done by the caller in Python exactly as the
+numpy path does. Every function here is plain Python over scalars and small arrays, so
+it also runs (slowly) without numba; ``jit`` compiles it when numba is installed.
+
+Output rows (float64, width ``8 + 3 N + 4``; see ``COL_*``): status, taut-set size,
+object (3, user units), contact (2, user units), normalised depth, taut mask (N, 0/1),
+weights (N), cable lengths (N, user units), the normalised point ``x = (r_o, v_o)`` (4).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any, Callable
+
+import numpy as np
+
+from ._tol import (ANGLE_TOL, COINCIDE_RTOL2, CURVATURE_TOL, INSIDE_WEIGHT, MAX_CONDITION,
+                   SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL)
+
+try:  # numba is a core dependency; without it (no wheel for this Python) numpy is used.
+    if os.environ.get("TAUT_DISABLE_NUMBA"):
+        raise ImportError("disabled by TAUT_DISABLE_NUMBA")
+    import numba
+except ImportError:  # pragma: no cover - depends on the environment
+    numba = None
+
+#: True when the compiled path is available.
+HAVE_NUMBA = numba is not None
+
+#: Row status values (the first three as in ``_kernel.STATUS_*``).
+STABLE, SADDLE, NOT_EQUILIBRIUM, PENDING = 0, 1, 2, 3
+#: Kernel return codes.
+OK, INFEASIBLE = 0, -1
+
+#: Columns of the 3 x 3 minors giving the null vector of a 3 x 4 matrix (signs +-+-).
+_MINOR_COLS = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+
+COL_STATUS, COL_TSIZE, COL_OBJECT, COL_CONTACT, COL_DEPTH, COL_TAUT = 0, 1, 2, 5, 7, 8
+
+
+def row_width(N: int) -> int:
+    """Width of an output row for ``N`` robots."""
+    return 12 + 3 * N
+
+
+def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``numba.njit(cache=True)`` when numba is available, else ``fn`` itself."""
+    if numba is None:  # pragma: no cover - depends on the environment
+        return fn
+    return numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
+
+
+@jit
+def _lu_solve(K, rhs, n):  # type: ignore[no-untyped-def]
+    """Solve ``K[:n, :n] y = rhs[:n]`` in place by LU with partial pivoting (as LAPACK's
+    getrf). Returns ``(det, ok_solved)``; ``rhs`` holds the solution; ``K`` is destroyed.
+    A zero pivot leaves ``det = 0`` (the caller then rejects the system)."""
+    det = 1.0
+    for k in range(n):
+        p = k
+        best = abs(K[k, k])
+        for i in range(k + 1, n):
+            if abs(K[i, k]) > best:
+                best = abs(K[i, k])
+                p = i
+        if best == 0.0:
+            return 0.0, False
+        if p != k:
+            for j in range(n):
+                t = K[k, j]
+                K[k, j] = K[p, j]
+                K[p, j] = t
+            t = rhs[k]
+            rhs[k] = rhs[p]
+            rhs[p] = t
+            det = -det
+        piv = K[k, k]
+        det *= piv
+        for i in range(k + 1, n):
+            f = K[i, k] / piv
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    K[i, j] -= f * K[k, j]
+                rhs[i] -= f * rhs[k]
+    for k in range(n - 1, -1, -1):
+        s = rhs[k]
+        for j in range(k + 1, n):
+            s -= K[k, j] * rhs[j]
+        rhs[k] = s / K[k, k]
+    return det, True
+
+
+@jit
+def _lagrange(G, bvec, members, s, K, rhs, work):  # type: ignore[no-untyped-def]
+    """Solve candidate ``members[:s]``'s bordered system into ``rhs[:s+1]`` = (w, mu).
+    Returns False where the system is singular (policy of ``_kernel._screen_and_solve``:
+    relative determinant, then the condition number of the 6 x 6 padded form)."""
+    n = s + 1
+    for a in range(s):
+        ia = members[a]
+        for c in range(s):
+            K[a, c] = G[ia, members[c]]
+        K[a, s] = 1.0
+        K[s, a] = 1.0
+        rhs[a] = bvec[ia]
+    K[s, s] = 0.0
+    rhs[s] = 1.0
+    norms = 1.0
+    for a in range(n):
+        r2 = 0.0
+        for c in range(n):
+            r2 += K[a, c] * K[a, c]
+            work[a, c] = K[a, c]
+        norms *= math.sqrt(r2)
+    det, solved = _lu_solve(K, rhs, n)
+    if solved and abs(det) > SINGULAR_RTOL * norms:
+        return True
+    # Suspect: condition number of the padded 6 x 6 form (extra singular values 1).
+    sv = np.linalg.svd(work[:n, :n].copy())[1]
+    smax = max(sv[0], 1.0)
+    smin = min(sv[n - 1], 1.0)
+    if not (smin > 0.0 and smax / smin < MAX_CONDITION):
+        return False
+    if not solved:
+        return False
+    return True
+
+
+@jit
+def _in_hull(Rn, taut, N, px, py, ang):  # type: ignore[no-untyped-def]
+    """The paper's projection test (``_kernel.in_hull_2d``) for the robots in ``taut``."""
+    m = 0
+    scale2 = 1.0
+    for j in range(N):
+        if taut[j]:
+            dx = Rn[j, 0] - px
+            dy = Rn[j, 1] - py
+            d2 = dx * dx + dy * dy
+            if d2 > scale2:
+                scale2 = d2
+    for j in range(N):
+        if taut[j]:
+            dx = Rn[j, 0] - px
+            dy = Rn[j, 1] - py
+            if dx * dx + dy * dy <= COINCIDE_RTOL2 * scale2:
+                return True
+            ang[m] = math.atan2(dy, dx)
+            m += 1
+    a = np.sort(ang[:m])
+    gap = a[0] + 2.0 * math.pi - a[m - 1]
+    for k in range(m - 1):
+        if a[k + 1] - a[k] > gap:
+            gap = a[k + 1] - a[k]
+    return gap <= math.pi + ANGLE_TOL
+
+
+@jit
+def _project_out(v, Q, q):  # type: ignore[no-untyped-def]
+    """Remove from ``v`` (4,) its components along the first ``q`` rows of ``Q`` (twice:
+    "twice is enough" for Gram-Schmidt); returns the residual norm."""
+    for _ in range(2):
+        for k in range(q):
+            dot = v[0] * Q[k, 0] + v[1] * Q[k, 1] + v[2] * Q[k, 2] + v[3] * Q[k, 3]
+            for c in range(4):
+                v[c] -= dot * Q[k, c]
+    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3])
+
+
+@jit
+def _orthonormal_complement(D, nrows, Q):  # type: ignore[no-untyped-def]
+    """Orthonormal rows ``Q[nrows:4]`` spanning the null space of the ``nrows`` (affinely
+    independent, so linearly independent) rows of ``D`` (4 columns), which are first
+    orthonormalised into ``Q[:nrows]``; each further row is the coordinate axis with the
+    largest residual (no threshold needed)."""
+    v = np.empty(4)
+    for r in range(nrows):
+        for c in range(4):
+            v[c] = D[r, c]
+        nv = _project_out(v, Q, r)
+        for c in range(4):
+            Q[r, c] = v[c] / nv
+    best = np.empty(4)
+    for q in range(nrows, 4):
+        top = -1.0
+        for axis in range(4):
+            for c in range(4):
+                v[c] = 0.0
+            v[axis] = 1.0
+            nv = _project_out(v, Q, q)
+            if nv > top:
+                top = nv
+                for c in range(4):
+                    best[c] = v[c] / nv
+        for c in range(4):
+            Q[q, c] = best[c]
+
+
+@jit
+def _reduced_min_eig(P, members, s):  # type: ignore[no-untyped-def]
+    """Smallest eigenvalue of diag(1, 1, -1, -1) on the face's tangent space
+    (``_kernel.reduced_hessian_min_eig``): +inf for 5 members, the generalised cross
+    product for 4, a 2 x 2 closed form for 3, a 3 x 3 one for 2 (docs/sheet_kinematics.md
+    §5)."""
+    if s >= 5:
+        return np.inf
+    D = np.empty((4, 4))
+    for a in range(1, s):
+        for c in range(4):
+            D[a - 1, c] = P[members[a], c] - P[members[0], c]
+    if s == 4:
+        num = 0.0
+        den = 0.0
+        for k in range(4):
+            c0, c1, c2 = _MINOR_COLS[k, 0], _MINOR_COLS[k, 1], _MINOR_COLS[k, 2]
+            m3 = (D[0, c0] * (D[1, c1] * D[2, c2] - D[1, c2] * D[2, c1])
+                  - D[0, c1] * (D[1, c0] * D[2, c2] - D[1, c2] * D[2, c0])
+                  + D[0, c2] * (D[1, c0] * D[2, c1] - D[1, c1] * D[2, c0]))
+            nk2 = m3 * m3
+            num += nk2 if k < 2 else -nk2
+            den += nk2
+        return num / den
+    Q = np.zeros((4, 4))
+    _orthonormal_complement(D, s - 1, Q)
+    nz = 5 - s
+    H = np.zeros((3, 3))
+    for i in range(nz):
+        for j in range(nz):
+            zi, zj = s - 1 + i, s - 1 + j
+            H[i, j] = (Q[zi, 0] * Q[zj, 0] + Q[zi, 1] * Q[zj, 1]
+                       - Q[zi, 2] * Q[zj, 2] - Q[zi, 3] * Q[zj, 3])
+    if nz == 2:
+        half = 0.5 * (H[0, 0] - H[1, 1])
+        return 0.5 * (H[0, 0] + H[1, 1]) - math.sqrt(half * half + H[0, 1] * H[0, 1])
+    return np.linalg.eigvalsh(H[:nz, :nz].copy())[0]
+
+
+@jit
+def _frame(R, Vn, scale, Rn, P, G, bvec):  # type: ignore[no-untyped-def]
+    """Normalised robots ``Rn``, lifted points ``P`` (N, 5), Gram matrix ``G`` and ``b``
+    (``_kernel.Frame.build``); returns the formation centre (cx, cy)."""
+    N = R.shape[0]
+    cx = 0.0
+    cy = 0.0
+    for i in range(N):
+        cx += R[i, 0]
+        cy += R[i, 1]
+    cx /= N
+    cy /= N
+    for i in range(N):
+        Rn[i, 0] = (R[i, 0] - cx) / scale
+        Rn[i, 1] = (R[i, 1] - cy) / scale
+        b = (Rn[i, 0] * Rn[i, 0] + Rn[i, 1] * Rn[i, 1]) - (Vn[i, 0] * Vn[i, 0] + Vn[i, 1] * Vn[i, 1])
+        P[i, 0] = -2.0 * Rn[i, 0]
+        P[i, 1] = -2.0 * Rn[i, 1]
+        P[i, 2] = 2.0 * Vn[i, 0]
+        P[i, 3] = 2.0 * Vn[i, 1]
+        P[i, 4] = b
+        bvec[i] = b
+    for i in range(N):
+        for j in range(N):
+            G[i, j] = 2.0 * ((Rn[i, 0] * Rn[j, 0] + Rn[i, 1] * Rn[j, 1])
+                             - (Vn[i, 0] * Vn[j, 0] + Vn[i, 1] * Vn[j, 1]))
+    return cx, cy
+
+
+@jit
+def feasible(R, lim2):  # type: ignore[no-untyped-def]
+    """Finite coordinates and no robot pair farther apart than its (tolerant) sheet
+    distance (``model.check_formations``); ``lim2`` (N, N) squared limits."""
+    N = R.shape[0]
+    for i in range(N):
+        if not (math.isfinite(R[i, 0]) and math.isfinite(R[i, 1])):
+            return False
+    for i in range(N):
+        for j in range(i + 1, N):
+            dx = R[i, 0] - R[j, 0]
+            dy = R[i, 1] - R[j, 1]
+            if dx * dx + dy * dy > lim2[i, j]:
+                return False
+    return True
+
+
+@jit
+def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key):  # type: ignore[no-untyped-def]
+    """Steps 2-3 for every candidate of ``table`` (C, 5): ``sol[c]`` = (w (5), x (4), mu,
+    depth2), ``taut[c]`` the exact taut set and ``key[c]`` its sort key (taut-set size,
+    then taut set, then the own-set preference, then table order), or -1 where the
+    candidate fails. Returns the number of survivors."""
+    N = Rn.shape[0]
+    C = table.shape[0]
+    K = np.empty((6, 6))
+    work = np.empty((6, 6))
+    rhs = np.empty(6)
+    found = 0
+    for c in range(C):
+        key[c] = -1
+        s = sizes[c]
+        members = table[c]
+        if not _lagrange(G, bvec, members, s, K, rhs, work):
+            continue
+        x0 = x1 = x2 = x3 = 0.0
+        for a in range(s):
+            m = members[a]
+            w = rhs[a]
+            x0 += w * Rn[m, 0]
+            x1 += w * Rn[m, 1]
+            x2 += w * (P[m, 2] * 0.5)
+            x3 += w * (P[m, 3] * 0.5)
+        mu = rhs[s]
+        depth2 = -((x0 * x0 + x1 * x1) - (x2 * x2 + x3 * x3) + mu)
+        if not (depth2 > TAUT_TOL and depth2 < z2):
+            continue
+        worst = -np.inf
+        code = 0
+        tsize = 0
+        for j in range(N):
+            e = (x0 * P[j, 0] + x1 * P[j, 1] + x2 * P[j, 2] + x3 * P[j, 3]) + (P[j, 4] - mu)
+            if e > worst:
+                worst = e
+            t = e >= -TAUT_TOL
+            taut[c, j] = t
+            if t:
+                tsize += 1
+            else:
+                code |= 1 << (N - 1 - j)
+        if not worst <= TAUT_TOL:
+            continue
+        for a in range(5):
+            sol[c, a] = rhs[a] if a < s else 0.0
+        sol[c, 5] = x0
+        sol[c, 6] = x1
+        sol[c, 7] = x2
+        sol[c, 8] = x3
+        sol[c, 9] = mu
+        sol[c, 10] = depth2
+        prefer = 0 if tsize == s else 1
+        key[c] = ((((tsize << N) | code) * 2 + prefer) * C + c)
+        found += 1
+    return found
+
+
+@jit
+def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang):  # type: ignore[no-untyped-def]
+    """Step 4 for candidate ``c`` whose exact taut set is ``taut_c``: -1 when the paper's
+    projection test fails, else the status (``PENDING`` for weight families)."""
+    N = Rn.shape[0]
+    s = sizes[c]
+    min_w = np.inf
+    for a in range(s):
+        if sol[c, a] < min_w:
+            min_w = sol[c, a]
+    if tsize < 3:
+        return -1
+    if not min_w > INSIDE_WEIGHT:
+        if not _in_hull(Rn, taut_c, N, sol[c, 5], sol[c, 6], ang):
+            return -1
+    if tsize != s:
+        return PENDING
+    if min_w < -WEIGHT_TOL:
+        return NOT_EQUILIBRIUM
+    if _reduced_min_eig(P, table[c], s) > CURVATURE_TOL:
+        return STABLE
+    return SADDLE
+
+
+@jit
+def _write_row(out, k, status, c, sol, taut_c, tsize, table, sizes, Vn, scale, cx, cy,
+               vcx, vcy, hold):  # type: ignore[no-untyped-def]
+    """Row ``k`` of ``out`` in the caller's units (layout in the module docstring)."""
+    N = Vn.shape[0]
+    out[k, 0] = status
+    out[k, 1] = tsize
+    depth = math.sqrt(sol[c, 10])
+    out[k, 2] = sol[c, 5] * scale + cx
+    out[k, 3] = sol[c, 6] * scale + cy
+    out[k, 4] = hold - depth * scale
+    out[k, 5] = sol[c, 7] * scale + vcx
+    out[k, 6] = sol[c, 8] * scale + vcy
+    out[k, 7] = depth
+    wcol = 8 + N
+    lcol = 8 + 2 * N
+    for j in range(N):
+        out[k, 8 + j] = 1.0 if taut_c[j] else 0.0
+        out[k, wcol + j] = 0.0
+        dx = Vn[j, 0] - sol[c, 7]
+        dy = Vn[j, 1] - sol[c, 8]
+        out[k, lcol + j] = math.sqrt(dx * dx + dy * dy) * scale
+    for a in range(sizes[c]):
+        out[k, wcol + table[c, a]] = sol[c, a]
+    xcol = 8 + 3 * N
+    for a in range(4):
+        out[k, xcol + a] = sol[c, 5 + a]
+
+
+@jit
+def solve_formation(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out):  # type: ignore[no-untyped-def]
+    """Every rest state of one formation ``R`` (N, 2, caller's units) into rows of
+    ``out`` (at least C rows of ``row_width(N)``). ``Vn`` (N, 2) normalised vertices,
+    ``table`` (C, 5) / ``sizes`` (C,) the candidates, ``lim2`` (N, N) squared pair limits.
+    Returns ``(rows, stable_rows, pending_rows)``, or ``(INFEASIBLE, 0, 0)`` for a
+    non-finite or torn formation (nothing solved)."""
+    N = R.shape[0]
+    if not feasible(R, lim2):
+        return INFEASIBLE, 0, 0
+    C = table.shape[0]
+    Rn = np.empty((N, 2))
+    P = np.empty((N, 5))
+    G = np.empty((N, N))
+    bvec = np.empty(N)
+    cx, cy = _frame(R, Vn, scale, Rn, P, G, bvec)
+    z = hold / scale
+    sol = np.empty((C, 11))
+    taut = np.zeros((C, N), dtype=np.bool_)
+    key = np.empty(C, dtype=np.int64)
+    found = _candidates(Rn, P, G, bvec, table, sizes, z * z, sol, taut, key)
+    if found == 0:
+        return 0, 0, 0
+    order = np.argsort(key)
+    ang = np.empty(N)
+    k = 0
+    stable = 0
+    pending = 0
+    last = -1
+    for r in range(C - found, C):
+        c = order[r]
+        head = key[c] // (2 * C)
+        if head == last:
+            continue
+        last = head
+        tsize = 0
+        for j in range(N):
+            if taut[c, j]:
+                tsize += 1
+        status = _classify_row(Rn, P, table, sizes, c, sol, taut[c], tsize, ang)
+        if status < 0:
+            continue
+        _write_row(out, k, status, c, sol, taut[c], tsize, table, sizes, Vn, scale, cx, cy,
+                   vcx, vcy, hold)
+        if status == STABLE:
+            stable += 1
+        elif status == PENDING:
+            pending += 1
+        k += 1
+    return k, stable, pending
+
+
+@jit
+def solve_formations(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):  # type: ignore[no-untyped-def]
+    """:func:`solve_formation` for each of ``Rb`` (B, N, 2). Returns the rows (M, width)
+    with their formation index ``form`` (M,), and the first infeasible formation's index
+    (or -1)."""
+    B, N = Rb.shape[0], Rb.shape[1]
+    C = table.shape[0]
+    W = 12 + 3 * N
+    buf = np.empty((C, W))
+    cap = max(16, 2 * B)
+    rows = np.empty((cap, W))
+    form = np.empty(cap, dtype=np.int64)
+    M = 0
+    for b in range(B):
+        k, _, _ = solve_formation(Rb[b], Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf)
+        if k < 0:
+            return rows[:M], form[:M], b
+        if M + k > cap:
+            cap = max(2 * cap, M + k)
+            grown = np.empty((cap, W))
+            grown[:M] = rows[:M]
+            rows = grown
+            gform = np.empty(cap, dtype=np.int64)
+            gform[:M] = form[:M]
+            form = gform
+        rows[M:M + k] = buf[:k]
+        form[M:M + k] = b
+        M += k
+    return rows[:M], form[:M], -1
+
+
+@jit
+def lifted_points(R, Vn, scale):  # type: ignore[no-untyped-def]
+    """Normalised lifted points :math:`P_i = (\\mathbf{a}_i, b_i)` (N, 5) of formation
+    ``R`` (docs/sheet_kinematics.md §1), as ``_kernel.Frame.build``."""
+    N = R.shape[0]
+    Rn = np.empty((N, 2))
+    P = np.empty((N, 5))
+    G = np.empty((N, N))
+    bvec = np.empty(N)
+    _frame(R, Vn, scale, Rn, P, G, bvec)
+    return P
