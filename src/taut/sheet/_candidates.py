@@ -153,45 +153,90 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     (``f`` an upper facet containing ``S``) spanned by ``u_g = n_g[:4] - n_g[4] x_f`` for
     ``5 - |S|`` other facets ``g``; the stationary point of ``q + g_i`` on it solves a
     1x1 or 2x2 system (closed form). This replaces the paper's Lagrange solve (eq. 14)
-    for every candidate; the exact maximiser test still decides which are valid.
+    for every candidate; the exact maximiser test still decides which are valid
+    (docs/sheet_kinematics.md §2).
 
     Returns the stationary points, and the faces (``size -> subsets``) whose directions
     are too ill-conditioned for the closed form (nearly coplanar neighbouring facets),
     which go through the general solver; or None for hulls where the shortcut does not
     apply at all (coplanar points or merged facets).
     """
-    if len(hull.coplanar):
+    facets = _upper_facets(hull, basis)
+    if facets is None:
         return None
-    eq = hull.equations
-    # Qt gives every simplex of a merged (non-simplicial) facet that facet's hyperplane.
-    probe = np.sort(eq @ _PROBE)
-    if np.any(probe[1:] == probe[:-1]):
-        return None
-    nP = eq[:, :5] @ basis.T         # outward unit normals in lifted coords (basis orthogonal)
-    upper = nP[:, 4] > UPPER_NORMAL_TOL
-    N = len(P)
-    uf = np.flatnonzero(upper)
+    nP, upper, uf = facets
     simp_u = hull.simplices[uf]                  # Qhull's vertex order: neighbours follow it
     sorted_u = np.sort(simp_u, axis=1)
+    nbr = hull.neighbors[uf]
     # Facets: the stationary point is the facet's own vertex of the arrangement.
     subsets = [sorted_u]
     xs = [nP[uf, :4] / nP[uf, 4:5]]
     sizes = [np.full(len(uf), 5, dtype=np.intp)]
     curvs = [np.full(len(uf), np.inf)]
-    # Ridges: facet f minus its vertex j, shared with neighbour g = neighbors[f, j]
-    # (Qhull orders neighbours opposite the unsorted simplex's vertices).
-    nbr = hull.neighbors[uf]
+    faces = [_ridge_faces(nP, upper, uf, simp_u, sorted_u, nbr),
+             _triangle_faces(nP, uf, simp_u, sorted_u, nbr, len(P))]
+    fallback: dict[int, list[np.ndarray]] = {}
+    for face, xf, dirs in faces:
+        c = _J * xf + 0.5 * P[face[:, 0], :4]             # gradient terms at x_f (any i)
+        if len(dirs) == 1:
+            ok, x, curv = _closed_form_line(xf, c, dirs[0])
+        else:
+            ok, x, curv = _closed_form_plane(xf, c, dirs[0], dirs[1])
+        curvs.append(curv)
+        if not np.all(ok):
+            s_face = 5 - len(dirs)
+            fallback.setdefault(s_face, []).append(face[~ok, :s_face])
+        xs.append(x)
+        subsets.append(face[ok])
+        sizes.append(np.full(len(x), 5 - len(dirs), dtype=np.intp))
+    subset = np.vstack(subsets)
+    x = np.vstack(xs)
+    first = P[subset[:, 0]]
+    mu = (first[:, :4] * x) @ _ONES + first[:, 4]
+    sq = x * x
+    depth2 = -((sq[:, 0] + sq[:, 1]) - (sq[:, 2] + sq[:, 3]) + mu)
+    return Stationary(np.zeros(len(x), np.intp), subset, np.concatenate(sizes), x, mu, depth2,
+                      np.concatenate(curvs)), {s: np.vstack(v) for s, v in fallback.items()}
+
+
+def _upper_facets(hull: ConvexHull, basis: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Outward unit normals ``nP`` of every facet in lifted coordinates, the upper mask
+    and the upper facets' indices; None when the hull has coplanar points or merged
+    facets (Qt gives every simplex of a merged facet that facet's hyperplane)."""
+    if len(hull.coplanar):
+        return None
+    eq = hull.equations
+    probe = np.sort(eq @ _PROBE)
+    if np.any(probe[1:] == probe[:-1]):
+        return None
+    nP = eq[:, :5] @ basis.T         # outward unit normals in lifted coords (basis orthogonal)
+    upper = nP[:, 4] > UPPER_NORMAL_TOL
+    return nP, upper, np.flatnonzero(upper)
+
+
+def _ridge_faces(nP: np.ndarray, upper: np.ndarray, uf: np.ndarray, simp_u: np.ndarray,
+                 sorted_u: np.ndarray, nbr: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """Ridges (4-faces): facet f minus its vertex j, shared with neighbour g =
+    neighbors[f, j] (Qhull orders neighbours opposite the unsorted simplex's vertices),
+    each once. Returns the padded subsets, the points x_f and the direction u_g."""
     fi, j = np.nonzero(~upper[nbr] | (uf[:, None] < nbr))
     f, g = uf[fi], nbr[fi, j]
     rows = sorted_u[fi]
     ridge = np.full((len(f), 5), -1, dtype=np.intp)
     ridge[:, :4] = rows[rows != simp_u[fi, j][:, None]].reshape(-1, 4)
     x1 = nP[f, :4] / nP[f, 4:5]
-    faces = [(ridge, x1, (nP[g, :4] - nP[g, 4:5] * x1,))]
-    # 2-faces: every 3-subset S of an upper facet f. The facets sharing with f the ridges
-    # opposite f's two other vertices also contain S (they are f's neighbours around S).
-    # Of the upper facets containing S keep the one whose two directions u_g (see below)
-    # are best conditioned: nearly coplanar neighbours give tiny or nearly parallel ones.
+    return ridge, x1, (nP[g, :4] - nP[g, 4:5] * x1,)
+
+
+def _triangle_faces(nP: np.ndarray, uf: np.ndarray, simp_u: np.ndarray, sorted_u: np.ndarray,
+                    nbr: np.ndarray, N: int
+                    ) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """2-faces: every 3-subset S of an upper facet f. The facets sharing with f the ridges
+    opposite f's two other vertices also contain S (f's neighbours around S). Of the upper
+    facets containing S keep the one whose two directions u_g are best conditioned:
+    nearly coplanar neighbours give tiny or nearly parallel ones."""
     perm = np.argsort(simp_u, axis=1)              # sorted_u = simp_u in the order perm
     tri = sorted_u[:, _TRI_POS].reshape(-1, 3)
     f3 = np.repeat(uf, 10)
@@ -215,68 +260,57 @@ def _stationary_from_normals(P: np.ndarray, hull: ConvexHull, basis: np.ndarray
     pick = order[keep]
     face = np.full((len(pick), 5), -1, dtype=np.intp)
     face[:, :3] = tri[pick]
-    faces.append((face, x3[pick], (u3[pick], v3[pick])))
-    fallback: dict[int, list[np.ndarray]] = {}
-    for face, xf, dirs in faces:
-        # Stationary point of q + g_i on x_f + span(u_g): a 1x1 or 2x2 system in closed
-        # form (A = U J U', U the rows u_g; row sums by products with _ONES). Also the
-        # reduced Hessian's smallest eigenvalue on span(u_g), in an orthonormal basis.
-        c = _J * xf + 0.5 * P[face[:, 0], :4]             # gradient terms at x_f (any i)
-        u = dirs[0]
-        uu = u * u
-        a11, n1 = uu @ _J, uu @ _ONES
-        r1 = -((u * c) @ _ONES)
-        # Directions nearly lost to cancellation (nearly coplanar neighbouring facets) are
-        # solved by the general Lagrange kernel instead.
-        size_u = np.sqrt(n1)                              # relative to |n_g| = 1
-        if len(dirs) == 1:
-            ok = (np.abs(a11) > CLOSED_FORM_RTOL * n1) & (size_u > FALLBACK_SIN)
-            x = xf[ok] + (r1[ok] / a11[ok])[:, None] * u[ok]
-            curvs.append(a11[ok] / n1[ok])
-        else:
-            v = dirs[1]
-            vv = v * v
-            a12, a22 = (u * v) @ _J, vv @ _J
-            r2 = -((v * c) @ _ONES)
-            det = a11 * a22 - a12 * a12
-            m2, g12 = vv @ _ONES, (u * v) @ _ONES
-            n2 = n1 + m2
-            size_v = np.sqrt(m2)
-            sin_uv = np.sqrt(np.maximum(m2 - g12 * g12 / np.maximum(n1, TINY), 0.0) /
-                             np.maximum(m2, TINY))
-            ok = ((np.abs(det) > CLOSED_FORM_RTOL * n2 * n2) & (size_u > FALLBACK_SIN)
-                  & (size_v > FALLBACK_SIN) & (sin_uv > FALLBACK_SIN))
-            t1 = (a22 * r1 - a12 * r2)[ok] / det[ok]
-            t2 = (a11 * r2 - a12 * r1)[ok] / det[ok]
-            x = xf[ok] + t1[:, None] * u[ok] + t2[:, None] * v[ok]
-            # Orthonormal basis (Gram-Schmidt) e1 = u / |u|, e2 ~ v - (v.e1) e1; closed-form
-            # 2 x 2 eigenvalue. Nearly parallel u, v lose digits: leave those (NaN) to the
-            # SVD-based reduced_hessian_min_eig.
-            n1, m2, g12, a11, a12, a22 = n1[ok], m2[ok], g12[ok], a11[ok], a12[ok], a22[ok]
-            s1 = g12 / n1                                    # n1 > 0 where ok
-            w2 = m2 - s1 * g12                               # |v - s1 u|^2
-            good = w2 > GRAM_SCHMIDT_RTOL2 * m2
-            w2 = np.where(good, w2, 1.0)
-            h11 = a11 / n1
-            h12 = (a12 - s1 * a11) / np.sqrt(n1 * w2)
-            h22 = (a22 - 2.0 * s1 * a12 + s1 * s1 * a11) / w2
-            half = 0.5 * (h11 - h22)
-            curv = 0.5 * (h11 + h22) - np.sqrt(half * half + h12 * h12)
-            curvs.append(np.where(good, curv, np.nan))
-        if not np.all(ok):
-            s_face = 5 - len(dirs)
-            fallback.setdefault(s_face, []).append(face[~ok, :s_face])
-        xs.append(x)
-        subsets.append(face[ok])
-        sizes.append(np.full(len(x), 5 - len(dirs), dtype=np.intp))
-    subset = np.vstack(subsets)
-    x = np.vstack(xs)
-    first = P[subset[:, 0]]
-    mu = (first[:, :4] * x) @ _ONES + first[:, 4]
-    sq = x * x
-    depth2 = -((sq[:, 0] + sq[:, 1]) - (sq[:, 2] + sq[:, 3]) + mu)
-    return Stationary(np.zeros(len(x), np.intp), subset, np.concatenate(sizes), x, mu, depth2,
-                      np.concatenate(curvs)), {s: np.vstack(v) for s, v in fallback.items()}
+    return face, x3[pick], (u3[pick], v3[pick])
+
+
+def _closed_form_line(xf: np.ndarray, c: np.ndarray, u: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stationary point of q + g_i on the line x_f + t u (a 1x1 system, A = u J u') and
+    the reduced Hessian's eigenvalue on it; ``ok`` False where the direction is nearly
+    lost to cancellation (left to the general Lagrange kernel)."""
+    uu = u * u
+    a11, n1 = uu @ _J, uu @ _ONES
+    r1 = -((u * c) @ _ONES)
+    size_u = np.sqrt(n1)                              # relative to |n_g| = 1
+    ok = (np.abs(a11) > CLOSED_FORM_RTOL * n1) & (size_u > FALLBACK_SIN)
+    x = xf[ok] + (r1[ok] / a11[ok])[:, None] * u[ok]
+    return ok, x, a11[ok] / n1[ok]
+
+
+def _closed_form_plane(xf: np.ndarray, c: np.ndarray, u: np.ndarray, v: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stationary point of q + g_i on the plane x_f + span(u, v) (a 2x2 system in closed
+    form) and the reduced Hessian's smallest eigenvalue on it, in an orthonormal basis
+    (Gram-Schmidt e1 = u / |u|, e2 ~ v - (v.e1) e1). Nearly parallel u, v lose digits:
+    their curvature is NaN (left to the SVD-based reduced_hessian_min_eig)."""
+    uu, vv = u * u, v * v
+    a11, n1 = uu @ _J, uu @ _ONES
+    r1 = -((u * c) @ _ONES)
+    size_u = np.sqrt(n1)
+    a12, a22 = (u * v) @ _J, vv @ _J
+    r2 = -((v * c) @ _ONES)
+    det = a11 * a22 - a12 * a12
+    m2, g12 = vv @ _ONES, (u * v) @ _ONES
+    n2 = n1 + m2
+    size_v = np.sqrt(m2)
+    sin_uv = np.sqrt(np.maximum(m2 - g12 * g12 / np.maximum(n1, TINY), 0.0) /
+                     np.maximum(m2, TINY))
+    ok = ((np.abs(det) > CLOSED_FORM_RTOL * n2 * n2) & (size_u > FALLBACK_SIN)
+          & (size_v > FALLBACK_SIN) & (sin_uv > FALLBACK_SIN))
+    t1 = (a22 * r1 - a12 * r2)[ok] / det[ok]
+    t2 = (a11 * r2 - a12 * r1)[ok] / det[ok]
+    x = xf[ok] + t1[:, None] * u[ok] + t2[:, None] * v[ok]
+    n1, m2, g12, a11, a12, a22 = n1[ok], m2[ok], g12[ok], a11[ok], a12[ok], a22[ok]
+    s1 = g12 / n1                                    # n1 > 0 where ok
+    w2 = m2 - s1 * g12                               # |v - s1 u|^2
+    good = w2 > GRAM_SCHMIDT_RTOL2 * m2
+    w2 = np.where(good, w2, 1.0)
+    h11 = a11 / n1
+    h12 = (a12 - s1 * a11) / np.sqrt(n1 * w2)
+    h22 = (a22 - 2.0 * s1 * a12 + s1 * s1 * a11) / w2
+    half = 0.5 * (h11 - h22)
+    curv = 0.5 * (h11 + h22) - np.sqrt(half * half + h12 * h12)
+    return ok, x, np.where(good, curv, np.nan)
 
 
 def hull_candidates(P: np.ndarray, pairs: bool, *, shortcut: bool = True,

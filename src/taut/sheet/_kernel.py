@@ -281,7 +281,7 @@ def _screen_and_solve(K: np.ndarray, rhs: np.ndarray, independent: bool
     """Solve the systems ``K`` (M, n, n) ``[w, mu] = rhs`` (M, n) (n <= 6: a candidate's
     members and its constraint row, possibly padded to 6) and flag the non-singular ones
     (policy of :func:`solve_candidates`). ``K`` is overwritten where singular."""
-    ok = None
+    ok: np.ndarray | None = None
     if independent:
         try:
             sol = np.linalg.solve(K, rhs[..., None])[..., 0]
@@ -305,6 +305,7 @@ def _screen_and_solve(K: np.ndarray, rhs: np.ndarray, independent: bool
         if not ok.all():
             K[~ok] = np.eye(K.shape[1])        # singular: solved harmlessly, dropped later
         sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+    assert ok is not None
     return ok, sol
 
 

@@ -29,19 +29,20 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 from typing import Any, Callable
 
 import numpy as np
 
-from ._tol import (ANGLE_TOL, COINCIDE_RTOL2, CURVATURE_TOL, INSIDE_WEIGHT, MAX_CONDITION,
-                   SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL)
+from ._tol import (ANGLE_TOL, COINCIDE_RTOL2, CURVATURE_TOL, INSIDE_WEIGHT, JACOBI_TOL,
+                   MAX_CONDITION, SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL)
 
 try:  # numba is a core dependency; without it (no wheel for this Python) numpy is used.
     if os.environ.get("TAUT_DISABLE_NUMBA"):
         raise ImportError("disabled by TAUT_DISABLE_NUMBA")
     import numba
 except ImportError:  # pragma: no cover - depends on the environment
-    numba = None
+    numba = None  # type: ignore[assignment]
 
 #: True when the compiled path is available.
 HAVE_NUMBA = numba is not None
@@ -62,6 +63,37 @@ def row_width(N: int) -> int:
     return 12 + 3 * N
 
 
+def _writable(directory: str) -> bool:
+    """Whether a file can be created in ``directory`` (created if missing)."""
+    try:
+        os.makedirs(directory, exist_ok=True)
+        with tempfile.TemporaryFile(dir=directory):
+            return True
+    except OSError:
+        return False
+
+
+def _ensure_cache_dir() -> None:
+    """numba caches next to this file (``__pycache__``) or in the user's cache directory;
+    when neither is writable (a read-only install for a user without a home) and
+    ``NUMBA_CACHE_DIR`` is not set, use a per-user directory under the system's
+    temporary directory, so that ``cache=True`` never fails."""
+    if numba is None or os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "__pycache__")
+    if _writable(here):
+        return
+    user = os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"),
+                        "numba")
+    if _writable(user):
+        return
+    numba.config.CACHE_DIR = os.path.join(tempfile.gettempdir(),
+                                          f"taut-numba-cache-{os.getuid()}")
+
+
+_ensure_cache_dir()
+
+
 def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
     """``numba.njit(cache=True)`` when numba is available, else ``fn`` itself."""
     if numba is None:  # pragma: no cover - depends on the environment
@@ -70,7 +102,7 @@ def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
 
 
 @jit
-def _lu_solve(K, rhs, n):  # type: ignore[no-untyped-def]
+def _lu_solve(K, rhs, n):
     """Solve ``K[:n, :n] y = rhs[:n]`` in place by LU with partial pivoting (as LAPACK's
     getrf). Returns ``(det, ok_solved)``; ``rhs`` holds the solution; ``K`` is destroyed.
     A zero pivot leaves ``det = 0`` (the caller then rejects the system)."""
@@ -110,7 +142,7 @@ def _lu_solve(K, rhs, n):  # type: ignore[no-untyped-def]
 
 
 @jit
-def _lagrange(G, bvec, members, s, K, rhs, work):  # type: ignore[no-untyped-def]
+def _lagrange(G, bvec, members, s, K, rhs, work):
     """Solve candidate ``members[:s]``'s bordered system into ``rhs[:s+1]`` = (w, mu).
     Returns False where the system is singular (policy of ``_kernel._screen_and_solve``:
     relative determinant, then the condition number of the 6 x 6 padded form)."""
@@ -135,9 +167,9 @@ def _lagrange(G, bvec, members, s, K, rhs, work):  # type: ignore[no-untyped-def
     if solved and abs(det) > SINGULAR_RTOL * norms:
         return True
     # Suspect: condition number of the padded 6 x 6 form (extra singular values 1).
-    sv = np.linalg.svd(work[:n, :n].copy())[1]
-    smax = max(sv[0], 1.0)
-    smin = min(sv[n - 1], 1.0)
+    top, bottom = _singular_extremes(work, n)
+    smax = max(top, 1.0)
+    smin = min(bottom, 1.0)
     if not (smin > 0.0 and smax / smin < MAX_CONDITION):
         return False
     if not solved:
@@ -146,7 +178,46 @@ def _lagrange(G, bvec, members, s, K, rhs, work):  # type: ignore[no-untyped-def
 
 
 @jit
-def _in_hull(Rn, taut, N, px, py, ang):  # type: ignore[no-untyped-def]
+def _singular_extremes(W, n):
+    """Largest and smallest singular value of ``W[:n, :n]`` (destroyed) by one-sided
+    Jacobi rotations of its columns (Hestenes): accurate small singular values, and far
+    less to compile than LAPACK's SVD."""
+    for _ in range(60):
+        rotated = False
+        for p in range(n - 1):
+            for q in range(p + 1, n):
+                alpha = beta = gamma = 0.0
+                for i in range(n):
+                    alpha += W[i, p] * W[i, p]
+                    beta += W[i, q] * W[i, q]
+                    gamma += W[i, p] * W[i, q]
+                if abs(gamma) <= JACOBI_TOL * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = c * t
+                for i in range(n):
+                    wp, wq = W[i, p], W[i, q]
+                    W[i, p] = c * wp - s * wq
+                    W[i, q] = s * wp + c * wq
+        if not rotated:
+            break
+    top = 0.0
+    bottom = np.inf
+    for j in range(n):
+        norm = 0.0
+        for i in range(n):
+            norm += W[i, j] * W[i, j]
+        norm = math.sqrt(norm)
+        top = max(top, norm)
+        bottom = min(bottom, norm)
+    return top, bottom
+
+
+@jit
+def _in_hull(Rn, taut, N, px, py, ang):
     """The paper's projection test (``_kernel.in_hull_2d``) for the robots in ``taut``."""
     m = 0
     scale2 = 1.0
@@ -165,7 +236,14 @@ def _in_hull(Rn, taut, N, px, py, ang):  # type: ignore[no-untyped-def]
                 return True
             ang[m] = math.atan2(dy, dx)
             m += 1
-    a = np.sort(ang[:m])
+    a = ang[:m]
+    for k in range(1, m):                          # insertion sort (m <= N is small)
+        v = a[k]
+        i = k - 1
+        while i >= 0 and a[i] > v:
+            a[i + 1] = a[i]
+            i -= 1
+        a[i + 1] = v
     gap = a[0] + 2.0 * math.pi - a[m - 1]
     for k in range(m - 1):
         if a[k + 1] - a[k] > gap:
@@ -174,7 +252,7 @@ def _in_hull(Rn, taut, N, px, py, ang):  # type: ignore[no-untyped-def]
 
 
 @jit
-def _project_out(v, Q, q):  # type: ignore[no-untyped-def]
+def _project_out(v, Q, q):
     """Remove from ``v`` (4,) its components along the first ``q`` rows of ``Q`` (twice:
     "twice is enough" for Gram-Schmidt); returns the residual norm."""
     for _ in range(2):
@@ -186,7 +264,7 @@ def _project_out(v, Q, q):  # type: ignore[no-untyped-def]
 
 
 @jit
-def _orthonormal_complement(D, nrows, Q):  # type: ignore[no-untyped-def]
+def _orthonormal_complement(D, nrows, Q):
     """Orthonormal rows ``Q[nrows:4]`` spanning the null space of the ``nrows`` (affinely
     independent, so linearly independent) rows of ``D`` (4 columns), which are first
     orthonormalised into ``Q[:nrows]``; each further row is the coordinate axis with the
@@ -215,13 +293,18 @@ def _orthonormal_complement(D, nrows, Q):  # type: ignore[no-untyped-def]
 
 
 @jit
-def _reduced_min_eig(P, members, s):  # type: ignore[no-untyped-def]
+def _reduced_min_eig(P, members, s):
     """Smallest eigenvalue of diag(1, 1, -1, -1) on the face's tangent space
     (``_kernel.reduced_hessian_min_eig``): +inf for 5 members, the generalised cross
     product for 4, a 2 x 2 closed form for 3, a 3 x 3 one for 2 (docs/sheet_kinematics.md
     §5)."""
     if s >= 5:
         return np.inf
+    if s <= 2:
+        # A 3-space: by Cauchy interlacing against diag(1, 1, -1, -1) the smallest
+        # eigenvalue is exactly -1 (such rows never get here: a 2-cable taut set fails
+        # the paper's test, larger ones are weight families).
+        return -1.0
     D = np.empty((4, 4))
     for a in range(1, s):
         for c in range(4):
@@ -250,11 +333,11 @@ def _reduced_min_eig(P, members, s):  # type: ignore[no-untyped-def]
     if nz == 2:
         half = 0.5 * (H[0, 0] - H[1, 1])
         return 0.5 * (H[0, 0] + H[1, 1]) - math.sqrt(half * half + H[0, 1] * H[0, 1])
-    return np.linalg.eigvalsh(H[:nz, :nz].copy())[0]
+    return H[0, 0]                                 # not reached: nz is 1 or 2
 
 
 @jit
-def _frame(R, Vn, scale, Rn, P, G, bvec):  # type: ignore[no-untyped-def]
+def _frame(R, Vn, scale, Rn, P, G, bvec):
     """Normalised robots ``Rn``, lifted points ``P`` (N, 5), Gram matrix ``G`` and ``b``
     (``_kernel.Frame.build``); returns the formation centre (cx, cy)."""
     N = R.shape[0]
@@ -283,7 +366,7 @@ def _frame(R, Vn, scale, Rn, P, G, bvec):  # type: ignore[no-untyped-def]
 
 
 @jit
-def feasible(R, lim2):  # type: ignore[no-untyped-def]
+def feasible(R, lim2):
     """Finite coordinates and no robot pair farther apart than its (tolerant) sheet
     distance (``model.check_formations``); ``lim2`` (N, N) squared limits."""
     N = R.shape[0]
@@ -300,7 +383,7 @@ def feasible(R, lim2):  # type: ignore[no-untyped-def]
 
 
 @jit
-def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key):  # type: ignore[no-untyped-def]
+def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key):
     """Steps 2-3 for every candidate of ``table`` (C, 5): ``sol[c]`` = (w (5), x (4), mu,
     depth2), ``taut[c]`` the exact taut set and ``key[c]`` its sort key (taut-set size,
     then taut set, then the own-set preference, then table order), or -1 where the
@@ -359,7 +442,7 @@ def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key):  # type: igno
 
 
 @jit
-def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang):  # type: ignore[no-untyped-def]
+def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang):
     """Step 4 for candidate ``c`` whose exact taut set is ``taut_c``: -1 when the paper's
     projection test fails, else the status (``PENDING`` for weight families)."""
     N = Rn.shape[0]
@@ -384,7 +467,7 @@ def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang):  # type: ign
 
 @jit
 def _write_row(out, k, status, c, sol, taut_c, tsize, table, sizes, Vn, scale, cx, cy,
-               vcx, vcy, hold):  # type: ignore[no-untyped-def]
+               vcx, vcy, hold):
     """Row ``k`` of ``out`` in the caller's units (layout in the module docstring)."""
     N = Vn.shape[0]
     out[k, 0] = status
@@ -412,7 +495,7 @@ def _write_row(out, k, status, c, sol, taut_c, tsize, table, sizes, Vn, scale, c
 
 
 @jit
-def solve_formation(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out):  # type: ignore[no-untyped-def]
+def solve_formation(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out):
     """Every rest state of one formation ``R`` (N, 2, caller's units) into rows of
     ``out`` (at least C rows of ``row_width(N)``). ``Vn`` (N, 2) normalised vertices,
     ``table`` (C, 5) / ``sizes`` (C,) the candidates, ``lim2`` (N, N) squared pair limits.
@@ -464,7 +547,7 @@ def solve_formation(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out):  # t
 
 
 @jit
-def solve_formations(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):  # type: ignore[no-untyped-def]
+def solve_formations(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     """:func:`solve_formation` for each of ``Rb`` (B, N, 2). Returns the rows (M, width)
     with their formation index ``form`` (M,), and the first infeasible formation's index
     (or -1)."""
@@ -495,7 +578,7 @@ def solve_formations(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):  # type
 
 
 @jit
-def lifted_points(R, Vn, scale):  # type: ignore[no-untyped-def]
+def lifted_points(R, Vn, scale):
     """Normalised lifted points :math:`P_i = (\\mathbf{a}_i, b_i)` (N, 5) of formation
     ``R`` (docs/sheet_kinematics.md §1), as ``_kernel.Frame.build``."""
     N = R.shape[0]
@@ -505,3 +588,46 @@ def lifted_points(R, Vn, scale):  # type: ignore[no-untyped-def]
     bvec = np.empty(N)
     _frame(R, Vn, scale, Rn, P, G, bvec)
     return P
+
+
+@jit
+def similar_fit(R, A):
+    """Scale and largest robot displacement of the closest similar copy ``s Q A + c`` of
+    the centred vertices ``A`` (N, 2) to formation ``R`` (rotation only, centroid kept;
+    ``fk.similar_copy`` without building the copy). The displacement is +inf where the
+    best orthogonal fit is a reflection (``det(A' R_c) < 0``), as there."""
+    N = R.shape[0]
+    cx = 0.0
+    cy = 0.0
+    for i in range(N):
+        cx += R[i, 0]
+        cy += R[i, 1]
+    cx /= N
+    cy /= N
+    m00 = m01 = m10 = m11 = aa = 0.0
+    for i in range(N):
+        rx, ry = R[i, 0] - cx, R[i, 1] - cy
+        m00 += A[i, 0] * rx
+        m01 += A[i, 0] * ry
+        m10 += A[i, 1] * rx
+        m11 += A[i, 1] * ry
+        aa += A[i, 0] * A[i, 0] + A[i, 1] * A[i, 1]
+    if m00 * m11 - m01 * m10 < 0.0:
+        return 0.0, np.inf
+    # Best rotation for a 2 x 2 cross-covariance with det >= 0: angle from its rotation
+    # part; the sum of its singular values is the norm of that part.
+    c = m00 + m11
+    s = m01 - m10
+    nuc = math.sqrt(c * c + s * s)
+    if nuc == 0.0:
+        return 0.0, np.inf
+    cos, sin = c / nuc, s / nuc
+    scale = nuc / aa
+    dist = 0.0
+    for i in range(N):
+        qx = scale * (cos * A[i, 0] - sin * A[i, 1]) + cx
+        qy = scale * (sin * A[i, 0] + cos * A[i, 1]) + cy
+        d = max(abs(qx - R[i, 0]), abs(qy - R[i, 1]))
+        if d > dist:
+            dist = d
+    return scale, dist

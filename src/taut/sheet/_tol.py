@@ -39,6 +39,9 @@ SINGULAR_RTOL = 1e-10
 #: Condition number (dimensionless) above which a Lagrange system counts as singular
 #: (affinely dependent lifted points give ~1e16; valid ill-conditioned ones reach ~1e8).
 MAX_CONDITION = 1e12
+#: One-sided Jacobi (compiled condition-number test) stops rotating a column pair whose
+#: cosine is below this (dimensionless): machine precision, columns orthogonal.
+JACOBI_TOL = 1e-15
 #: With affinely independent candidates (hull faces) a solution component above this
 #: (dimensionless weights / normalised mu) means LAPACK solved a singular system.
 MAX_SOLUTION = 1e9
@@ -95,6 +98,9 @@ FAST_CHECK_RTOL = 1e-12
 SNAP_TOL = 1e-7
 #: ... but not those closer than this (relative): they are the copy, up to rounding.
 SNAP_MIN = 1e-13
+#: Relative widening of the compiled pre-screen of the snap test (its closed-form fit
+#: agrees with the SVD-based one to ~1e-12; the exact test runs on what passes).
+SCREEN_SLACK = 1e-6
 
 # --- Weight families (LP / QP for taut sets larger than the state determines) ---
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import weakref
 from dataclasses import fields
-from typing import Literal
+from typing import Iterable, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -68,10 +68,10 @@ def _check_sheet(sheet: Sheet) -> Sheet:
     return sheet
 
 
-def _check_method(method: str) -> str:
+def _check_method(method: str) -> Method:
     if method not in METHODS:
         raise InvalidInputError("method", f"must be one of {', '.join(METHODS)}; got {method!r}")
-    return method
+    return method  # type: ignore[return-value]
 
 
 def _check_mass(mass: float | None) -> float | None:
@@ -82,7 +82,7 @@ def _check_mass(mass: float | None) -> float | None:
 _SIDES2: "weakref.WeakKeyDictionary[Sheet, np.ndarray]" = weakref.WeakKeyDictionary()
 
 
-def _formations(sheet: Sheet, formations: np.ndarray, field: str, single: bool) -> np.ndarray:
+def _formations(sheet: Sheet, formations: ArrayLike, field: str, single: bool) -> np.ndarray:
     """``check_formation(s)`` with a fast path: formations whose robots are all clearly
     closer than their sheet vertices (squared distances below the cached squared side
     lengths) are accepted at once; anything else gets the full check, which decides
@@ -211,6 +211,7 @@ def _solve_as_given(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
     tauts: list[np.ndarray] = []
     N = frame.R.shape[1]
     if groups is not None:
+        chunks: Iterable[Solved]
         if isinstance(groups, tuple):
             chunks = [solve_candidates(frame, *groups, independent=independent)]
         else:
@@ -315,6 +316,21 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
         hold height or mass, unknown method, exhaustive search too large.
     InfeasibleFormationError
         Two robots farther apart than their sheet vertices (paper's FormationFeasible).
+
+    Examples
+    --------
+    A unit square sheet held by robots on a square of side 0.9 at height 1: the object
+    hangs below the centre on all four cables, each as long as the sheet's half-diagonal.
+
+    >>> import taut.sheet as ts
+    >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+    >>> res = ts.forward_kinematics(sheet, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], 1.0,
+    ...                             mass=2.0)
+    >>> e = res.lowest
+    >>> e.taut, e.status, [round(float(c), 4) for c in e.object]
+    ((0, 1, 2, 3), 'stable', [0.45, 0.45, 0.6918])
+    >>> [round(float(w), 3) for w in e.weights]     # equal load shares
+    [0.25, 0.25, 0.25, 0.25]
 
     Notes
     -----

@@ -185,13 +185,13 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
         i, j = int(iu[p]), int(ju[p])
         dr = np.sqrt(d2)
         b += start
-        step = int(b) if r.shape[0] > 1 else None
-        where = f" at step {step}" if step is not None else ""
+        at: int | None = int(b) if r.shape[0] > 1 else None
+        where = f" at step {at}" if at is not None else ""
         raise InfeasibleFormationError(
             field,
             f"robots {i + 1} and {j + 1} are {dr[b - start, p]:.6g} apart{where} but their sheet "
             f"vertices only {limit[i, j] / (1 + GEOMETRY_RTOL):.6g} (the sheet would tear)",
-            pair=(i, j), step=step)
+            pair=(i, j), step=at)
     return r
 
 

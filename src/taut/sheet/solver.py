@@ -11,7 +11,10 @@ same equilibria (tested against each other).
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import weakref
+from types import ModuleType
 from typing import Literal
 
 import numpy as np
@@ -19,17 +22,32 @@ from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_positive
 from ..errors import InvalidInputError
-from . import _small_kernel as sk
 from ._candidates import hull_candidates, padded_small_subsets
 from ._finalize import _min_eig_family, _weights_family
 from ._kernel import Frame, pad_groups
-from ._tol import CURVATURE_TOL, GEOMETRY_RTOL, SNAP_MIN, SNAP_TOL, WEIGHT_TOL
+from ._tol import (CURVATURE_TOL, GEOMETRY_RTOL, SCREEN_SLACK, SNAP_MIN, SNAP_TOL,
+                   WEIGHT_TOL)
 from .fk import (Method, _check_mass, _check_method, _check_sheet,
                  _forward_numpy, _forward_numpy_batch, similar_copy)
 from .model import Sheet, check_formation, check_formations, check_hold_height
 from .results import BatchFKResult, FKResult
 
-__all__ = ["FKSolver", "Backend", "COMPILED_MAX_N"]
+__all__ = ["FKSolver", "Backend", "COMPILED_MAX_N", "HAVE_NUMBA"]
+
+#: numba importable (and not disabled by the environment variable TAUT_DISABLE_NUMBA).
+#: The kernel module (and numba) is imported on the first solver that uses it, so that
+#: ``import taut`` stays fast.
+HAVE_NUMBA = (importlib.util.find_spec("numba") is not None
+              and not os.environ.get("TAUT_DISABLE_NUMBA"))
+sk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._small_kernel, once loaded
+
+
+def _load_kernel() -> ModuleType:
+    global sk
+    if sk is None:
+        from . import _small_kernel
+        sk = _small_kernel
+    return sk
 
 Backend = Literal["auto", "numba", "numpy"]
 _BACKENDS = ("auto", "numba", "numpy")
@@ -75,15 +93,15 @@ class FKSolver:
     >>> res = solver.solve([[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]])
     >>> [e.taut for e in res.stable]
     [(0, 1, 2, 3)]
-    >>> np.round(res.lowest.object, 4).tolist()
-    [0.45, 0.45, 0.6444]
+    >>> np.round(res.lowest.object, 4).tolist()   # 1 - sqrt(0.5 - 0.405): cables of 0.7071
+    [0.45, 0.45, 0.6918]
     >>> batch = solver.solve_batch(np.stack([res.formation, res.formation + 0.1]))
     >>> batch.count.tolist()
     [1, 1]
     """
 
     __slots__ = ("sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
-                 "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "__weakref__")
+                 "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "__weakref__")
 
     def __init__(self, sheet: Sheet | ArrayLike, hold_height: float, *,
                  method: Method = "fast", backend: Backend = "auto") -> None:
@@ -96,13 +114,13 @@ class FKSolver:
         N = sheet.n
         fits = method != "exhaustive" and N <= KERNEL_MAX_N
         if backend == "numba":
-            if not sk.HAVE_NUMBA:
+            if not HAVE_NUMBA:
                 raise InvalidInputError("backend", "numba is not installed (pip install numba)")
             if not fits:
                 raise InvalidInputError("backend", f"the compiled kernel takes methods 'fast' "
                                                    f"and 'subsets' with N <= {KERNEL_MAX_N}")
         self.backend = "numba" if backend == "numba" or (backend == "auto" and fits
-                                                         and sk.HAVE_NUMBA) else "numpy"
+                                                         and HAVE_NUMBA) else "numpy"
         # "fast" above COMPILED_MAX_N: the kernel solves the hull's candidates instead.
         self._hull = method == "fast" and N > COMPILED_MAX_N
         V = sheet.vertices
@@ -110,12 +128,17 @@ class FKSolver:
         vc = V.mean(axis=0)
         self._vcx, self._vcy = float(vc[0]), float(vc[1])
         self._Vn = np.ascontiguousarray((V - vc) / self._scale)
-        table = padded_small_subsets(N, sheet.has_collinear_vertices)
+        self._A = np.ascontiguousarray(V - vc)
+        # The all-subsets table (O(N^5) rows) only where it is used.
+        table = (padded_small_subsets(N, sheet.has_collinear_vertices)
+                 if self.backend == "numba" and not self._hull else np.zeros((0, 5), np.intp))
         self._table = np.ascontiguousarray(table, dtype=np.int64)
         self._sizes = np.ascontiguousarray((table >= 0).sum(axis=1), dtype=np.int64)
         limit = sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
         self._lim2 = np.ascontiguousarray(limit * limit)
-        self._width = sk.row_width(N)
+        self._width = 12 + 3 * N                   # _small_kernel.row_width(N)
+        if self.backend == "numba":
+            _load_kernel()
 
     def __repr__(self) -> str:
         return (f"FKSolver(N={self.sheet.n}, hold_height={self.hold_height:g}, "
@@ -222,9 +245,14 @@ class FKSolver:
     def _snap(self, R: np.ndarray) -> np.ndarray | None:
         """``fk._snap_near_similar`` for one formation: the rows of the similar copy of
         the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state."""
-        copies, scale, dist = similar_copy(self.sheet.vertices, R[None])
         size = self.sheet.size
-        if not (SNAP_MIN * size < dist[0] <= SNAP_TOL * size and scale[0] <= 1.0):
+        scale, dist = sk.similar_fit(R, self._A)        # cheap screen first
+        slack = 1.0 + SCREEN_SLACK
+        if not (SNAP_MIN * size / slack < dist <= SNAP_TOL * size * slack
+                and scale <= slack):
+            return None
+        copies, scales, dists = similar_copy(self.sheet.vertices, R[None])
+        if not (SNAP_MIN * size < dists[0] <= SNAP_TOL * size and scales[0] <= 1.0):
             return None
         found = self._kernel(np.ascontiguousarray(copies[0]))
         if found is None or found[1] == 0:
