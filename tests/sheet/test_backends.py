@@ -202,12 +202,13 @@ def test_kernel_is_cached_on_disk_and_cache_dir_falls_back(monkeypatch, tmp_path
 
     import numba
 
-    from taut.sheet import _small_kernel as sk
+    from taut.sheet import _jit as sk
+    from taut.sheet import _small_kernel
 
     sheet = Sheet.regular(4, 1.0)
     FKSolver(sheet, 1.0).solve(0.8 * sheet.vertices)
-    where = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(os.path.dirname(sk.__file__),
-                                                               "__pycache__")
+    where = (os.environ.get("NUMBA_CACHE_DIR")
+             or os.path.join(os.path.dirname(_small_kernel.__file__), "__pycache__"))
     index = [f for _, _, files in os.walk(where) for f in files
              if f.startswith("_small_kernel.solve_formation") and f.endswith(".nbi")]
     assert index

@@ -2,11 +2,12 @@
 
 Everything that depends only on the sheet and the hold height (normalised vertices,
 candidate subset tables, pair limits for the formation check) is computed once; each
-:meth:`FKSolver.solve` then costs the solve itself. Small teams (``N <= COMPILED_MAX_N``
-with the default method) run the compiled kernel of ``_small_kernel`` (numba, every
-candidate of at most five cables); larger teams, and every team when numba is missing or
-``backend="numpy"``, run the vectorised numpy path of :mod:`taut.sheet.fk`. Both give the
-same equilibria (tested against each other).
+:meth:`FKSolver.solve` then costs the solve itself. Teams of up to ``KERNEL_MAX_N``
+robots run the compiled kernel of ``_small_kernel`` (numba): every candidate of at most
+five cables up to ``COMPILED_MAX_N`` robots, the upper-hull faces above. Larger teams, the
+exhaustive method, and every team when numba is missing or ``backend="numpy"``, run the
+vectorised numpy path of :mod:`taut.sheet.fk`. Both give the same equilibria (tested
+against each other; docs/sheet_fk_solver.md).
 """
 
 from __future__ import annotations
@@ -74,10 +75,8 @@ class FKSolver:
         As in :func:`~taut.sheet.forward_kinematics`.
     backend : {"auto", "numba", "numpy"}
         ``"auto"``: the compiled kernel where it applies (numba installed, ``method`` not
-        ``"exhaustive"``, ``N <= COMPILED_MAX_N``, or ``N <= KERNEL_MAX_N`` for
-        ``"subsets"``), else numpy. ``"numba"`` insists on the kernel (every subset of at
-        most five cables, any ``N <= KERNEL_MAX_N``; same equilibria as ``"fast"``);
-        ``"numpy"`` never uses it.
+        ``"exhaustive"``, ``N <= KERNEL_MAX_N``), else numpy. ``"numba"`` insists on the
+        kernel (an error where it does not apply); ``"numpy"`` never uses it.
 
     Attributes
     ----------
@@ -101,7 +100,8 @@ class FKSolver:
     """
 
     __slots__ = ("sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
-                 "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "__weakref__")
+                 "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
+                 "__weakref__")
 
     def __init__(self, sheet: Sheet | ArrayLike, hold_height: float, *,
                  method: Method = "fast", backend: Backend = "auto") -> None:
@@ -137,6 +137,8 @@ class FKSolver:
         limit = sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
         self._lim2 = np.ascontiguousarray(limit * limit)
         self._width = 12 + 3 * N                   # _small_kernel.row_width(N)
+        self._args = (self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
+                      self.hold_height, self._lim2)
         if self.backend == "numba":
             _load_kernel()
 
@@ -175,7 +177,15 @@ class FKSolver:
                 mass = as_positive(mass, "mass")
         else:
             R = np.array(formation, dtype=np.float64, order="C")
-        rows = self._rows(R)
+        if self._hull:
+            rows = self._rows(R)
+        else:                                       # the hot path, inlined
+            out = np.empty((len(self._table), self._width))
+            k, stable, pending = sk.solve_formation(R, *self._args, out)
+            if k > 0 and stable and not pending:
+                rows = out[:k]
+            else:
+                rows = None if k < 0 else self._finish(R, out[:k], stable, pending)
         if rows is None:
             check_formation(self.sheet, R)          # raises with the usual message
             return _forward_numpy(self.sheet, R, self.hold_height, mass, self.method)
@@ -187,7 +197,14 @@ class FKSolver:
         found = self._kernel(R)
         if found is None:
             return None
-        rows, stable = found
+        return self._finish(R, *found, 0)
+
+    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int
+                ) -> np.ndarray:
+        """Rows of ``R`` after the kernel: weight families resolved (``pending`` rows),
+        snapped to a similar copy of the sheet when nothing is stable."""
+        if pending:
+            stable = self._resolve_families(R, rows)
         if stable == 0:
             snapped = self._snap(R)
             if snapped is not None:
