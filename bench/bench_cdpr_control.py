@@ -6,7 +6,7 @@ Measures, in one run on this machine (interleaved repeats, median and min-max sp
     the whole call (set-up: reference tensions, context, initial equilibrium) and the loop;
   * a batched Monte Carlo over 100 seeded 5 mm exit-error plants (one compiled loop over all
     plants) against 100 single runs extrapolated from 10, and its statistics.
-Run: ``python bench/bench_cdpr_control.py [--repeats 3] [--runs 100]`` (needs taut[fast]).
+Run: ``python bench/bench_cdpr_control.py [--repeats 3] [--runs 100]`` (numba, a dependency of taut).
 """
 
 from __future__ import annotations

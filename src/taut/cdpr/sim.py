@@ -166,8 +166,8 @@ def _engine(engine: str, controller: Controller) -> str:
         import numba  # noqa: F401
     except ImportError:
         if engine == "numba":
-            raise InvalidInputError("engine", "numba is not installed (pip install "
-                                              "'taut[fast]')") from None
+            raise InvalidInputError("engine", "numba is not installed (it is a dependency "
+                                              "of taut; pip install numba)") from None
         return "numpy"
     if not compiled:
         raise InvalidInputError("engine", "the numba engine runs VelocityController and "

@@ -1,5 +1,5 @@
 """From solved candidate sets to classified equilibria: de-duplication, the paper's
-force-closure test, exact weights, stability and tensions (DESIGN.md Sec. 3-5)."""
+force-closure test, exact weights, stability and tensions (docs/sheet_kinematics.md §3-§5)."""
 
 from __future__ import annotations
 
@@ -8,12 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog, minimize
 
-from ._kernel import (CURVATURE_TOL, STATUS_NOT_EQUILIBRIUM, STATUS_SADDLE, STATUS_STABLE,
-                      WEIGHT_TOL, Frame, Solved, in_hull_2d, reduced_hessian_min_eig)
-
-
-#: Candidates whose weights all exceed this pass the paper's projection test unchecked.
-INSIDE_WEIGHT = 1e-6
+from ._kernel import (STATUS_NOT_EQUILIBRIUM, STATUS_SADDLE, STATUS_STABLE, Frame, Solved,
+                      in_hull_2d, reduced_hessian_min_eig)
+from ._tol import (CURVATURE_TOL, FAMILY_FTOL, FAMILY_RESIDUAL, INSIDE_WEIGHT, RANK_TOL,
+                   WEIGHT_TOL)
+from ._util import q_hessian
 
 
 @dataclass
@@ -67,7 +66,7 @@ def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: n
 
     Returns the minimum-norm weights (non-negative when possible) and the largest
     achievable minimum weight ``t*`` (an LP solved with HiGHS): ``t* >= 0`` iff some
-    non-negative weights balance the object (DESIGN.md Sec. 3).
+    non-negative weights balance the object (docs/sheet_kinematics.md §3).
     """
     k = len(idx)
     E = np.vstack([frame.R[f, idx].T, frame.V[idx].T, np.ones(k)])
@@ -76,14 +75,14 @@ def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: n
     # deficient; rounding then leaves the 5 equations inconsistent at ~1e-12 and the LP
     # infeasible. Keep the equations along E's significant singular directions.
     U, S, _ = np.linalg.svd(E, full_matrices=False)
-    rank = int(np.sum(S > 1e-9 * S[0]))
+    rank = int(np.sum(S > RANK_TOL * S[0]))
     E, rhs = U[:, :rank].T @ E, U[:, :rank].T @ rhs
     c = np.zeros(k + 1)
     c[-1] = -1.0
     A_ub = np.hstack([-np.eye(k), np.ones((k, 1))])
     lp = linprog(c, A_ub=A_ub, b_ub=np.zeros(k), A_eq=np.hstack([E, np.zeros((rank, 1))]),
                  b_eq=rhs, bounds=[(None, None)] * (k + 1), method="highs")
-    w_min_norm = np.linalg.pinv(E, rcond=1e-9) @ rhs
+    w_min_norm = np.linalg.pinv(E, rcond=RANK_TOL) @ rhs
     if not lp.success:
         return w_min_norm, -np.inf
     t_star = float(lp.x[-1])
@@ -92,8 +91,8 @@ def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: n
     res = minimize(lambda w: 0.5 * w @ w, np.maximum(lp.x[:k], 0.0), jac=lambda w: w,
                    method="SLSQP", bounds=[(0.0, None)] * k,
                    constraints=[{"type": "eq", "fun": lambda w: E @ w - rhs, "jac": lambda w: E}],
-                   options={"ftol": 1e-15, "maxiter": 200})
-    w = res.x if res.success and np.abs(E @ res.x - rhs).max() < 1e-9 else lp.x[:k]
+                   options={"ftol": FAMILY_FTOL, "maxiter": 200})
+    w = res.x if res.success and np.abs(E @ res.x - rhs).max() < FAMILY_RESIDUAL else lp.x[:k]
     return w, t_star
 
 
@@ -101,11 +100,11 @@ def _min_eig_family(frame: Frame, f: int, idx: np.ndarray) -> float:
     A = frame.P[f, idx, :4]
     D = A[1:] - A[:1]
     _, sv, vt = np.linalg.svd(D, full_matrices=True)
-    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0] if len(sv) else 1.0)))
+    r = int(np.sum(sv > RANK_TOL * max(1.0, sv[0] if len(sv) else 1.0)))
     Z = vt[r:]
     if len(Z) == 0:
         return np.inf
-    Hr = Z @ np.diag([1.0, 1.0, -1.0, -1.0]) @ Z.T
+    Hr = Z @ q_hessian() @ Z.T
     return float(np.linalg.eigvalsh(Hr)[0])
 
 

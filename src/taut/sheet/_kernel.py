@@ -1,6 +1,6 @@
 """Numerical core of VVCM forward kinematics, batched over candidate taut sets.
 
-Notation (FK paper, Sec. III; DESIGN.md Sec. 1). Robots :math:`\\mathbf{r}_i`, sheet
+Notation (FK paper, Sec. III; docs/sheet_kinematics.md §1). Robots :math:`\\mathbf{r}_i`, sheet
 vertices :math:`\\mathbf{v}_i`, unknowns :math:`x = (\\mathbf{r}_o, \\mathbf{v}_o)`. The
 feasibility of cable ``i`` (eq. 1) reads :math:`g_i(x) + q(x) + d^2 \\le 0` with
 
@@ -22,7 +22,7 @@ equivalent *weight* form: the stationary point of ``q`` on ``{g_i equal, i in S}
 where :math:`\\mu` is the common value of :math:`g_i` on ``S``. The paper's multipliers
 are :math:`\\lambda_j = -w_j` (``j != i_1``). The weights are exactly the normalised
 vertical tension shares (FK paper eq. 16), which makes force closure an exact test:
-``w >= 0`` (DESIGN.md Sec. 3).
+``w >= 0`` (docs/sheet_kinematics.md §3).
 
 All work is done in a normalised frame (formation and sheet centred, lengths divided by
 the sheet size), so every tolerance below is relative to the sheet size.
@@ -34,28 +34,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Cable ``j`` counts as taut when :math:`L_j^2 - l_j^2 \\ge -` this (in sheet-size^2 units).
-TAUT_TOL = 1e-9
-#: Weights above ``-WEIGHT_TOL`` count as non-negative (weights are dimensionless shares of
-#: the load, sum 1). Ten times ``TAUT_TOL``: where the taut set changes, a cable that is
-#: taut only within ``TAUT_TOL`` carries a weight of that order and either sign.
-WEIGHT_TOL = 1e-8
-#: Reduced-Hessian eigenvalues above this count as positive (dimensionless).
-CURVATURE_TOL = 1e-9
-#: Relative determinant (|det K| / prod of row norms) below which a candidate's Lagrange
-#: system is checked for singularity by its condition number.
-SINGULAR_RTOL = 1e-10
-#: Condition number above which a Lagrange system counts as singular (affinely dependent
-#: lifted points give ~1e16; valid but ill-conditioned systems seen up to ~1e8).
-MAX_CONDITION = 1e12
-#: Angular slack (radians) of the paper's projection test.
-ANGLE_TOL = 1e-9
+from ._tol import (ANGLE_TOL, COINCIDE_RTOL2, CURVATURE_TOL, MAX_CONDITION, MAX_SOLUTION,
+                   SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL)
+from ._util import Q_SIGNS
+
+__all__ = ["TAUT_TOL", "WEIGHT_TOL", "CURVATURE_TOL", "SINGULAR_RTOL", "MAX_CONDITION",
+           "ANGLE_TOL", "STATUS_STABLE", "STATUS_SADDLE", "STATUS_NOT_EQUILIBRIUM",
+           "STATUS_NAMES", "Frame", "Solved", "solve_candidates", "solve_table",
+           "height_ok", "taut_masks", "maximiser_masks", "in_hull_2d",
+           "reduced_hessian_min_eig", "pad_groups"]
 
 STATUS_STABLE, STATUS_SADDLE, STATUS_NOT_EQUILIBRIUM = 0, 1, 2
 STATUS_NAMES = ("stable", "saddle", "not_equilibrium")
 
 # Reduced Hessian of q, up to the factor 2 (does not change signs).
-_H = np.array([1.0, 1.0, -1.0, -1.0])
+_H = Q_SIGNS
 # Columns and signs of the 3 x 3 minors giving the null vector of a 3 x 4 matrix.
 _MINOR_COLS = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 _MINOR_SIGN = np.array([1.0, -1.0, 1.0, -1.0])
@@ -288,14 +281,14 @@ def _screen_and_solve(K: np.ndarray, rhs: np.ndarray, independent: bool
     """Solve the systems ``K`` (M, n, n) ``[w, mu] = rhs`` (M, n) (n <= 6: a candidate's
     members and its constraint row, possibly padded to 6) and flag the non-singular ones
     (policy of :func:`solve_candidates`). ``K`` is overwritten where singular."""
-    ok = None
+    ok: np.ndarray | None = None
     if independent:
         try:
             sol = np.linalg.solve(K, rhs[..., None])[..., 0]
         except np.linalg.LinAlgError:
             independent = False
         else:
-            ok = np.all(np.abs(sol) < 1e9, axis=1)
+            ok = np.all(np.abs(sol) < MAX_SOLUTION, axis=1)
     if not independent:
         # Cheap screen by the determinant, then the condition number for the suspects
         # (of the 6 x 6 padded form: identity rows and columns for unused slots).
@@ -312,6 +305,7 @@ def _screen_and_solve(K: np.ndarray, rhs: np.ndarray, independent: bool
         if not ok.all():
             K[~ok] = np.eye(K.shape[1])        # singular: solved harmlessly, dropped later
         sol = np.linalg.solve(K, rhs[..., None])[..., 0]
+    assert ok is not None
     return ok, sol
 
 
@@ -401,7 +395,7 @@ def in_hull_2d(points: np.ndarray, valid: np.ndarray, p: np.ndarray) -> np.ndarr
     d = points - p[:, None, :]
     dist2 = d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]
     scale2 = np.max(dist2, axis=1, where=valid, initial=1.0)     # max(scale, 1) squared
-    coincide = np.any(valid & (dist2 <= 1e-24 * scale2[:, None]), axis=1)
+    coincide = np.any(valid & (dist2 <= COINCIDE_RTOL2 * scale2[:, None]), axis=1)
     ang = np.arctan2(d[..., 1], d[..., 0])
     # Unused slots repeat the row's first valid direction (no new gap); the last column
     # closes the circle.
@@ -417,7 +411,7 @@ def reduced_hessian_min_eig(frame: Frame, form: np.ndarray, idx: np.ndarray) -> 
     The tangent space is the null space of the differences :math:`\\mathbf{a}_i -
     \\mathbf{a}_{i_1}` over each affinely independent set ``idx`` (M, 5), padded with -1
     (2..5 members). With 5 members the face is a vertex of the arrangement and the
-    result is ``+inf`` (DESIGN.md Sec. 5). The Hessian is scaled to ``diag(1,1,-1,-1)``.
+    result is ``+inf`` (docs/sheet_kinematics.md §5). The Hessian is scaled to ``diag(1,1,-1,-1)``.
     """
     M = len(form)
     out = np.full(M, np.inf)

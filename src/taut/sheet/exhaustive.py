@@ -11,7 +11,8 @@ from math import comb
 import numpy as np
 
 from ..errors import InvalidInputError
-from ._candidates import combo_table
+from ._tol import ELIMINATION_RTOL
+from ._util import combo_table
 from ._kernel import Frame, Solved, height_ok, pad_groups, solve_candidates, taut_masks
 from .results import Funnel
 
@@ -36,7 +37,7 @@ def _independent_rows(A: np.ndarray) -> np.ndarray:
         v = A[:, j, :]
         res = v - np.einsum("mik,mi->mk", Q, np.einsum("mik,mk->mi", Q, v))
         norm = np.linalg.norm(res, axis=1)
-        new = (norm > 1e-10 * scale) & (count < c)
+        new = (norm > ELIMINATION_RTOL * scale) & (count < c)
         rows = np.flatnonzero(new)
         Q[rows, count[rows]] = res[rows] / norm[rows, None]
         count[rows] += 1

@@ -9,7 +9,7 @@ Methods (one interface, chosen by ``method``):
 
 ``"fast"`` (default)
     Candidate taut sets from the upper convex hull of the lifted points (Qhull), their
-    stationary points read off the facet normals (DESIGN.md Sec. 2). Same solutions as
+    stationary points read off the facet normals (docs/sheet_kinematics.md §2). Same solutions as
     Algorithm 1; O(N^2) candidates. Teams of at most ``SMALL_TEAM`` robots take every
     small subset instead (as ``"subsets"``), one cached table solved for all formations
     at once, which is cheaper there.
@@ -24,11 +24,13 @@ Methods (one interface, chosen by ``method``):
 
 from __future__ import annotations
 
+import math
 import weakref
 from dataclasses import fields
-from typing import Literal
+from typing import Iterable, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import (MAX_SHEET_LENGTH, as_array, as_positive, check_range,
                          require_nonempty)
@@ -38,6 +40,7 @@ from ._finalize import Classified, classify
 from ._kernel import (STATUS_NAMES, STATUS_NOT_EQUILIBRIUM, STATUS_STABLE, Frame, Solved,
                       height_ok, in_hull_2d, maximiser_masks, pad_groups, solve_candidates,
                       solve_table)
+from ._tol import FAST_CHECK_RTOL, SNAP_MIN, SNAP_TOL
 from .exhaustive import exhaustive_search, funnel_from
 from .model import Sheet, check_formations, check_hold_height
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult
@@ -50,9 +53,6 @@ METHODS: tuple[str, ...] = ("fast", "exhaustive", "subsets")
 #: Up to this many robots every small subset (N = 8: 182 candidates) is cheaper than a
 #: convex hull, for one formation and for batches alike (measured).
 SMALL_TEAM = 8
-#: Formations without a stable state within this distance (relative to the sheet size) of
-#: a similar copy of the sheet are solved as that copy (see ``_snap_near_similar``).
-SNAP_TOL = 1e-7
 #: Candidate systems solved per block when every formation shares one candidate table.
 TABLE_BLOCK = 65_536
 #: Hull candidates: run the maximiser scan before the projection test when it touches at
@@ -69,21 +69,21 @@ def _check_sheet(sheet: Sheet) -> Sheet:
     return sheet
 
 
-def _check_method(method: str) -> str:
+def _check_method(method: str) -> Method:
     if method not in METHODS:
         raise InvalidInputError("method", f"must be one of {', '.join(METHODS)}; got {method!r}")
-    return method
+    return method  # type: ignore[return-value]
 
 
 def _check_mass(mass: float | None) -> float | None:
     return None if mass is None else as_positive(mass, "mass")
 
 
-#: Squared sheet side lengths, shrunk by a relative 1e-12, per sheet (see _formations).
+#: Squared sheet side lengths, shrunk by FAST_CHECK_RTOL, per sheet (see _formations).
 _SIDES2: "weakref.WeakKeyDictionary[Sheet, np.ndarray]" = weakref.WeakKeyDictionary()
 
 
-def _formations(sheet: Sheet, formations: np.ndarray, field: str, single: bool) -> np.ndarray:
+def _formations(sheet: Sheet, formations: ArrayLike, field: str, single: bool) -> np.ndarray:
     """``check_formation(s)`` with a fast path: formations whose robots are all clearly
     closer than their sheet vertices (squared distances below the cached squared side
     lengths) are accepted at once; anything else gets the full check, which decides
@@ -94,7 +94,7 @@ def _formations(sheet: Sheet, formations: np.ndarray, field: str, single: bool) 
     if rb.shape[1:] == (sheet.n, 2):
         sides2 = _SIDES2.get(sheet)
         if sides2 is None:
-            sides2 = _SIDES2[sheet] = sheet.side_lengths() ** 2 * (1.0 - 1e-12)
+            sides2 = _SIDES2[sheet] = sheet.side_lengths() ** 2 * (1.0 - FAST_CHECK_RTOL)
         d = rb[:, :, None, :] - rb[:, None, :, :]
         if np.all(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1] <= sides2):
             return rb
@@ -181,7 +181,7 @@ def _snap_near_similar(sheet: Sheet, R: np.ndarray, hold_height: float, method: 
     if len(todo) == 0:
         return c
     copies, scale, dist = similar_copy(sheet.vertices, R[todo])
-    near = ((dist > 1e-13 * sheet.size) & (dist <= SNAP_TOL * sheet.size)
+    near = ((dist > SNAP_MIN * sheet.size) & (dist <= SNAP_TOL * sheet.size)
             & (scale <= 1.0))
     if not near.any():
         return c
@@ -213,6 +213,7 @@ def _solve_as_given(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
     tauts: list[np.ndarray] = []
     N = frame.R.shape[1]
     if groups is not None:
+        chunks: Iterable[Solved]
         if isinstance(groups, tuple):
             chunks = [solve_candidates(frame, *groups, independent=independent)]
         else:
@@ -318,6 +319,21 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
     InfeasibleFormationError
         Two robots farther apart than their sheet vertices (paper's FormationFeasible).
 
+    Examples
+    --------
+    A unit square sheet held by robots on a square of side 0.9 at height 1: the object
+    hangs below the centre on all four cables, each as long as the sheet's half-diagonal.
+
+    >>> import taut.sheet as ts
+    >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+    >>> res = ts.forward_kinematics(sheet, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], 1.0,
+    ...                             mass=2.0)
+    >>> e = res.lowest
+    >>> e.taut, e.status, [round(float(c), 4) for c in e.object]
+    ((0, 1, 2, 3), 'stable', [0.45, 0.45, 0.6918])
+    >>> [round(float(w), 3) for w in e.weights]     # equal load shares
+    [0.25, 0.25, 0.25, 0.25]
+
     Notes
     -----
     The object is a point mass; the sheet inelastic and perfectly flexible; cable ``i``
@@ -327,8 +343,24 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
     """
     sheet = _check_sheet(sheet)
     method = _check_method(method)
+    z = _hold_height(hold_height)
+    if method == "exhaustive":
+        return _forward_numpy(sheet, formation, z, mass, method)
+    return cached_solver(sheet, z, method).solve(formation, mass=mass)
+
+
+def _hold_height(hold_height: float) -> float:
+    """``check_hold_height`` with a fast path for a plain positive finite float."""
+    if type(hold_height) is float and 0.0 < hold_height < math.inf:
+        return hold_height
+    return check_hold_height(hold_height)
+
+
+def _forward_numpy(sheet: Sheet, formation: ArrayLike, z: float, mass: float | None,
+                   method: str) -> FKResult:
+    """:func:`forward_kinematics` on the numpy path (``sheet``, ``z``, ``method`` already
+    validated)."""
     mass = _check_mass(mass)
-    z = check_hold_height(hold_height)
     Rb = _formations(sheet, formation, "formation", single=True)
     R = Rb[0]
     frame, c, counts = _solve(sheet, Rb, z, method)
@@ -374,8 +406,17 @@ def forward_kinematics_batch(sheet: Sheet, formations: np.ndarray, hold_height: 
     method = _check_method(method)
     if method == "exhaustive":
         raise InvalidInputError("method", "the batched form supports 'fast' and 'subsets'")
+    z = _hold_height(hold_height)
+    return cached_solver(sheet, z, method).solve_batch(formations, mass=mass)
+
+
+def _forward_numpy_batch(sheet: Sheet, formations: ArrayLike, z: float, mass: float | None,
+                         method: str) -> BatchFKResult:
+    """:func:`forward_kinematics_batch` on the numpy path (inputs but ``formations`` and
+    ``mass`` validated)."""
+    if method == "exhaustive":
+        raise InvalidInputError("method", "the batched form supports 'fast' and 'subsets'")
     mass = _check_mass(mass)
-    z = check_hold_height(hold_height)
     R = _formations(sheet, formations, "formations", single=False)
     B, N = R.shape[:2]
     frame, c, _ = _solve(sheet, R, z, method)
@@ -402,3 +443,6 @@ def forward_kinematics_batch(sheet: Sheet, formations: np.ndarray, hold_height: 
     status[c.form, slot] = c.status
     return BatchFKResult(count, valid, taut, obj_arr, con, wts, ten, status, sheet, R, z,
                          mass, method)
+
+
+from .solver import cached_solver  # noqa: E402  (solver builds on the numpy path above)

@@ -8,11 +8,10 @@ import numpy as np
 
 from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, as_array, as_points, as_positive, check_range
 from ..errors import InfeasibleFormationError, InvalidInputError, InvalidSheetError
+from ._tol import GEOMETRY_RTOL, WINDING_TOL
 
 __all__ = ["Sheet", "check_formation", "check_formations", "check_hold_height"]
 
-#: Relative tolerance (times the sheet size) for geometric equalities on input data.
-GEOMETRY_RTOL = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,7 +80,7 @@ class Sheet:
                                     "(vertices must go around a convex polygon in order)")
         # Consistent turn direction but winding more than once: self-intersecting (a star).
         angles = np.arctan2(cross, np.einsum("ij,ij->i", prev, edges))
-        if abs(abs(angles.sum()) - 2 * np.pi) > 1e-6:
+        if abs(abs(angles.sum()) - 2 * np.pi) > WINDING_TOL:
             raise InvalidSheetError("sheet", "polygon is self-intersecting (it winds around "
                                     "more than once)")
         v.setflags(write=False)
@@ -191,13 +190,13 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
         i, j = int(iu[p]), int(ju[p])
         dr = np.sqrt(d2)
         b += start
-        step = int(b) if r.shape[0] > 1 else None
-        where = f" at step {step}" if step is not None else ""
+        at: int | None = int(b) if r.shape[0] > 1 else None
+        where = f" at step {at}" if at is not None else ""
         raise InfeasibleFormationError(
             field,
             f"robots {i + 1} and {j + 1} are {dr[b - start, p]:.6g} apart{where} but their sheet "
             f"vertices only {limit[i, j] / (1 + GEOMETRY_RTOL):.6g} (the sheet would tear)",
-            pair=(i, j), step=step)
+            pair=(i, j), step=at)
     return r
 
 

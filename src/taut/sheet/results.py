@@ -6,7 +6,10 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from .._validate import as_array
+from ..errors import InvalidInputError
 from .model import Sheet
 
 __all__ = ["Equilibrium", "Funnel", "FKResult", "BatchFKResult", "Status", "GRAVITY"]
@@ -45,7 +48,7 @@ class Equilibrium:
         positive-definite reduced Hessian). ``saddle``: an equilibrium that is not a strict
         minimum. ``not_equilibrium``: passes the paper's force-closure test (projection
         inside the taut robots' polygon) but no non-negative weights exist, so the object
-        would move (DESIGN.md Sec. 3).
+        would move (docs/sheet_kinematics.md §3).
     """
 
     taut: tuple[int, ...]
@@ -94,16 +97,27 @@ class Funnel:
     force_closure: int
 
 
-@dataclass(frozen=True, eq=False)
+def _equilibrium(taut: tuple[int, ...], obj: np.ndarray, contact: np.ndarray,
+                 weights: np.ndarray, tensions: np.ndarray | None, lengths: np.ndarray,
+                 status: str) -> Equilibrium:
+    """An :class:`Equilibrium` without the dataclass ``__init__`` (the hot path of
+    :class:`FKResult`; fields as in the class)."""
+    e = object.__new__(Equilibrium)
+    e.__dict__.update(taut=taut, object=obj, contact=contact, weights=weights,
+                      tensions=tensions, cable_lengths=lengths, status=status)
+    return e
+
+
 class FKResult:
     """All rest states of the object for one formation (FK paper's output
-    :math:`\\mathbb{P}_o, \\mathbb{V}_o, \\mathbb{I}_t`).
+    :math:`\\mathbb{P}_o, \\mathbb{V}_o, \\mathbb{I}_t`). Frozen.
 
     Attributes
     ----------
     equilibria : tuple of Equilibrium
         Every state that passes the paper's Algorithm 1, sorted by number of taut cables
-        then by taut set.
+        then by taut set. (Built on first access when the result came from the compiled
+        kernel; the numbers are fixed when the result is made.)
     funnel : Funnel or None
         Step counts of Algorithm 1 (``method="exhaustive"`` only).
     method : str
@@ -112,13 +126,67 @@ class FKResult:
         The inputs (formation as an (N, 2) array).
     """
 
-    equilibria: tuple[Equilibrium, ...]
+    _equilibria: tuple[Equilibrium, ...] | None
+    _rows: np.ndarray | None
     funnel: Funnel | None
     method: str
     sheet: Sheet
     formation: np.ndarray
     hold_height: float
     mass: float | None
+
+    def __init__(self, equilibria: tuple[Equilibrium, ...], funnel: Funnel | None,
+                 method: str, sheet: Sheet, formation: np.ndarray, hold_height: float,
+                 mass: float | None) -> None:
+        self.__dict__.update(_equilibria=tuple(equilibria), _rows=None, funnel=funnel,
+                             method=method, sheet=sheet, formation=formation,
+                             hold_height=hold_height, mass=mass)
+
+    @classmethod
+    def _from_rows(cls, rows: np.ndarray, method: str, sheet: Sheet, formation: np.ndarray,
+                   hold_height: float, mass: float | None) -> "FKResult":
+        """A result whose equilibria are built on access from kernel rows (layout of
+        ``_small_kernel``: status, taut-set size, object, contact, depth, taut mask,
+        weights, lengths, ...)."""
+        self = object.__new__(cls)
+        self.__dict__.update(_equilibria=None, _rows=rows, funnel=None, method=method,
+                             sheet=sheet, formation=formation, hold_height=hold_height,
+                             mass=mass)
+        return self
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"FKResult is frozen: cannot assign to {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"FKResult is frozen: cannot delete {name!r}")
+
+    @property
+    def equilibria(self) -> tuple[Equilibrium, ...]:
+        eqs = self._equilibria
+        if eqs is None:
+            eqs = self._build(self._rows)
+            self.__dict__.update(_equilibria=eqs, _rows=None)
+        return eqs
+
+    def _build(self, rows: np.ndarray | None) -> tuple[Equilibrium, ...]:
+        if rows is None or len(rows) == 0:
+            return ()
+        N = self.sheet.n
+        scale = self.sheet.size
+        names = ("stable", "saddle", "not_equilibrium")
+        force = None if self.mass is None else self.mass * GRAVITY
+        out = []
+        for row in rows:
+            idx = np.flatnonzero(row[8:8 + N])
+            w = row[8 + N + idx]
+            lengths = row[8 + 2 * N + idx]
+            st = int(row[0])
+            tensions = None
+            if force is not None and st != 2:
+                tensions = w * force * (lengths / scale) / row[7]
+            out.append(_equilibrium(tuple(idx.tolist()), row[2:5].copy(), row[5:7].copy(),
+                                    w, tensions, lengths, names[st]))
+        return tuple(out)
 
     @property
     def stable(self) -> tuple[Equilibrium, ...]:
@@ -131,8 +199,49 @@ class FKResult:
         st = self.stable
         return min(st, key=lambda e: e.height) if st else None
 
+    def closest_stable(self, point: ArrayLike) -> Equilibrium | None:
+        """The stable equilibrium whose object is nearest to ``point``.
+
+        Parameters
+        ----------
+        point : array_like, shape (3,) or (2,)
+            A reference object position :math:`\\mathbf{p}_o` (e.g. the previous state
+            of a tracked object), same length unit as the formation; with two
+            coordinates only the horizontal distance counts.
+
+        Returns
+        -------
+        Equilibrium or None
+            The nearest stable state (Euclidean distance; the first in output order on
+            ties), None when there is no stable state.
+
+        Examples
+        --------
+        >>> import taut.sheet as ts
+        >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+        >>> res = ts.forward_kinematics(sheet, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], 1.0)
+        >>> e = res.closest_stable([0.45, 0.45, 0.5])
+        >>> e is not None and e.stable
+        True
+        """
+        p = as_array(point, "point", ndim=1)
+        if p.shape[0] not in (2, 3):
+            raise InvalidInputError("point", f"must have 2 (x, y) or 3 (x, y, z) "
+                                             f"coordinates, got {p.shape[0]}")
+        st = self.stable
+        if not st:
+            return None
+        d = [float(np.sum((e.object[:len(p)] - p) ** 2)) for e in st]
+        return st[int(np.argmin(d))]
+
     def __len__(self) -> int:
+        if self._equilibria is None and self._rows is not None:
+            return len(self._rows)
         return len(self.equilibria)
+
+    def __repr__(self) -> str:
+        return (f"FKResult(method={self.method!r}, N={self.sheet.n}, "
+                f"equilibria={len(self)}, stable={len(self.stable)})")
 
 
 @dataclass(frozen=True, eq=False)

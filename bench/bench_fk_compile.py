@@ -1,0 +1,53 @@
+"""First-call cost of the compiled FK kernel: compilation, then the on-disk cache.
+
+Usage::
+
+    python bench/bench_fk_compile.py
+
+Runs three fresh Python processes with ``NUMBA_CACHE_DIR`` pointing to a new, empty
+directory: the first compiles every kernel function (numba, ``cache=True``), the second
+and third load them from that directory. Each reports the time of ``import taut.sheet``
+and of the first ``FKSolver.solve`` and one ``solve_batch`` call (wall seconds; the
+machine may be loaded by other work, so run it twice).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+CHILD = r"""
+import json, time
+t0 = time.perf_counter()
+import numpy as np
+import taut.sheet as ts
+t1 = time.perf_counter()
+sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+solver = ts.FKSolver(sheet, 1.0)
+solver.solve([[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]]).equilibria
+t2 = time.perf_counter()
+solver.solve_batch(np.array([[[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]]] * 2))
+t3 = time.perf_counter()
+print(json.dumps({"import_s": t1 - t0, "first_solve_s": t2 - t1, "first_batch_s": t3 - t2,
+                  "backend": solver.backend}))
+"""
+
+
+def main() -> None:
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        for label in ("compile (empty cache)", "cached, new process", "cached, new process"):
+            out = subprocess.run([sys.executable, "-c", CHILD], env=env, check=True,
+                                 capture_output=True, text=True).stdout
+            r = json.loads(out)
+            files = sum(len(f) for _, _, f in os.walk(cache))
+            print(f"{label:24s} import {r['import_s']:.2f} s, first solve "
+                  f"{r['first_solve_s']:.2f} s, first batch {r['first_batch_s']:.2f} s "
+                  f"({r['backend']}; {files} cache files)")
+
+
+if __name__ == "__main__":
+    main()

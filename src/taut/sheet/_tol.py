@@ -1,0 +1,110 @@
+"""Every numerical threshold of the sheet forward-kinematics core, in one place.
+
+All FK work happens in a normalised frame (formation and sheet centred, lengths divided
+by the sheet size :math:`s`, docs/sheet_kinematics.md §1), so "normalised length" below
+means a length in units of the sheet size and "normalised area" one in units of
+:math:`s^2`. Changing any value here can change answers; the ones a user may want to
+move are exposed as keyword arguments where they are used.
+"""
+
+from __future__ import annotations
+
+# --- Taut sets, weights, stability (decide the answers; docs/sheet_kinematics.md §1-§5) ---
+
+#: Cable ``j`` counts as taut when :math:`L_j^2 - l_j^2 \\ge -` this (normalised area).
+#: Rounding of the lifted-point products is ~1e-15; 1e-9 also absorbs inputs given to
+#: ~9 significant digits (a robot pair placed "at" its sheet distance).
+TAUT_TOL = 1e-9
+#: Weights above ``-WEIGHT_TOL`` count as non-negative (dimensionless load shares, sum 1).
+#: Ten times ``TAUT_TOL``: where the taut set changes, a cable that is taut only within
+#: ``TAUT_TOL`` carries a weight of that order and either sign.
+WEIGHT_TOL = 1e-8
+#: Reduced-Hessian eigenvalues above this count as positive (dimensionless: the Hessian
+#: of q is scaled to diag(1, 1, -1, -1), eigenvalues lie in [-1, 1]).
+CURVATURE_TOL = 1e-9
+#: Candidates whose weights all exceed this (dimensionless) pass the paper's projection
+#: test unchecked: r_o = sum w_i r_i is then strictly inside the taut robots' polygon.
+INSIDE_WEIGHT = 1e-6
+#: Angular slack (radians) of the paper's projection test (no gap wider than pi).
+ANGLE_TOL = 1e-9
+#: Squared relative distance (dimensionless) below which the projected object counts as
+#: sitting on a taut robot in the projection test (a distance of 1e-12 of the polygon).
+COINCIDE_RTOL2 = 1e-24
+
+# --- Lagrange systems (which candidate systems are solvable) ---
+
+#: Relative determinant (|det K| / product of row norms, dimensionless) below which a
+#: candidate's Lagrange system is checked for singularity by its condition number.
+SINGULAR_RTOL = 1e-10
+#: Condition number (dimensionless) above which a Lagrange system counts as singular
+#: (affinely dependent lifted points give ~1e16; valid ill-conditioned ones reach ~1e8).
+MAX_CONDITION = 1e12
+#: One-sided Jacobi (compiled condition-number test) stops rotating a column pair whose
+#: cosine is below this (dimensionless): machine precision, columns orthogonal.
+JACOBI_TOL = 1e-15
+#: With affinely independent candidates (hull faces) a solution component above this
+#: (dimensionless weights / normalised mu) means LAPACK solved a singular system.
+MAX_SOLUTION = 1e9
+
+# --- Ranks and flatness of the lifted points (normalised lengths) ---
+
+#: Singular values of centred lifted points, differences or weight equations below this
+#: times the largest (or 1) count as zero: lifted coordinates are O(1) normalised, their
+#: rounding ~1e-15, genuine thickness of non-degenerate teams >> 1e-9.
+RANK_TOL = 1e-9
+#: Relative thickness (smallest over largest singular value of the centred lifted points)
+#: below which the points are flat for Qhull's purposes ...
+EXACT_FLAT = 1e-13
+#: ... and below which (but above EXACT_FLAT) they are "nearly flat": neither the flat
+#: nor the full hull is reliable, so small teams take every subset.
+NEAR_FLAT = 1e-9
+#: Linear independence threshold of Gaussian elimination in the exhaustive method
+#: (relative to the largest row norm or 1): as in the paper's rank test (eq. 5).
+ELIMINATION_RTOL = 1e-10
+#: The "up" axis lies in the lifted points' affine hull when its projection has norm
+#: above 1 - this (dimensionless).
+UP_IN_HULL_TOL = 1e-9
+#: Facets whose outward unit normal has last component above this are upper facets (the
+#: shortcut path); in reduced coordinates facets with up-component above minus this.
+UPPER_NORMAL_TOL = 1e-12
+
+# --- Closed-form stationary points from facet normals (_candidates) ---
+
+#: Faces whose spanning directions have a relative size or mutual sine below this are
+#: solved by the Lagrange kernel rather than in closed form from the facet normals.
+FALLBACK_SIN = 1e-3
+#: Relative determinant of the 1x1 / 2x2 closed-form systems below which they count as
+#: singular (then the Lagrange kernel decides).
+CLOSED_FORM_RTOL = 1e-12
+#: Gram-Schmidt residual (relative squared norm) below which the closed-form curvature
+#: is left to the SVD-based reduced Hessian (digits lost to cancellation).
+GRAM_SCHMIDT_RTOL2 = 1e-2
+#: Guard against division by zero in ratios of squared norms (any tiny positive value).
+TINY = 1e-300
+
+# --- Input checks and snapping (relative to the sheet size) ---
+
+#: Relative tolerance (times the sheet size) for geometric equalities on input data:
+#: robot pairs may exceed their sheet distance by this much (rounding of given data).
+GEOMETRY_RTOL = 1e-9
+#: Winding-number slack (radians) when telling a convex polygon from a star.
+WINDING_TOL = 1e-6
+#: The fast formation check accepts pairs whose squared distance is below the squared
+#: sheet distance shrunk by this relative amount; anything closer to the limit gets the
+#: full check (which applies GEOMETRY_RTOL).
+FAST_CHECK_RTOL = 1e-12
+#: Formations without a stable state within this distance (relative to the sheet size)
+#: of a similar copy of the sheet are solved as that copy (see fk._snap_near_similar).
+SNAP_TOL = 1e-7
+#: ... but not those closer than this (relative): they are the copy, up to rounding.
+SNAP_MIN = 1e-13
+#: Relative widening of the compiled pre-screen of the snap test (its closed-form fit
+#: agrees with the SVD-based one to ~1e-12; the exact test runs on what passes).
+SCREEN_SLACK = 1e-6
+
+# --- Weight families (LP / QP for taut sets larger than the state determines) ---
+
+#: Equality residual (dimensionless) the QP's min-norm weights must meet to be used.
+FAMILY_RESIDUAL = 1e-9
+#: SLSQP function tolerance for the min-norm non-negative weights (dimensionless).
+FAMILY_FTOL = 1e-15
