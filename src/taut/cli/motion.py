@@ -117,6 +117,9 @@ def register(app: typer.Typer) -> None:
         m = as_positive(mass, "--mass") if mass is not None else sc.mass
         r = inverse_kinematics(sc.sheet, object_position, sc.hold_height,
                                contact=contact, heading=np.radians(heading), mass=m)
+        if not r.success:                      # a valid question answered "no": exit 1
+            typer.echo(f"taut: {r.status}: {r.message}", err=True)
+            raise typer.Exit(1)
         if as_json:
             typer.echo(json.dumps(ik_to_dict(r), indent=2))
         else:

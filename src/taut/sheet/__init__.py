@@ -11,6 +11,8 @@ from .ik import (IKConstraints, IKResult, contact_weights, formation_from_angles
 from .model import Sheet, check_formation, check_formations
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult, Funnel
 from .simulate import SimulationEvent, SimulationResult, simulate
+from .ik import IKCertificate
+from .simulate import Simulator, SimulatorState
 
 __all__ = [
     "Sheet", "check_formation", "check_formations",
@@ -21,4 +23,5 @@ __all__ = [
     "simulate", "SimulationResult", "SimulationEvent",
     "formation_metrics", "FormationMetrics", "minimum_enclosing_circle", "formation_size",
     "max_obstacle_height", "min_robot_distance", "max_obstacle_diameter",
+    "IKCertificate", "Simulator", "SimulatorState",
 ]
