@@ -320,3 +320,33 @@ def test_result_convention_and_budget():
     assert "multi-start" in r.message and np.all(np.isnan(r.formation))
     with pytest.raises(InvalidInputError):
         inverse_kinematics(sheet, [0, 0, 0.5], 1.0, budget=-1)
+
+
+def test_lp_relaxation_certificate():
+    """A shallow target near a vertex (N = 4) that the pair proof does not refute: the LP
+    relaxation of the polygon-closing condition is infeasible, and its Farkas multipliers
+    re-check from the target alone."""
+    V = [[0.1510990495582096, -0.6629525570303044], [0.7329824021267202, 0.30443147164229767],
+         [-0.6835135471718619, 0.3485312377993233], [-0.6584213906229159, -0.4093340061843917]]
+    vo = np.array([0.3603519753616005, -0.2859430096203684])
+    p = np.array([0.1, 0.2, 1.0 - 0.05713317576543746])
+    r = inverse_kinematics(Sheet(V), p, 1.0, contact=vo)
+    assert r.status == "unreachable" and r.certificate.kind == "closure_lp"
+    y = r.certificate.multipliers
+    assert np.all(y >= 0) and y.sum() == pytest.approx(1.0)
+    assert_valid_certificate(Sheet(V), p, vo, r.certificate)
+
+
+def test_relaxation_never_refutes_a_reachable_target():
+    """Validity of the relaxation: on targets IK reaches (verified by FK), neither the LP
+    nor the pair proof claims unreachability."""
+    from taut.sheet._ik_certificate import closure_lp_certificate, radial_certificate
+    for sheet, p, vo, _, _ in fk_targets(5, 30, range(4, 10)):
+        r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+        if not r.success:
+            continue
+        s = sheet.size
+        rho = r.reach / s
+        V = (sheet.vertices - vo) / s
+        assert closure_lp_certificate(V, rho) is None
+        assert radial_certificate(V, rho, s) is None
