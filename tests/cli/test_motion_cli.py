@@ -52,8 +52,17 @@ def test_ik_table_and_heading(capsys):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--object", "0", "0", "2"], ["object_position", "not below the holding height"]),
-    (["--object", "0", "0", "0.05"], ["object_position", "too deep"]),
+    (["--object", "0", "0", "2"], ["unreachable", "not below the holding height"]),
+    (["--object", "0", "0", "0.05"], ["unreachable", "too deep"]),
+])
+def test_ik_unreachable_exits_1_with_one_line(capsys, args, words):
+    code, out, err = run(capsys, "ik", SCENARIO, *args)
+    assert code == 1 and out == "" and err.count("\n") == 1, err
+    for w in words:
+        assert w in err, err
+
+
+@pytest.mark.parametrize("args, words", [
     (["--object", "0", "0", "1", "--contact", "5", "0"], ["contact", "not strictly inside"]),
     (["--object", "0", "0"], ["object"]),
     (["--object", "0", "0", "1", "--mass", "-2"], ["--mass", "positive"]),

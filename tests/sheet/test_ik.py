@@ -6,10 +6,11 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from taut.errors import InvalidInputError, UnreachableTargetError
-from taut.sheet import Sheet, forward_kinematics
-from taut.sheet.ik import (contact_weights, formation_from_angles, ik_constraints,
-                           inverse_kinematics)
+from taut._outcome import STATUSES
+from taut.errors import InvalidInputError
+from taut.sheet import (IKCertificate, Sheet, contact_weights, forward_kinematics,
+                        formation_from_angles, ik_constraints, inverse_kinematics)
+from taut.sheet._ik_certificate import verify_certificate
 from taut.sheet.model import check_formation
 from taut.sheet.random import random_team
 from taut.sheet.results import GRAVITY
@@ -27,6 +28,17 @@ def all_taut_stable_at(sheet, formation, z, target, contact=None, tol=1e-6, mass
             continue
         return e
     return None
+
+
+def assert_valid_certificate(sheet, p, vo, cert, z=1.0):
+    """Re-check a certificate from the target alone (normalised frame of the contact)."""
+    assert isinstance(cert, IKCertificate) and cert.message and cert.margin >= 0
+    s = sheet.size
+    lengths = np.linalg.norm(sheet.vertices - vo, axis=1)
+    d = z - p[2]
+    with np.errstate(invalid="ignore"):
+        rho = np.sqrt(lengths ** 2 - d ** 2) / s
+    assert verify_certificate(cert, (sheet.vertices - vo) / s, rho, d, lengths)
 
 
 def fk_targets(seed, count, sizes):
@@ -48,14 +60,15 @@ def test_round_trip_success_rate_n3_to_12():
     targets = fk_targets(7, 72, range(3, 13))
     ok = proved = 0
     for k, (sheet, p, vo, _, _) in enumerate(targets):
-        try:
-            r = inverse_kinematics(sheet, p, 1.0, contact=vo, heading=0.37 * k)
-        except UnreachableTargetError as exc:
-            # Only targets proved unreachable (two robots' required radial distances differ
-            # by more than the sheet lets them stand apart) may fail: 100 % of the rest.
-            assert "no all-taut formation exists" in str(exc), str(exc)
+        r = inverse_kinematics(sheet, p, 1.0, contact=vo, heading=0.37 * k)
+        if not r.success:
+            # Only targets proved unreachable may fail, each with a certificate that an
+            # independent re-check confirms: 100 % of the rest are found.
+            assert r.status == "unreachable", r.message
+            assert_valid_certificate(sheet, p, vo, r.certificate)
             proved += 1
             continue
+        assert r.status == "ok" and r.certificate is None
         assert all_taut_stable_at(sheet, r.formation, 1.0, p, vo) is not None
         ok += 1
     assert ok + proved == len(targets) and ok / len(targets) >= 0.95, (ok, proved)
@@ -74,19 +87,20 @@ def test_unreachable_target_is_proved_by_radial_spacing():
     sheet = Sheet(V)
     p = [0.2520437052874605, -0.3440197874546382, 0.32611031440979465]
     vo = [0.01905116787815906, 0.15351676460669145]
-    with pytest.raises(UnreachableTargetError, match="robots 1 and 8 must stand") as exc:
-        inverse_kinematics(sheet, p, 1.0, contact=vo)
-    assert exc.value.field == "object_position"
+    r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+    assert (r.success, r.status) == (False, "unreachable")
+    assert r.certificate.kind == "radial_spacing" and r.certificate.pair == (0, 7)
+    assert "robots 1 and 8 must stand" in r.message
+    assert np.all(np.isnan(r.formation))
+    assert_valid_certificate(sheet, np.array(p), np.array(vo), r.certificate)
     # Scale invariance: the same target in millimetres is just as unreachable.
-    with pytest.raises(UnreachableTargetError, match="robots 1 and 8"):
-        inverse_kinematics(Sheet(np.array(V) * 1000), np.array(p) * 1000, 1000.0,
-                           contact=np.array(vo) * 1000)
+    mm = inverse_kinematics(Sheet(np.array(V) * 1000), np.array(p) * 1000, 1000.0,
+                            contact=np.array(vo) * 1000)
+    assert mm.status == "unreachable" and "robots 1 and 8" in mm.message
     # A slightly higher object shrinks the gap below the edge length: no longer refuted
     # by this test (whatever the search then finds).
-    try:
-        inverse_kinematics(sheet, [p[0], p[1], 0.5], 1.0, contact=vo)
-    except UnreachableTargetError as exc2:
-        assert "robots 1 and 8 must stand" not in str(exc2)
+    higher = inverse_kinematics(sheet, [p[0], p[1], 0.5], 1.0, contact=vo)
+    assert "robots 1 and 8 must stand" not in higher.message
 
 
 def test_round_trip_is_exact_for_all_taut_targets():
@@ -109,10 +123,12 @@ def test_default_contact_solution_or_typed_error(seed, n, depth, heading):
     sheet, _ = random_team(n, rng)
     target = np.array([rng.normal(), rng.normal(), 1.0 - depth * sheet.size])
     assume(target[2] > 0)
-    try:
-        r = inverse_kinematics(sheet, target, 1.0, heading=heading)
-    except UnreachableTargetError as exc:
-        assert exc.field == "object_position" and exc.problem
+    r = inverse_kinematics(sheet, target, 1.0, heading=heading, budget=3)
+    assert r.status in STATUSES and r.message
+    if not r.success:
+        assert r.status in ("unreachable", "budget_exhausted")
+        if r.status == "unreachable":
+            assert_valid_certificate(sheet, target, r.contact, r.certificate)
         return
     check_formation(sheet, r.formation)              # never tears the sheet
     assert r.min_weight > 0 and r.spacing >= 0 and r.curvature > 0
@@ -158,10 +174,9 @@ def test_three_robots_weights_are_barycentric_and_fixed_by_contact():
 
 def test_reference_keeps_robots_close():
     for sheet, p, vo, R, _ in fk_targets(3, 6, [4, 5, 6]):
-        try:
-            free = inverse_kinematics(sheet, p, 1.0, contact=vo)
-            near = inverse_kinematics(sheet, p, 1.0, contact=vo, reference=R)
-        except UnreachableTargetError:
+        free = inverse_kinematics(sheet, p, 1.0, contact=vo)
+        near = inverse_kinematics(sheet, p, 1.0, contact=vo, reference=R)
+        if not (free.success and near.success):
             continue
         assert np.sum((near.formation - R) ** 2) <= np.sum((free.formation - R) ** 2) + 1e-9
         assert all_taut_stable_at(sheet, near.formation, 1.0, p, vo) is not None
@@ -192,30 +207,44 @@ def test_angle_constraints_flag_torn_sheet():
     assert not bool(c.feasible)
 
 
+@pytest.mark.parametrize("kwargs, kind, words", [
+    (dict(object_position=[0, 0, 1.0]), "depth", "not below the holding height"),
+    (dict(object_position=[0, 0, 0.05], hold_height=2.0), "depth", "too deep"),
+])
+def test_unreachable_targets_say_why(kwargs, kind, words):
+    sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
+    args = dict(hold_height=1.0) | kwargs
+    p, z = np.array(args.pop("object_position"), float), args.pop("hold_height")
+    r = inverse_kinematics(sheet, p, z, **args)
+    assert (r.success, r.status, r.certificate.kind) == (False, "unreachable", kind)
+    assert words in r.message
+    assert_valid_certificate(sheet, p, r.contact, r.certificate, z=z)
+
+
 @pytest.mark.parametrize("kwargs, field, words", [
-    (dict(object_position=[0, 0, 1.0]), "object_position", "not below the holding height"),
     (dict(object_position=[0, 0, -0.1]), "object_position", "not above the ground"),
-    (dict(object_position=[0, 0, 0.05], hold_height=2.0), "object_position", "too deep"),
     (dict(object_position=[0, 0, 0.5], contact=[3, 0]), "contact", "not strictly inside"),
     (dict(object_position=[0, 0, 0.5], contact=[1, 0]), "contact", "not strictly inside"),
 ])
-def test_unreachable_targets_say_why(kwargs, field, words):
+def test_malformed_targets_raise(kwargs, field, words):
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
     args = dict(hold_height=1.0) | kwargs
-    with pytest.raises(UnreachableTargetError) as exc:
+    with pytest.raises(InvalidInputError) as exc:
         inverse_kinematics(sheet, args.pop("object_position"), args.pop("hold_height"), **args)
     assert exc.value.field == field and words in exc.value.problem
 
 
 def test_three_robots_contact_near_vertex_cannot_balance():
     sheet = Sheet([[0, 0], [2, 0], [0.5, 1.5]])
-    with pytest.raises(UnreachableTargetError) as exc:
-        inverse_kinematics(sheet, [0, 0, 0.5], 1.0, contact=[0.6, 0.05])
-    assert "no stable all-taut formation" in exc.value.problem
-    assert "cable 2 would pull sideways harder than the other two" in exc.value.problem
-    with pytest.raises(UnreachableTargetError) as exc:     # shallow: robots 1, 2 too far apart
-        inverse_kinematics(sheet, [0, 0, 0.95], 1.0, contact=[1.2, 0.1])
-    assert "farther apart than the sheet allows" in exc.value.problem
+    r = inverse_kinematics(sheet, [0, 0, 0.5], 1.0, contact=[0.6, 0.05])
+    assert r.status == "unreachable" and r.certificate.kind == "triangle"
+    assert "no stable all-taut formation" in r.message
+    assert "cable 2 would pull sideways harder than the other two" in r.message
+    assert_valid_certificate(sheet, np.array([0, 0, 0.5]), np.array([0.6, 0.05]),
+                             r.certificate)
+    r = inverse_kinematics(sheet, [0, 0, 0.95], 1.0, contact=[1.2, 0.1])  # shallow
+    assert r.status == "unreachable" and r.certificate.kind == "triangle"
+    assert "farther apart than the sheet allows" in r.message
 
 
 @pytest.mark.parametrize("kwargs, field", [
@@ -239,3 +268,85 @@ def test_angles_of_wrong_length():
     with pytest.raises(InvalidInputError) as exc:
         formation_from_angles(Sheet.regular(4, 1.0), [0, 0, 0.5], 1.0, [0.0, 1.0])
     assert exc.value.field == "angles"
+
+
+# An FK state (5 robots) whose target can only be held with robots 3 and 4 at exactly their
+# sheet distance (see the test below).
+BOUNDARY_SHEET = [
+    [-0.8215671781018933, 0.21133763951480128], [-0.4572019260741518, -0.7614908232096091],
+    [0.7371385344688903, -0.38532806946406745], [0.867699105759606, 0.17674529913444362],
+    [-0.08312267281366938, 0.8329468370774251]]
+BOUNDARY_FORMATION = [
+    [-0.46582475522204, 0.47225328326042626], [-0.02759193136135421, -0.46115247620233524],
+    [0.24370120071158596, -0.0853237490314625], [0.790715867463156, 0.09838114698958794],
+    [0.014245277146485158, 0.8445951250121855]]
+
+
+def test_boundary_target_with_a_pair_at_exactly_its_sheet_distance():
+    """Issue 12's miss: a target whose every all-taut formation has a robot pair at exactly
+    its sheet distance. Built from an FK state: in this 5-robot formation robots 3 and 4
+    stand on one ray from the object, exactly |v_3 - v_4| apart, and the object's depth
+    makes their required horizontal distances differ by exactly that length. So every
+    formation for the target has |r_3 - r_4| >= |rho_3 - rho_4| = |v_3 - v_4| (triangle
+    inequality) and, being feasible, equality: the pair is at its limit in all of them."""
+    V, F = BOUNDARY_SHEET, BOUNDARY_FORMATION
+    sheet = Sheet(V)
+    state = [e for e in forward_kinematics(sheet, F, 1.0).stable if len(e.taut) == 5]
+    assert len(state) == 1
+    p, vo = state[0].object, state[0].contact
+    Vn = np.array(V)
+    lengths = np.linalg.norm(Vn - vo, axis=1)
+    rho = np.sqrt(lengths ** 2 - (1.0 - p[2]) ** 2)
+    edge = np.linalg.norm(Vn[2] - Vn[3])
+    assert abs(abs(rho[3] - rho[2]) - edge) < 1e-12 * sheet.size        # the tight bound
+    r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+    assert r.success, r.message
+    assert abs(np.linalg.norm(r.formation[2] - r.formation[3]) - edge) < 1e-9
+    assert r.spacing == pytest.approx(0.0, abs=1e-9)
+    check_formation(sheet, r.formation)
+    assert all_taut_stable_at(sheet, r.formation, 1.0, p, vo) is not None
+
+
+def test_result_convention_and_budget():
+    """Outcome fields on success and failure; a zero budget on a target that needs the
+    search reports budget_exhausted (what was tried), never a false 'unreachable'."""
+    sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
+    ok = inverse_kinematics(sheet, [0, 0, 0.5], 1.0)
+    assert (ok.success, ok.status, ok.certificate) == (True, "ok", None) and ok.message
+    V, F = BOUNDARY_SHEET, BOUNDARY_FORMATION
+    e = [q for q in forward_kinematics(Sheet(V), F, 1.0).stable if len(q.taut) == 5][0]
+    r = inverse_kinematics(Sheet(V), e.object, 1.0, contact=e.contact, budget=0)
+    assert (r.success, r.status, r.certificate) == (False, "budget_exhausted", None)
+    assert "multi-start" in r.message and np.all(np.isnan(r.formation))
+    with pytest.raises(InvalidInputError):
+        inverse_kinematics(sheet, [0, 0, 0.5], 1.0, budget=-1)
+
+
+def test_lp_relaxation_certificate():
+    """A shallow target near a vertex (N = 4) that the pair proof does not refute: the LP
+    relaxation of the polygon-closing condition is infeasible, and its Farkas multipliers
+    re-check from the target alone."""
+    V = [[0.1510990495582096, -0.6629525570303044], [0.7329824021267202, 0.30443147164229767],
+         [-0.6835135471718619, 0.3485312377993233], [-0.6584213906229159, -0.4093340061843917]]
+    vo = np.array([0.3603519753616005, -0.2859430096203684])
+    p = np.array([0.1, 0.2, 1.0 - 0.05713317576543746])
+    r = inverse_kinematics(Sheet(V), p, 1.0, contact=vo)
+    assert r.status == "unreachable" and r.certificate.kind == "closure_lp"
+    y = r.certificate.multipliers
+    assert np.all(y >= 0) and y.sum() == pytest.approx(1.0)
+    assert_valid_certificate(Sheet(V), p, vo, r.certificate)
+
+
+def test_relaxation_never_refutes_a_reachable_target():
+    """Validity of the relaxation: on targets IK reaches (verified by FK), neither the LP
+    nor the pair proof claims unreachability."""
+    from taut.sheet._ik_certificate import closure_lp_certificate, radial_certificate
+    for sheet, p, vo, _, _ in fk_targets(5, 30, range(4, 10)):
+        r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+        if not r.success:
+            continue
+        s = sheet.size
+        rho = r.reach / s
+        V = (sheet.vertices - vo) / s
+        assert closure_lp_certificate(V, rho) is None
+        assert radial_certificate(V, rho, s) is None

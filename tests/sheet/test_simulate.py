@@ -263,3 +263,56 @@ def test_no_stable_state_at_start():
     with pytest.raises(InvalidTrajectoryError) as exc:
         simulate(SQUARE, R, 0.5)
     assert "step 0" in exc.value.problem
+
+
+def test_simulator_steps_reproduce_simulate_through_a_jump():
+    """The stateful Simulator and simulate share one tracker: stepping the jump scenario
+    formation by formation gives the same states and the same jump."""
+    from taut.sheet import Simulator
+    R = load_trajectory(EXAMPLES / "square4_jump.csv").formations
+    res = simulate(SQUARE, R, 1.5, mass=2.0)
+    sim = Simulator(SQUARE, 1.5, R[0], mass=2.0)
+    np.testing.assert_allclose(sim.state.object, res.object[0], atol=1e-12)
+    kinds = []
+    for t in range(1, len(R)):
+        st = sim.step(R[t])
+        assert st.step == t and st.success and st.status == "ok"
+        np.testing.assert_allclose(st.object, res.object[t], atol=1e-9)
+        assert st.taut == res.taut[t]
+        np.testing.assert_allclose(st.tensions, res.tensions[t], rtol=1e-7, atol=1e-9)
+        kinds += [(e.kind, e.step) for e in st.events]
+    assert kinds == [(e.kind, e.step) for e in res.events] == [("jump", 120)]
+    assert res.success and res.status == "ok" and res.message
+
+
+def test_simulator_velocities_match_formations_and_start():
+    from taut.sheet import Simulator
+    rng = np.random.default_rng(3)
+    sheet, R0 = team(5, rng, slack=(0.6, 0.8))
+    R = wobble(R0, 30, rng)
+    by_formation = Simulator(sheet, 1.0, R[0])
+    by_velocity = Simulator(sheet, 1.0, R[0], dt=0.5)
+    for t in range(1, len(R)):
+        a = by_formation.step(R[t])
+        b = by_velocity.step(velocities=(R[t] - R[t - 1]) / 0.5)
+        np.testing.assert_allclose(a.object, b.object, atol=1e-9)
+    assert b.time == pytest.approx(0.5 * (len(R) - 1))
+    # Without new velocities the robots keep moving at the last ones.
+    c = by_velocity.step()
+    np.testing.assert_allclose(c.formation, b.formation + (R[-1] - R[-2]), atol=1e-12)
+    # start: the stable state of the first formation closest to a reference point.
+    Rj = load_trajectory(EXAMPLES / "square4_jump.csv").formations
+    stable = forward_kinematics(SQUARE, Rj[0], 1.5).stable
+    other = max(stable, key=lambda e: e.height)
+    np.testing.assert_allclose(Simulator(SQUARE, 1.5, Rj[0], start=other.object + 0.01)
+                               .state.object, other.object)
+    with pytest.raises(InvalidInputError):
+        by_velocity.step(R[0], velocities=np.zeros((5, 2)))
+    with pytest.raises(InfeasibleFormationError):
+        by_velocity.step(R[0] * 50)
+
+
+def test_lost_object_is_a_diverged_result():
+    R = load_trajectory(EXAMPLES / "square4_jump.csv").formations
+    res = simulate(SQUARE, np.concatenate([R, R[::-1]]), 0.925)
+    assert not res.success and res.status == "diverged" and "lost at step" in res.message

@@ -87,6 +87,9 @@ def register(app: typer.Typer) -> None:
         r = inverse_kinematics(sc.sheet, object_position, sc.hold_height,
                                contact=contact, heading=np.radians(heading),
                                mass=m if m is not None else sc.mass)
+        if not r.success:                      # a valid question answered "no": exit 1
+            typer.echo(f"taut: {r.status}: {r.message}", err=True)
+            raise typer.Exit(1)
         if as_json:
             typer.echo(to_json(ik_to_dict(r)))
         else:

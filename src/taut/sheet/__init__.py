@@ -12,6 +12,8 @@ from .model import Sheet, check_formation, check_formations
 from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult, Funnel
 from .simulate import SimulationEvent, SimulationResult, simulate
 from .solver import FKSolver
+from .ik import IKCertificate
+from .simulate import Simulator, SimulatorState
 
 __all__ = [
     "Sheet", "check_formation", "check_formations",
@@ -23,4 +25,5 @@ __all__ = [
     "formation_metrics", "FormationMetrics", "minimum_enclosing_circle", "formation_size",
     "max_obstacle_height", "min_robot_distance", "max_obstacle_diameter",
     "FKSolver",
+    "IKCertificate", "Simulator", "SimulatorState",
 ]

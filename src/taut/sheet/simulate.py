@@ -1,6 +1,6 @@
 """Quasi-static transport simulation: what the object does while the robots move.
 
-Model (FK paper Sec. II; DESIGN.md Sec. 1-5). At every instant the object rests at a
+Model (FK paper Sec. II; docs/sheet_kinematics.md §1-§5). At every instant the object rests at a
 strict local minimum of :math:`F(x) = \\max_i(|\\mathbf{r}_o - \\mathbf{r}_i|^2 -
 |\\mathbf{v}_o - \\mathbf{v}_i|^2)` over :math:`x = (\\mathbf{r}_o, \\mathbf{v}_o)` (the depth is
 :math:`d^2 = -F`). The robots move slowly (quasi-static), so the object follows its local
@@ -35,443 +35,151 @@ is the descent's end point (not the nearest stable state, as vvcm-rs picks); sub
 positions are linear interpolations of the formations.
 
 Tracking is vectorised over chunks of steps (one batched small solve per chunk), so the
-cost per step is a few microseconds; full FK is called only at events.
+cost per step is a few microseconds; full FK is called only at events. The same tracker
+(:mod:`._branch`) drives the stateful :class:`Simulator`, one step at a time, for control
+loops (set robot velocities or formations, step, read the object).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal
-
 import numpy as np
-from scipy.optimize import linprog, nnls
 
-from .._validate import as_array
+from .._validate import as_array, as_positive
 from ..errors import InvalidInputError, InvalidTrajectoryError
-from ._kernel import (CURVATURE_TOL, WEIGHT_TOL, Frame, height_ok, reduced_hessian_min_eig,
-                      solve_candidates, taut_masks)
-from .fk import _check_mass, _check_sheet, forward_kinematics, forward_kinematics_batch
-from .model import Sheet, check_formations, check_hold_height
-from .results import GRAVITY, Equilibrium
+from ._branch import (State, Tracker, branch, fk_result, fk_stable_batch, from_equilibrium,
+                      make_event, members, nearest, resolve_step)
+from ._sim_results import EventKind, SimulationEvent, SimulationResult, SimulatorState
+from .fk import _check_mass, _check_sheet
+from .model import (GEOMETRY_RTOL, Sheet, check_formation, check_formations,
+                    check_hold_height)
+from .results import GRAVITY
 
-__all__ = ["SimulationEvent", "SimulationResult", "simulate"]
-
-EventKind = Literal["taut_change", "jump", "lost", "recovered"]
-
-#: Continuation tolerance at an event (times the sheet size), plus a motion-based term.
-CONTINUATION_RTOL = 1e-6
-#: Precision (fraction of a step) to which an event is located.
-EVENT_STEP_TOL = 1e-10
-#: Teams up to this size use FK's complete 'subsets' method at events.
-SUBSETS_UP_TO = 10
-#: A descent has arrived when the pieces active at its point (within 1e-6) form a stable
-#: state this close (times the sheet size) to it.
-ARRIVAL_RTOL = 0.05
-_J = np.array([1.0, 1.0, -1.0, -1.0])
+__all__ = ["SimulationEvent", "SimulationResult", "SimulatorState", "Simulator", "simulate",
+           "EventKind"]
 
 
-@dataclass(frozen=True, eq=False)
-class SimulationEvent:
-    """Something discontinuous that happened between steps ``step - 1`` and ``step``.
-
-    Attributes
-    ----------
-    step : int
-        First trajectory step whose state reflects the event.
-    fraction : float
-        Where between the two steps (0..1, formations interpolated linearly).
-    kind : {"taut_change", "jump", "lost", "recovered"}
-        ``taut_change``: the taut set changed along a continuous branch. ``jump``: the
-        branch ended and the object rolled to another minimum. ``lost``: no stable
-        state exists (e.g. the object would touch the ground); states are NaN until
-        ``recovered`` (the lowest stable state once one exists again).
-    taut_before, taut_after : tuple of int
-        0-based taut sets.
-    object_before, object_after : ndarray, shape (3,)
-        Object positions just before and after (NaN when lost).
-    drop : float
-        Height lost, :math:`z_{before} - z_{after}` (about 0 for taut-set changes).
-    """
-
-    step: int
-    fraction: float
-    kind: EventKind
-    taut_before: tuple[int, ...]
-    taut_after: tuple[int, ...]
-    object_before: np.ndarray
-    object_after: np.ndarray
-    drop: float
+def _initial_state(sheet: Sheet, R: np.ndarray, z: float, start: object | None,
+                   field: str) -> State:
+    """The stable state of formation R nearest to ``start`` (3,) (default: the lowest)."""
+    fk0 = fk_result(sheet, R, z)
+    if not fk0.stable:
+        raise InvalidTrajectoryError(field, "no stable rest state for the object at step 0")
+    if start is None:
+        first = fk0.lowest
+        assert first is not None
+    else:
+        p = as_array(start, "start", shape=(3,))
+        first = min(fk0.stable, key=lambda e: float(np.linalg.norm(e.object - p)))
+    return from_equilibrium(first, sheet, R, z)
 
 
-@dataclass(frozen=True, eq=False)
-class SimulationResult:
-    """Object state at every step of a quasi-static simulation.
+class _Record:
+    """Per-step arrays of a simulation being filled in."""
 
-    Attributes
-    ----------
-    object : ndarray, shape (T, 3)
-        :math:`\\mathbf{p}_o` per step (NaN while lost).
-    contact : ndarray, shape (T, 2)
-        :math:`\\mathbf{v}_o` per step.
-    taut : tuple of tuple of int
-        Taut set per step (0-based).
-    weights : ndarray, shape (T, N)
-        Load shares (0 on slack cables).
-    tensions : ndarray, shape (T, N), or None
-        Cable tensions in N when a mass was given (0 on slack cables).
-    events : tuple of SimulationEvent
-        In time order.
-    formations : ndarray, shape (T, N, 2)
-    hold_height : float
-    mass : float or None
-    """
+    def __init__(self, T: int, N: int):
+        self.obj = np.full((T, 3), np.nan)
+        self.con = np.full((T, 2), np.nan)
+        self.wts = np.zeros((T, N))
+        self.taut = np.zeros((T, N), dtype=bool)
 
-    object: np.ndarray
-    contact: np.ndarray
-    taut: tuple[tuple[int, ...], ...]
-    weights: np.ndarray
-    tensions: np.ndarray | None
-    events: tuple[SimulationEvent, ...]
-    formations: np.ndarray
-    hold_height: float
-    mass: float | None
+    def store(self, t: int, s: State | None) -> None:
+        if s is None:
+            return
+        self.obj[t] = (*s.ro, s.z)
+        self.con[t] = s.vo
+        self.wts[t] = s.w
+        self.taut[t, list(s.taut)] = True
 
-    @property
-    def jumps(self) -> tuple[SimulationEvent, ...]:
-        """The events where the object jumped to another minimum."""
-        return tuple(e for e in self.events if e.kind == "jump")
-
-    @property
-    def taut_mask(self) -> np.ndarray:
-        """Bool (T, N): taut cables per step."""
-        m = np.zeros(self.weights.shape, dtype=bool)
-        for t, s in enumerate(self.taut):
-            m[t, list(s)] = True
-        return m
-
-    def __len__(self) -> int:
-        return int(self.object.shape[0])
+    def store_branch(self, t: int, k: int, ro: np.ndarray, vo: np.ndarray, zo: np.ndarray,
+                     w: np.ndarray, tight: np.ndarray) -> None:
+        sl = slice(t, t + k)
+        self.obj[sl, :2], self.obj[sl, 2], self.con[sl], self.wts[sl] = ro, zo, vo, w
+        self.taut[sl] = tight
 
 
-@dataclass
-class _State:
-    """Object state; ``support`` (3..5 cables, affinely independent lifted points, the
-    set that is re-solved along the branch) is a subset of ``taut`` (the exact maximiser
-    set, reported; larger only at degenerate states such as all-taut IK formations)."""
-
-    support: tuple[int, ...]
-    taut: tuple[int, ...]
-    ro: np.ndarray
-    vo: np.ndarray
-    z: float
-    w: np.ndarray                          # (N,)
-
-    @property
-    def point(self) -> np.ndarray:
-        return np.concatenate([self.ro, self.vo, [self.z]])
+def _tensions(sheet: Sheet, z: float, mass: float | None, contact: np.ndarray,
+              obj: np.ndarray, weights: np.ndarray, taut: np.ndarray) -> np.ndarray | None:
+    """:math:`F_i = w_i m g l_i / d` (..., N) in N on taut cables, 0 on slack ones."""
+    if mass is None:
+        return None
+    lengths = np.linalg.norm(sheet.vertices - contact[..., None, :], axis=-1)
+    depth = z - obj[..., 2]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(taut, weights * mass * GRAVITY * lengths / depth[..., None], 0.0)
 
 
-def _support(sheet: Sheet, R: np.ndarray, z: float, e: Equilibrium) -> tuple[int, ...]:
-    """A subset of the taut set to follow: at most 5 cables whose lifted points are
-    affinely independent and span the same face, carrying non-negative weights for the
-    same state (a basic solution of the weight equations, Caratheodory), so that solving
-    it reproduces the state."""
-    T = np.array(e.taut, dtype=np.intp)
-    frame = Frame.build(sheet.vertices, R[None], z, sheet.size)
-    P = frame.P[0, T]
-
-    def rank(rows: np.ndarray) -> int:
-        if len(rows) < 2:
-            return len(rows)
-        sv = np.linalg.svd(P[rows[1:]] - P[rows[:1]], compute_uv=False)
-        return 1 + int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
-
-    everything = np.arange(len(T))
-    full = rank(everything)
-    if len(T) <= 5 and full == len(T):
-        return tuple(int(i) for i in T)
-    E = np.vstack([np.ones(len(T)), frame.R[0, T].T, frame.V[T].T])
-    lp = linprog(-np.asarray(e.weights), A_eq=E, b_eq=E @ e.weights,
-                 bounds=[(0, None)] * len(T), method="highs-ds")
-    w = lp.x if lp.success else np.asarray(e.weights)
-    chosen: list[int] = []
-    for i in np.argsort(-w):
-        if len(chosen) == full:
-            break
-        if rank(np.array(chosen + [int(i)])) == len(chosen) + 1:
-            chosen.append(int(i))
-    return tuple(sorted(int(T[i]) for i in chosen))
+def _recover(sheet: Sheet, R: np.ndarray, z: float, t: int, chunk: int
+             ) -> tuple[State | None, int]:
+    """First step >= t (within ``chunk`` steps) with a stable state: (its lowest state,
+    step), or (None, end of the chunk)."""
+    end = min(len(R), t + chunk)
+    found = np.flatnonzero(fk_stable_batch(sheet, R[t:end], z))
+    if not len(found):
+        return None, end
+    t += int(found[0])
+    lowest = fk_result(sheet, R[t], z).lowest
+    assert lowest is not None
+    return from_equilibrium(lowest, sheet, R[t], z), t
 
 
-def _from_equilibrium(e: Equilibrium, sheet: Sheet, R: np.ndarray, z: float) -> _State:
-    w = np.zeros(sheet.n)
-    w[list(e.taut)] = e.weights
-    return _State(_support(sheet, R, z, e), e.taut, e.object[:2].copy(), e.contact.copy(),
-                  float(e.object[2]), w)
+def _follow(sheet: Sheet, R: np.ndarray, z: float, state: State, t: int, chunk: int,
+            rec: _Record) -> tuple[State, int, bool]:
+    """Track ``state``'s support over steps t..t+chunk in one batched solve; returns the
+    last valid state, the first step not stored, and whether the chunk ended valid."""
+    end = min(len(R), t + chunk)
+    valid, ro, vo, zo, w, tight = branch(sheet, R[t:end], z, state.support)
+    bad = np.flatnonzero(~valid)
+    k = int(bad[0]) if len(bad) else end - t
+    if k:
+        rec.store_branch(t, k, ro[:k], vo[:k], zo[:k], w[:k], tight[:k])
+        state = State(state.support, members(tight[k - 1]), ro[k - 1], vo[k - 1],
+                      float(zo[k - 1]), w[k - 1])
+    return state, t + k, not len(bad)
 
 
-def _solve_sets(sheet: Sheet, R: np.ndarray, z: float, form: np.ndarray, idx: np.ndarray):
-    """Solve taut sets ``idx`` (M, 5), padded with -1, 3..5 cables each, on formations
-    ``R[form]`` (R (B, N, 2)), with the tests of :func:`forward_kinematics`.
-
-    Returns valid (M,), ro (M, 2), vo (M, 2), zo (M,), w (M, N) in world units, and the
-    exact taut sets (M, N) (NaN/0/False on rows whose system is singular)."""
-    M, N = len(form), R.shape[1]
-    frame = Frame.build(sheet.vertices, R, z, sheet.size)
-    sol = solve_candidates(frame, form, idx, independent=True)
-    valid = np.zeros(M, dtype=bool)
-    ro = np.full((M, 2), np.nan)
-    vo = np.full((M, 2), np.nan)
-    zo = np.full(M, np.nan)
-    w = np.zeros((M, N))
-    tight = np.zeros((M, N), dtype=bool)
-    if len(sol.form) == 0:
-        return valid, ro, vo, zo, w, tight
-    ok = height_ok(frame, sol)
-    ok_taut, tight_sol = taut_masks(frame, sol)
-    members = sol.subset >= 0
-    ok &= ok_taut & (np.where(members, sol.w, np.inf).min(axis=1) >= -WEIGHT_TOL)
-    ok &= reduced_hessian_min_eig(frame, sol.form, sol.subset) > CURVATURE_TOL
-    src, f = sol.source, sol.form
-    valid[src] = ok
-    ro[src] = sol.ro * frame.scale + frame.r_centre[f]
-    vo[src] = sol.vo * frame.scale + frame.v_centre
-    zo[src] = z - np.sqrt(np.maximum(sol.depth2, 0.0)) * frame.scale
-    rows, slots = np.nonzero(members)
-    w[src[rows], sol.subset[rows, slots]] = sol.w[rows, slots]
-    tight[src] = tight_sol
-    return valid, ro, vo, zo, w, tight
-
-
-def _members(mask_or_idx: np.ndarray) -> tuple[int, ...]:
-    a = np.asarray(mask_or_idx)
-    idx = np.flatnonzero(a) if a.dtype == bool else a
-    return tuple(sorted(int(i) for i in idx))
-
-
-def _branch(sheet: Sheet, R: np.ndarray, z: float, taut: tuple[int, ...]):
-    """One taut set (3..5 cables) on every formation of ``R`` (C, N, 2); see
-    :func:`_solve_sets`."""
-    C = R.shape[0]
-    idx = np.full((C, 5), -1, dtype=np.intp)
-    idx[:, :len(taut)] = taut
-    return _solve_sets(sheet, R, z, np.arange(C), idx)
-
-
-def _neighbour_sets(taut: tuple[int, ...], N: int) -> np.ndarray:
-    """Taut sets one cable away from ``taut`` (drop one, add one, or swap one), 3..5
-    cables, as rows padded with -1: the candidates for a continuous taut-set change."""
-    cur = set(taut)
-    out = []
-    for i in taut:
-        if len(cur) - 1 >= 3:
-            out.append(sorted(cur - {i}))
-    others = [j for j in range(N) if j not in cur]
-    for j in others:
-        if len(cur) + 1 <= 5:
-            out.append(sorted(cur | {j}))
-        for i in taut:
-            if len(cur) >= 3:
-                out.append(sorted((cur - {i}) | {j}))
-    idx = np.full((len(out), 5), -1, dtype=np.intp)
-    for k, row in enumerate(out):
-        idx[k, :len(row)] = row
-    return idx
-
-
-def _min_norm_combination(G: np.ndarray) -> np.ndarray:
-    """Point of minimum norm in the convex hull of the rows of ``G`` (k, 4)."""
-    if len(G) == 1:
-        return G[0]
-    M = 1e3 * max(1.0, float(np.abs(G).max()))
-    A = np.vstack([G.T, M * np.ones(len(G))])
-    b = np.zeros(A.shape[0])
-    b[-1] = M
-    lam, _ = nnls(A, b)
-    total = lam.sum()
-    if total <= 0:
-        return G[np.argmin(np.linalg.norm(G, axis=1))]
-    return (lam / total) @ G
-
-
-def _descend(P: np.ndarray, x0: np.ndarray, arrive, floor: float, maxit: int = 3000
-             ) -> np.ndarray | None:
-    """Steepest descent of F(x) = q(x) + max_i (a_i . x + b_i) from ``x0`` (normalised
-    units; P (N, 5) lifted points): epsilon-steepest-descent directions (minimum-norm
-    element of the gradients of the epsilon-active pieces) with Armijo backtracking, eps
-    shrinking as the method stalls. Every few iterations ``arrive(active, x)`` is asked
-    whether the pieces active at ``x`` already identify a stable minimum (it returns a
-    result or None); otherwise the descent ends at a (Clarke) stationary point and
-    returns ``x``. Returns None when F drops below ``floor`` (the object reaches the
-    ground, :math:`d \\ge z_r`)."""
-    A, b = P[:, :4], P[:, 4]
-
-    def F(x: np.ndarray) -> float:
-        return float(x @ (_J * x) + (A @ x + b).max())
-
-    x = x0.copy()
-    f = F(x)
-    eps, t = 1e-3, 1.0
-    for it in range(maxit):
-        vals = x @ (_J * x) + A @ x + b
-        top = vals.max()
-        if it % 4 == 0:
-            found = arrive(np.flatnonzero(vals >= top - 1e-6), x)
-            if found is not None:
-                return found
-        active = vals >= top - eps
-        g = _min_norm_combination(2 * _J * x + A[active])
-        gn2 = float(g @ g)
-        if gn2 < 1e-22:
-            if eps < 1e-12:
-                break
-            eps *= 0.1
+def _run(sheet: Sheet, R: np.ndarray, z: float, state: State, rec: _Record,
+         events: list[SimulationEvent], crossings: dict[int, tuple[float, np.ndarray]]
+         ) -> None:
+    """The driver loop: batched branch following, events resolved step by step."""
+    T = len(R)
+    tracker = Tracker(sheet, z)
+    motion = np.abs(np.diff(R, axis=0)).max(axis=(1, 2)) if T > 1 else np.zeros(0)
+    t, chunk = 1, 64
+    cur: State | None = state
+    while t < T:
+        if cur is None:                                    # lost: look for a rest state
+            cur, t_found = _recover(sheet, R, z, t, chunk)
+            if cur is None:
+                t, chunk = t_found, min(4 * chunk, 4096)
+                continue
+            events.append(make_event(t_found, 0.0, "recovered", None, cur))
+            rec.store(t_found, cur)
+            t, chunk = t_found + 1, 64
             continue
-        t = min(1.0, 4.0 * t)
-        while True:
-            trial = x - t * g
-            ft = F(trial)
-            if ft <= f - 1e-4 * t * gn2:
-                break
-            t *= 0.5
-            if t < 1e-14:
-                break
-        if t < 1e-14:
-            t = 1.0
-            if eps < 1e-12:
-                break
-            eps *= 0.1
-            continue
-        x, f = trial, ft
-        if f < floor:
-            return None
-    return x
+        if tracker.trackable(cur):
+            cur, t, whole = _follow(sheet, R, z, cur, t, chunk, rec)
+            if whole:
+                chunk = min(4 * chunk, 4096)
+                continue
+            chunk = 64
+        cur = resolve_step(tracker, cur, R[t - 1], R[t], t, float(motion[t - 1]), events,
+                           crossings)
+        rec.store(t, cur)
+        t += 1
 
 
-def _nearest(stable: tuple[Equilibrium, ...], point: np.ndarray) -> tuple[int, float]:
-    pts = np.array([np.concatenate([e.object[:2], e.contact, [e.object[2]]]) for e in stable])
-    d = np.linalg.norm(pts - point, axis=1)
-    j = int(np.argmin(d))
-    return j, float(d[j])
-
-
-class _Tracker:
-    def __init__(self, sheet: Sheet, z: float):
-        self.sheet, self.z = sheet, z
-        self.N = sheet.n
-
-    def trackable(self, state: _State) -> bool:
-        return 3 <= len(state.support) <= 5
-
-    def valid_at(self, state: _State, R: np.ndarray) -> tuple[bool, _State | None]:
-        if not self.trackable(state):
-            return False, None
-        valid, ro, vo, zo, w, tight = _branch(self.sheet, R[None], self.z, state.support)
-        if not valid[0]:
-            return False, None
-        return True, _State(state.support, _members(tight[0]), ro[0], vo[0], float(zo[0]),
-                            w[0])
-
-    def crossing(self, state: _State, R0: np.ndarray, R1: np.ndarray, s0: float
-                 ) -> tuple[float, float, _State]:
-        """Last valid fraction s_lo (with its state) and first invalid s_hi > s_lo."""
-        lo, hi, at_lo = s0, 1.0, state
-        while hi - lo > EVENT_STEP_TOL:
-            s = np.linspace(lo, hi, 18)[1:-1]
-            R = (1 - s)[:, None, None] * R0 + s[:, None, None] * R1
-            valid, ro, vo, zo, w, tight = _branch(self.sheet, R, self.z, state.support)
-            bad = np.flatnonzero(~valid)
-            k = int(bad[0]) if len(bad) else len(s)
-            if k > 0:
-                lo = float(s[k - 1])
-                at_lo = _State(state.support, _members(tight[k - 1]), ro[k - 1], vo[k - 1],
-                               float(zo[k - 1]), w[k - 1])
-            if k < len(s):
-                hi = float(s[k])
-        return lo, hi, at_lo
-
-    def stable_states(self, R: np.ndarray) -> tuple[Equilibrium, ...]:
-        """Stable FK states of one formation. Events happen at degenerate places (just
-        past a taut-set change, or leaving an all-taut IK formation) where the hull-based
-        method can miss states, so small teams use the complete 'subsets' method and
-        larger ones fall back to it when 'fast' finds none."""
-        method = "subsets" if self.N <= SUBSETS_UP_TO else "fast"
-        stable = forward_kinematics(self.sheet, R, self.z, method=method).stable
-        if not stable and method == "fast":
-            stable = forward_kinematics(self.sheet, R, self.z, method="subsets").stable
-        return stable
-
-    def settle(self, R: np.ndarray, before: _State, cont_tol: float
-               ) -> tuple[_State | None, EventKind | None]:
-        """State at formation ``R`` reached from ``before`` (continuation or descent).
-
-        A continuation is tried first among the taut sets one cable away from the
-        current one (no FK call, and exact at transitions where forward kinematics'
-        tolerance-based taut sets are ambiguous), then among FK's stable states; failing
-        both, the object rolls: steepest descent from ``before``, then the descent's
-        end point's active set (or the nearest stable FK state)."""
-        N, size = self.N, self.sheet.size
-        if self.trackable(before):
-            idx = _neighbour_sets(before.support, N)
-            if len(idx):
-                valid, ro, vo, zo, w, tight = _solve_sets(self.sheet, R[None], self.z,
-                                                          np.zeros(len(idx), np.intp), idx)
-                pts = np.column_stack([ro, vo, zo])
-                dist = np.where(valid, np.linalg.norm(pts - before.point, axis=1), np.inf)
-                k = int(np.argmin(dist))
-                if dist[k] <= cont_tol:
-                    new = _State(_members(idx[k][idx[k] >= 0]), _members(tight[k]), ro[k],
-                                 vo[k], float(zo[k]), w[k])
-                    return new, ("taut_change" if new.taut != before.taut else None)
-        stable = self.stable_states(R)
-        if stable:
-            j, dist = _nearest(stable, before.point)
-            if dist <= cont_tol:
-                new = _from_equilibrium(stable[j], self.sheet, R, self.z)
-                return new, ("taut_change" if new.taut != before.taut else None)
-        frame = Frame.build(self.sheet.vertices, R[None], self.z, size)
-        P = frame.P[0]
-
-        def to_world(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            return x[:2] * size + frame.r_centre[0], x[2:] * size + frame.v_centre
-
-        def arrive(active: np.ndarray, x: np.ndarray) -> _State | None:
-            if not 3 <= len(active) <= 5:
-                return None
-            idx = np.full((1, 5), -1, dtype=np.intp)
-            idx[0, :len(active)] = active
-            valid, ro, vo, zo, w, tight = _solve_sets(self.sheet, R[None], self.z,
-                                                      np.zeros(1, np.intp), idx)
-            ro_x, vo_x = to_world(x)
-            near = np.linalg.norm(np.r_[ro[0] - ro_x, vo[0] - vo_x]) <= ARRIVAL_RTOL * size
-            if not (valid[0] and near):
-                return None
-            return _State(_members(active), _members(tight[0]), ro[0], vo[0], float(zo[0]),
-                          w[0])
-
-        x0 = np.concatenate([(before.ro - frame.r_centre[0]) / size,
-                             (before.vo - frame.v_centre) / size])
-        out = _descend(P, x0, arrive, -frame.z ** 2)
-        if isinstance(out, _State):
-            return out, "jump"
-        if out is None:
-            return None, "lost"
-        vals = out @ (_J * out) + P[:, :4] @ out + P[:, 4]
-        ro, vo = to_world(out)
-        zo = self.z - np.sqrt(max(-float(vals.max()), 0.0)) * size
-        if not stable:
-            return None, "lost"
-        j, _ = _nearest(stable, np.concatenate([ro, vo, [zo]]))
-        return _from_equilibrium(stable[j], self.sheet, R, self.z), "jump"
-
-
-def _event(step: int, frac: float, kind: EventKind, a: _State | None, b: _State | None
-           ) -> SimulationEvent:
-    nan3 = np.full(3, np.nan)
-    pa = nan3 if a is None else np.array([*a.ro, a.z])
-    pb = nan3 if b is None else np.array([*b.ro, b.z])
-    return SimulationEvent(step, frac, kind, () if a is None else a.taut,
-                           () if b is None else b.taut, pa, pb, float(pa[2] - pb[2]))
+def _outcome(events: list[SimulationEvent] | tuple[SimulationEvent, ...], lost_now: bool
+             ) -> tuple[bool, str, str]:
+    """success, status, message of a run (or a step) from its events."""
+    lost = [e for e in events if e.kind == "lost"]
+    jumps = sum(e.kind == "jump" for e in events)
+    if not lost and not lost_now:
+        return True, "ok", f"object rested stably throughout ({len(events)} event(s), " \
+                           f"{jumps} jump(s))"
+    where = f"at step {lost[0].step}" if lost else "before this step"
+    back = any(e.kind == "recovered" for e in events) and not lost_now
+    return False, "diverged", (f"object lost {where} (it reached the ground: no stable "
+                               f"rest state){'; recovered later' if back else ''}")
 
 
 def simulate(sheet: Sheet, formations: object, hold_height: float, *,
@@ -487,7 +195,7 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
     hold_height : float
         :math:`z_r` (> 0).
     start : array_like, shape (3,), optional
-        Initial object position guess: the simulation starts at the stable equilibrium of
+        Reference object position: the simulation starts at the stable equilibrium of
         ``formations[0]`` nearest to it (default: the lowest).
     mass : float, optional
         Object mass (kg) for the tensions :math:`F_i = w_i m g l_i / d`.
@@ -495,6 +203,7 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
     Returns
     -------
     SimulationResult
+        ``success`` false (status ``diverged``) when the object was lost at some step.
 
     Raises
     ------
@@ -504,6 +213,19 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
         Some formation would tear the sheet; ``.step`` is its index.
     InvalidTrajectoryError
         No stable rest state at step 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from taut.sheet import Sheet, simulate
+    >>> square = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
+    >>> R0 = 0.8 * square.vertices
+    >>> path = R0 + np.linspace(0, 0.5, 11)[:, None, None] * [1.0, 0.0]   # slide along x
+    >>> res = simulate(square, path, 1.5)
+    >>> res.success, res.status, len(res), res.events
+    (True, 'ok', 11, ())
+    >>> bool(np.allclose(res.object[-1] - res.object[0], [0.5, 0, 0]))
+    True
     """
     sheet = _check_sheet(sheet)
     mass = _check_mass(mass)
@@ -512,81 +234,19 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
     T, N = R.shape[:2]
     if T == 0:
         raise InvalidInputError("formations", "needs at least one step")
-    fk0 = forward_kinematics(sheet, R[0], z)
-    if not fk0.stable:
-        raise InvalidTrajectoryError("formations", "no stable rest state for the object at "
-                                     "step 0")
-    if start is None:
-        first = fk0.lowest
-    else:
-        p = as_array(start, "start", shape=(3,))
-        first = min(fk0.stable, key=lambda e: float(np.linalg.norm(e.object - p)))
-    state: _State | None = _from_equilibrium(first, sheet, R[0], z)
-
-    obj = np.full((T, 3), np.nan)
-    con = np.full((T, 2), np.nan)
-    wts = np.zeros((T, N))
-    taut = np.zeros((T, N), dtype=bool)
+    state = _initial_state(sheet, R[0], z, start, "formations")
+    rec = _Record(T, N)
+    rec.store(0, state)
     events: list[SimulationEvent] = []
     crossings: dict[int, tuple[float, np.ndarray]] = {}
-    tracker = _Tracker(sheet, z)
-
-    def store(t: int, s: _State | None) -> None:
-        if s is None:
-            return
-        obj[t] = (*s.ro, s.z)
-        con[t] = s.vo
-        wts[t] = s.w
-        taut[t, list(s.taut)] = True
-
-    store(0, state)
-    motion = np.abs(np.diff(R, axis=0)).max(axis=(1, 2)) if T > 1 else np.zeros(0)
-    t, chunk = 1, 64
-    while t < T:
-        if state is None:                                  # lost: look for a rest state
-            end = min(T, t + chunk)
-            batch = forward_kinematics_batch(sheet, R[t:end], z)
-            found = np.flatnonzero(batch.stable.any(axis=1))
-            if not len(found):
-                t, chunk = end, min(4 * chunk, 4096)
-                continue
-            t += int(found[0])
-            state = _from_equilibrium(forward_kinematics(sheet, R[t], z).lowest, sheet, R[t], z)
-            events.append(_event(t, 0.0, "recovered", None, state))
-            store(t, state)
-            t, chunk = t + 1, 64
-            continue
-        if tracker.trackable(state):
-            end = min(T, t + chunk)
-            valid, ro, vo, zo, w, tight = _branch(sheet, R[t:end], z, state.support)
-            bad = np.flatnonzero(~valid)
-            k = int(bad[0]) if len(bad) else end - t
-            if k:
-                sl = slice(t, t + k)
-                obj[sl, :2], obj[sl, 2], con[sl], wts[sl] = ro[:k], zo[:k], vo[:k], w[:k]
-                taut[sl] = tight[:k]
-                state = _State(state.support, _members(tight[k - 1]), ro[k - 1], vo[k - 1],
-                               float(zo[k - 1]), w[k - 1])
-                t += k
-            if not len(bad):
-                chunk = min(4 * chunk, 4096)
-                continue
-            chunk = 64
-        state = _resolve_step(tracker, state, R[t - 1], R[t], t, float(motion[t - 1]),
-                              events, crossings)
-        store(t, state)
-        t += 1
-
-    tensions = None
-    if mass is not None:
-        lengths = np.linalg.norm(sheet.vertices[None] - con[:, None, :], axis=2)
-        depth = z - obj[:, 2]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            tensions = np.where(taut, wts * mass * GRAVITY * lengths / depth[:, None], 0.0)
-    taut_sets = tuple(tuple(int(i) for i in np.flatnonzero(row)) for row in taut)
-    events += _taut_changes(taut_sets, obj, events, crossings)
+    _run(sheet, R, z, state, rec, events, crossings)
+    tensions = _tensions(sheet, z, mass, rec.con, rec.obj, rec.wts, rec.taut)
+    taut_sets = tuple(tuple(int(i) for i in np.flatnonzero(row)) for row in rec.taut)
+    events += _taut_changes(taut_sets, rec.obj, events, crossings)
     events.sort(key=lambda e: (e.step, e.fraction))
-    return SimulationResult(obj, con, taut_sets, wts, tensions, tuple(events), R, z, mass)
+    ok, status, message = _outcome(events, bool(np.isnan(rec.obj[-1, 0])))
+    return SimulationResult(rec.obj, rec.con, taut_sets, rec.wts, tensions, tuple(events), R,
+                            z, mass, ok, status, message)
 
 
 def _taut_changes(taut: tuple[tuple[int, ...], ...], obj: np.ndarray,
@@ -605,42 +265,159 @@ def _taut_changes(taut: tuple[tuple[int, ...], ...], obj: np.ndarray,
     return out
 
 
-def _resolve_step(tracker: _Tracker, state: _State, R0: np.ndarray, R1: np.ndarray,
-                  step: int, motion: float, events: list[SimulationEvent],
-                  crossings: dict[int, tuple[float, np.ndarray]]) -> _State | None:
-    """Follow the object from formation R0 (valid ``state``) to R1 through events."""
-    size = tracker.sheet.size
-    if motion == 0.0:
-        return state
-    s0 = 0.0
-    for _ in range(25):
-        ok, at_end = tracker.valid_at(state, R1)
-        if ok:
-            return at_end
-        if tracker.trackable(state):
-            lo, hi, before = tracker.crossing(state, R0, R1, s0)
-        else:                                   # degenerate (>5 taut): leave it at once
-            lo, hi, before = s0, min(1.0, s0 + 1e-6), state
-        Rh = (1 - hi) * R0 + hi * R1
-        if tracker.trackable(before) and _branch(tracker.sheet, Rh[None], tracker.z,
-                                                 before.support)[3][0] <= 0.0:
-            events.append(_event(step, hi, "lost", before, None))     # on the ground
-            return None
-        cont_tol = CONTINUATION_RTOL * size + 100.0 * (hi - lo) * motion
-        new, kind = tracker.settle(Rh, before, cont_tol)
-        if kind is not None:
-            if kind == "taut_change":
-                crossings.setdefault(step, (hi, np.array([*before.ro, before.z])))
-            else:
-                events.append(_event(step, hi, kind, before, new))
-        if new is None:
-            return None
-        state, s0 = new, hi
-        if s0 >= 1.0:
-            return state
-    fk = forward_kinematics(tracker.sheet, R1, tracker.z)   # pragma: no cover - safeguard
-    if not fk.stable:                                       # pragma: no cover
-        events.append(_event(step, 1.0, "lost", state, None))
-        return None
-    j, _ = _nearest(fk.stable, state.point)                 # pragma: no cover
-    return _from_equilibrium(fk.stable[j], tracker.sheet, R1, tracker.z)  # pragma: no cover
+class Simulator:
+    """Stateful quasi-static simulator for control loops: move the robots (by formation or
+    by velocities over ``dt``), step, read the object (:attr:`state`).
+
+    It shares the branch tracker of :func:`simulate` (:mod:`._branch`): each step follows
+    the object's branch from the previous formation to the new one (straight-line
+    interpolation), through taut-set changes and jumps, exactly as :func:`simulate` does
+    between two samples.
+
+    Parameters
+    ----------
+    sheet : Sheet
+    hold_height : float
+        :math:`z_r` (> 0).
+    formation : array_like, shape (N, 2)
+        Initial robot positions (sheet units).
+    start : array_like, shape (3,), optional
+        Reference object position: the simulator starts at the stable state of
+        ``formation`` closest to it (default: the lowest).
+    mass : float, optional
+        Object mass (kg) for the tensions.
+    dt : float
+        Default time step (s) of :meth:`step` with velocities (1/30, as the peers').
+
+    Raises
+    ------
+    InvalidInputError
+        Bad shapes or values; InvalidTrajectoryError when ``formation`` has no stable
+        rest state.
+    InfeasibleFormationError
+        ``formation`` (or a later one) would tear the sheet.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from taut.sheet import Sheet, Simulator
+    >>> square = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
+    >>> sim = Simulator(square, 1.5, 0.8 * square.vertices)
+    >>> v = np.tile([0.3, 0.0], (4, 1))                  # every robot at 0.3 units/s in x
+    >>> for _ in range(10):
+    ...     state = sim.step(velocities=v, dt=0.1)
+    >>> state.status, state.step, round(state.time, 6)
+    ('ok', 10, 1.0)
+    >>> bool(np.allclose(state.object[:2], sim.initial.object[:2] + [0.3, 0.0]))
+    True
+    """
+
+    def __init__(self, sheet: Sheet, hold_height: float, formation: object, *,
+                 start: object | None = None, mass: float | None = None,
+                 dt: float = 1.0 / 30.0) -> None:
+        self.sheet = _check_sheet(sheet)
+        self.mass = _check_mass(mass)
+        self.hold_height = check_hold_height(hold_height)
+        self.dt = as_positive(dt, "dt")
+        R = check_formation(self.sheet, as_array(formation, "formation",
+                                                 shape=(self.sheet.n, 2)))
+        self._tracker = Tracker(self.sheet, self.hold_height, single_fast=True)
+        self._iu, self._ju = np.triu_indices(self.sheet.n, 1)
+        limit = self.sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * self.sheet.size
+        self._limit2 = limit[self._iu, self._ju] ** 2
+        self._cur: State | None = _initial_state(self.sheet, R, self.hold_height, start,
+                                                 "formation")
+        self._R = R.copy()
+        self._velocities = np.zeros_like(R)
+        self._steps, self._time = 0, 0.0
+        self._state = self._snapshot(())
+        self.initial = self._state
+
+    @property
+    def state(self) -> SimulatorState:
+        """The object after the last step."""
+        return self._state
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """The robot velocities (N, 2) used by :meth:`step` when none are given."""
+        return self._velocities.copy()
+
+    def _snapshot(self, events: tuple[SimulationEvent, ...]) -> SimulatorState:
+        s, N = self._cur, self.sheet.n
+        if s is None:
+            return SimulatorState(self._steps, self._time, self._R.copy(), np.full(3, np.nan),
+                                  np.full(2, np.nan), (), np.zeros(N), None, events, False,
+                                  "diverged", "object lost (no stable rest state)")
+        obj = np.array([*s.ro, s.z])
+        taut = np.zeros(N, dtype=bool)
+        taut[list(s.taut)] = True
+        ten = _tensions(self.sheet, self.hold_height, self.mass, s.vo, obj, s.w, taut)
+        return SimulatorState(self._steps, self._time, self._R.copy(), obj, s.vo.copy(),
+                              s.taut, s.w.copy(), ten, events, True, "ok",
+                              f"object resting on cables {[i + 1 for i in s.taut]}")
+
+    def _next_formation(self, formation: object | None, velocities: object | None,
+                        dt: float | None) -> tuple[np.ndarray, float]:
+        if formation is not None and velocities is not None:
+            raise InvalidInputError("formation", "give a formation or velocities, not both")
+        step_dt = self.dt if dt is None else as_positive(dt, "dt")
+        N = self.sheet.n
+        if formation is not None:
+            R1 = as_array(formation, "formation", shape=(N, 2))
+        else:
+            if velocities is not None:
+                self._velocities = as_array(velocities, "velocities", shape=(N, 2))
+            R1 = self._R + self._velocities * step_dt
+        gap = R1[self._iu] - R1[self._ju]
+        if np.any(np.einsum("pk,pk->p", gap, gap) > self._limit2):   # the precomputed test
+            check_formation(self.sheet, R1)      # raises with the pair named (and the step)
+        return R1, step_dt
+
+    def step(self, formation: object | None = None, *, velocities: object | None = None,
+             dt: float | None = None) -> SimulatorState:
+        """Advance one step and return the new :attr:`state`.
+
+        Parameters
+        ----------
+        formation : array_like, shape (N, 2), optional
+            The robots' new positions. Otherwise they move by ``velocities * dt``.
+        velocities : array_like, shape (N, 2), optional
+            Robot velocities (sheet units per second); kept for later steps. Default: the
+            last ones given (initially zero).
+        dt : float, optional
+            Step duration (s); default the simulator's ``dt``.
+
+        Returns
+        -------
+        SimulatorState
+            ``events`` holds what happened during this step.
+
+        Raises
+        ------
+        InvalidInputError, InfeasibleFormationError
+            Bad input, or a formation that would tear the sheet (the state is unchanged).
+        """
+        R1, step_dt = self._next_formation(formation, velocities, dt)
+        self._steps += 1
+        self._time += step_dt
+        events: list[SimulationEvent] = []
+        before = self._cur
+        if before is None:
+            lowest = fk_result(self.sheet, R1, self.hold_height).lowest
+            if lowest is not None:
+                self._cur = from_equilibrium(lowest, self.sheet, R1, self.hold_height)
+                events.append(make_event(self._steps, 0.0, "recovered", None, self._cur))
+        else:
+            crossings: dict[int, tuple[float, np.ndarray]] = {}
+            motion = float(np.abs(R1 - self._R).max())
+            self._cur = resolve_step(self._tracker, before, self._R, R1, self._steps, motion,
+                                     events, crossings)
+            if self._cur is not None and self._cur.taut != before.taut and not events:
+                frac, where = crossings.get(self._steps,
+                                            (1.0, np.array([*self._cur.ro, self._cur.z])))
+                events.append(SimulationEvent(self._steps, frac, "taut_change", before.taut,
+                                              self._cur.taut, where.copy(), where.copy(), 0.0))
+        self._R = R1.copy()
+        self._state = self._snapshot(tuple(events))
+        return self._state

@@ -1,0 +1,444 @@
+"""The branch tracker of quasi-static simulation, shared by :func:`simulate` and
+:class:`Simulator` (docs/sheet_kinematics.md §1-§5; FK paper Sec. II).
+
+A branch is followed by re-solving its *support* (3..5 taut cables with affinely
+independent lifted points) on each new formation with the same tests as forward
+kinematics. When the support stops being valid between two formations, the crossing is
+located by grid refinement and the object either continues on a neighbouring taut set, on a
+nearby stable FK state, or rolls (steepest descent, :mod:`._descent`) to another minimum.
+
+Hooks for a prepared FK solver: every per-step solve goes through :func:`solve_taut_sets`
+(the kernel's fixed-set Lagrange solve) and every full forward-kinematics call through
+:func:`fk_stable` .
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+import numpy as np
+from scipy.optimize import linprog
+
+from ._descent import descend
+from ._kernel import (CURVATURE_TOL, TAUT_TOL, WEIGHT_TOL, Frame, height_ok,
+                      reduced_hessian_min_eig, solve_candidates, taut_masks)
+from ._tol_motion import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL,
+                          EVENT_STEP_TOL, SUBSETS_UP_TO, SUPPORT_RANK_RTOL)
+from .fk import forward_kinematics, forward_kinematics_batch
+from .model import Sheet
+from ._sim_results import EventKind, SimulationEvent
+from .results import Equilibrium, FKResult
+
+__all__ = ["State", "Tracker", "solve_taut_sets", "branch", "fk_result", "fk_stable",
+           "fk_stable_batch", "from_equilibrium", "nearest", "resolve_step", "make_event",
+           "members"]
+
+_J = np.array([1.0, 1.0, -1.0, -1.0])
+FKMethod = Literal["fast", "exhaustive", "subsets"]
+
+
+@dataclass
+class State:
+    """Object state; ``support`` (3..5 cables, affinely independent lifted points, the
+    set that is re-solved along the branch) is a subset of ``taut`` (the exact maximiser
+    set, reported; larger only at degenerate states such as all-taut IK formations)."""
+
+    support: tuple[int, ...]
+    taut: tuple[int, ...]
+    ro: np.ndarray
+    vo: np.ndarray
+    z: float
+    w: np.ndarray                          # (N,)
+
+    @property
+    def point(self) -> np.ndarray:
+        """(r_o, v_o, z_o), shape (5,)."""
+        return np.concatenate([self.ro, self.vo, [self.z]])
+
+
+def _support(sheet: Sheet, R: np.ndarray, z: float, e: Equilibrium) -> tuple[int, ...]:
+    """A subset of the taut set to follow: at most 5 cables whose lifted points are
+    affinely independent and span the same face, carrying non-negative weights for the
+    same state (a basic solution of the weight equations, Caratheodory), so that solving
+    it reproduces the state."""
+    T = np.array(e.taut, dtype=np.intp)
+    frame = Frame.build(sheet.vertices, R[None], z, sheet.size)
+    P = frame.P[0, T]
+
+    def rank(rows: np.ndarray) -> int:
+        if len(rows) < 2:
+            return len(rows)
+        sv = np.linalg.svd(P[rows[1:]] - P[rows[:1]], compute_uv=False)
+        return 1 + int(np.sum(sv > SUPPORT_RANK_RTOL * max(1.0, sv[0])))
+
+    everything = np.arange(len(T))
+    full = rank(everything)
+    if len(T) <= 5 and full == len(T):
+        return tuple(int(i) for i in T)
+    E = np.vstack([np.ones(len(T)), frame.R[0, T].T, frame.V[T].T])
+    lp = linprog(-np.asarray(e.weights), A_eq=E, b_eq=E @ e.weights,
+                 bounds=[(0, None)] * len(T), method="highs-ds")
+    w = lp.x if lp.success else np.asarray(e.weights)
+    chosen: list[int] = []
+    for i in np.argsort(-w):
+        if len(chosen) == full:
+            break
+        if rank(np.array(chosen + [int(i)])) == len(chosen) + 1:
+            chosen.append(int(i))
+    return tuple(sorted(int(T[i]) for i in chosen))
+
+
+def from_equilibrium(e: Equilibrium, sheet: Sheet, R: np.ndarray, z: float) -> State:
+    """The tracker's state for the FK equilibrium ``e`` of formation ``R``."""
+    w = np.zeros(sheet.n)
+    w[list(e.taut)] = e.weights
+    return State(_support(sheet, R, z, e), e.taut, e.object[:2].copy(), e.contact.copy(),
+                 float(e.object[2]), w)
+
+
+#: valid (M,), ro (M, 2), vo (M, 2), zo (M,), w (M, N), exact taut sets (M, N).
+SetSolution = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def solve_taut_sets(sheet: Sheet, R: np.ndarray, z: float, form: np.ndarray,
+                    idx: np.ndarray) -> SetSolution:
+    """Solve taut sets ``idx`` (M, 5), padded with -1, 3..5 cables each, on formations
+    ``R[form]`` (R (B, N, 2)), with the tests of :func:`forward_kinematics`.
+
+    Returns valid (M,), ro (M, 2), vo (M, 2), zo (M,), w (M, N) in world units, and the
+    exact taut sets (M, N) (NaN/0/False on rows whose system is singular)."""
+    M, N = len(form), R.shape[1]
+    frame = Frame.build(sheet.vertices, R, z, sheet.size)
+    sol = solve_candidates(frame, form, idx, independent=True)
+    valid = np.zeros(M, dtype=bool)
+    ro = np.full((M, 2), np.nan)
+    vo = np.full((M, 2), np.nan)
+    zo = np.full(M, np.nan)
+    w = np.zeros((M, N))
+    tight = np.zeros((M, N), dtype=bool)
+    if len(sol.form) == 0:
+        return valid, ro, vo, zo, w, tight
+    ok = height_ok(frame, sol)
+    ok_taut, tight_sol = taut_masks(frame, sol)
+    members = sol.subset >= 0
+    ok &= ok_taut & (np.where(members, sol.w, np.inf).min(axis=1) >= -WEIGHT_TOL)
+    ok &= reduced_hessian_min_eig(frame, sol.form, sol.subset) > CURVATURE_TOL
+    src, f = sol.source, sol.form
+    valid[src] = ok
+    ro[src] = sol.ro * frame.scale + frame.r_centre[f]
+    vo[src] = sol.vo * frame.scale + frame.v_centre
+    zo[src] = z - np.sqrt(np.maximum(sol.depth2, 0.0)) * frame.scale
+    rows, slots = np.nonzero(members)
+    w[src[rows], sol.subset[rows, slots]] = sol.w[rows, slots]
+    tight[src] = tight_sol
+    return valid, ro, vo, zo, w, tight
+
+
+def _tangent_min_eig(D: np.ndarray) -> float:
+    """Smallest eigenvalue of diag(1,1,-1,-1) on the null space of the rows D (k-1, 4),
+    k = 3 or 4 affinely independent members (docs/sheet_kinematics.md §5)."""
+    _, _, vt = np.linalg.svd(D, full_matrices=True)
+    Z = vt[len(D):]
+    return float(np.linalg.eigvalsh((Z * _J) @ Z.T)[0])
+
+
+def solve_support_one(Xv: np.ndarray, v_centre: np.ndarray, size: float, z: float,
+                      R: np.ndarray, support: tuple[int, ...]
+                      ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, np.ndarray] | None:
+    """One formation R (N, 2), one support (3..5 cables): the kernel's Lagrange solve and
+    its tests (real depth above the ground, every cable admissible, weights >= 0, reduced
+    Hessian positive; docs/sheet_kinematics.md §1-§5) without batching.
+
+    ``Xv`` (N, 2) are the vertices centred at ``v_centre`` and divided by ``size``.
+    Returns ro (2,), vo (2,), zo, w (N,), exact taut mask (N,) in world units, or None
+    when the support does not give a stable state."""
+    S = list(support)
+    k = len(S)
+    r_centre = R.mean(axis=0)
+    Xr = (R - r_centre) / size
+    b = (Xr * Xr).sum(axis=1) - (Xv * Xv).sum(axis=1)
+    rs, vs = Xr[S], Xv[S]
+    K = np.ones((k + 1, k + 1))
+    K[:k, :k] = 2.0 * (rs @ rs.T - vs @ vs.T)
+    K[k, k] = 0.0
+    rhs = np.append(b[S], 1.0)
+    try:
+        sol = np.linalg.solve(K, rhs)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.abs(sol) < 1e9):
+        return None
+    w, mu = sol[:k], sol[k]
+    x = np.concatenate([w @ rs, w @ vs])
+    depth2 = -(x[0] * x[0] + x[1] * x[1] - x[2] * x[2] - x[3] * x[3] + mu)
+    zn = z / size
+    if not (depth2 > TAUT_TOL and depth2 < zn * zn) or w.min() < -WEIGHT_TOL:
+        return None
+    excess = (-2.0 * Xr) @ x[:2] + (2.0 * Xv) @ x[2:] + b - mu
+    if excess.max() > TAUT_TOL:
+        return None
+    if k < 5:
+        A = np.hstack([-2.0 * rs, 2.0 * vs])
+        if not _tangent_min_eig(A[1:] - A[:1]) > CURVATURE_TOL:
+            return None
+    w_full = np.zeros(len(Xv))
+    w_full[S] = w
+    return (x[:2] * size + r_centre, x[2:] * size + v_centre,
+            float(z - np.sqrt(max(depth2, 0.0)) * size), w_full, excess >= -TAUT_TOL)
+
+
+def members(mask_or_idx: np.ndarray) -> tuple[int, ...]:
+    a = np.asarray(mask_or_idx)
+    idx = np.flatnonzero(a) if a.dtype == bool else a
+    return tuple(sorted(int(i) for i in idx))
+
+
+def branch(sheet: Sheet, R: np.ndarray, z: float, taut: tuple[int, ...]) -> SetSolution:
+    """One taut set (3..5 cables) on every formation of ``R`` (C, N, 2); see
+    :func:`solve_taut_sets`."""
+    C = R.shape[0]
+    idx = np.full((C, 5), -1, dtype=np.intp)
+    idx[:, :len(taut)] = taut
+    return solve_taut_sets(sheet, R, z, np.arange(C), idx)
+
+
+def _neighbour_sets(taut: tuple[int, ...], N: int) -> np.ndarray:
+    """Taut sets one cable away from ``taut`` (drop one, add one, or swap one), 3..5
+    cables, as rows padded with -1: the candidates for a continuous taut-set change."""
+    cur = set(taut)
+    out = []
+    for i in taut:
+        if len(cur) - 1 >= 3:
+            out.append(sorted(cur - {i}))
+    others = [j for j in range(N) if j not in cur]
+    for j in others:
+        if len(cur) + 1 <= 5:
+            out.append(sorted(cur | {j}))
+        for i in taut:
+            if len(cur) >= 3:
+                out.append(sorted((cur - {i}) | {j}))
+    idx = np.full((len(out), 5), -1, dtype=np.intp)
+    for k, row in enumerate(out):
+        idx[k, :len(row)] = row
+    return idx
+
+
+def nearest(stable: tuple[Equilibrium, ...], point: np.ndarray) -> tuple[int, float]:
+    """Index and distance of the state nearest to ``point`` = (r_o, v_o, z_o) (5,)."""
+    pts = np.array([np.concatenate([e.object[:2], e.contact, [e.object[2]]]) for e in stable])
+    d = np.linalg.norm(pts - point, axis=1)
+    j = int(np.argmin(d))
+    return j, float(d[j])
+
+
+class Tracker:
+    """Follows the object's branch on one sheet at one hold height (module docstring).
+
+    ``single_fast`` switches the one-formation re-solve of :meth:`valid_at` to
+    :func:`solve_support_one` (same tests, no batching overhead; used by the stepping
+    :class:`Simulator`)."""
+
+    def __init__(self, sheet: Sheet, z: float, *, single_fast: bool = False):
+        self.sheet, self.z = sheet, z
+        self.N = sheet.n
+        self.single_fast = single_fast
+        self._v_centre = sheet.vertices.mean(axis=0)
+        self._Xv = (sheet.vertices - self._v_centre) / sheet.size
+
+    def trackable(self, state: State) -> bool:
+        return 3 <= len(state.support) <= 5
+
+    def valid_at(self, state: State, R: np.ndarray) -> tuple[bool, State | None]:
+        if not self.trackable(state):
+            return False, None
+        if self.single_fast:
+            one = solve_support_one(self._Xv, self._v_centre, self.sheet.size, self.z, R,
+                                    state.support)
+            if one is None:
+                return False, None
+            ro1, vo1, zo1, w1, tight1 = one
+            return True, State(state.support, members(tight1), ro1, vo1, zo1, w1)
+        valid, ro, vo, zo, w, tight = branch(self.sheet, R[None], self.z, state.support)
+        if not valid[0]:
+            return False, None
+        return True, State(state.support, members(tight[0]), ro[0], vo[0], float(zo[0]),
+                            w[0])
+
+    def crossing(self, state: State, R0: np.ndarray, R1: np.ndarray, s0: float
+                 ) -> tuple[float, float, State]:
+        """Last valid fraction s_lo (with its state) and first invalid s_hi > s_lo."""
+        lo, hi, at_lo = s0, 1.0, state
+        while hi - lo > EVENT_STEP_TOL:
+            s = np.linspace(lo, hi, 18)[1:-1]
+            R = (1 - s)[:, None, None] * R0 + s[:, None, None] * R1
+            valid, ro, vo, zo, w, tight = branch(self.sheet, R, self.z, state.support)
+            bad = np.flatnonzero(~valid)
+            k = int(bad[0]) if len(bad) else len(s)
+            if k > 0:
+                lo = float(s[k - 1])
+                at_lo = State(state.support, members(tight[k - 1]), ro[k - 1], vo[k - 1],
+                               float(zo[k - 1]), w[k - 1])
+            if k < len(s):
+                hi = float(s[k])
+        return lo, hi, at_lo
+
+    def stable_states(self, R: np.ndarray) -> tuple[Equilibrium, ...]:
+        """Stable FK states of one formation. Events happen at degenerate places (just
+        past a taut-set change, or leaving an all-taut IK formation) where the hull-based
+        method can miss states, so small teams use the complete 'subsets' method and
+        larger ones fall back to it when 'fast' finds none."""
+        method: FKMethod = "subsets" if self.N <= SUBSETS_UP_TO else "fast"
+        stable = fk_stable(self.sheet, R, self.z, method)
+        if not stable and method == "fast":
+            stable = fk_stable(self.sheet, R, self.z, "subsets")
+        return stable
+
+    def _neighbour_continuation(self, R: np.ndarray, before: State, cont_tol: float
+                                ) -> State | None:
+        """The state on a taut set one cable away from ``before``'s support within
+        ``cont_tol`` of it (no FK call, exact at transitions where forward kinematics'
+        tolerance-based taut sets are ambiguous)."""
+        if not self.trackable(before):
+            return None
+        idx = _neighbour_sets(before.support, self.N)
+        if not len(idx):
+            return None
+        valid, ro, vo, zo, w, tight = solve_taut_sets(self.sheet, R[None], self.z,
+                                                      np.zeros(len(idx), np.intp), idx)
+        pts = np.column_stack([ro, vo, zo])
+        dist = np.where(valid, np.linalg.norm(pts - before.point, axis=1), np.inf)
+        k = int(np.argmin(dist))
+        if dist[k] > cont_tol:
+            return None
+        return State(members(idx[k][idx[k] >= 0]), members(tight[k]), ro[k], vo[k],
+                     float(zo[k]), w[k])
+
+    def settle(self, R: np.ndarray, before: State, cont_tol: float
+               ) -> tuple[State | None, EventKind | None]:
+        """State at formation ``R`` reached from ``before`` (continuation or descent).
+
+        A continuation is tried first among the taut sets one cable away from the
+        current one, then among FK's stable states; failing both, the object rolls
+        (:meth:`roll`)."""
+        new = self._neighbour_continuation(R, before, cont_tol)
+        stable: tuple[Equilibrium, ...] = ()
+        if new is None:
+            stable = self.stable_states(R)
+            if stable:
+                j, dist = nearest(stable, before.point)
+                if dist <= cont_tol:
+                    new = from_equilibrium(stable[j], self.sheet, R, self.z)
+        if new is not None:
+            return new, ("taut_change" if new.taut != before.taut else None)
+        return self.roll(R, before, stable)
+
+    def roll(self, R: np.ndarray, before: State, stable: tuple[Equilibrium, ...]
+             ) -> tuple[State | None, EventKind]:
+        """The branch ended: steepest descent from ``before``, then the descent's end
+        point's active set (or the nearest of the ``stable`` FK states)."""
+        size = self.sheet.size
+        frame = Frame.build(self.sheet.vertices, R[None], self.z, size)
+        P = frame.P[0]
+
+        def to_world(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return x[:2] * size + frame.r_centre[0], x[2:] * size + frame.v_centre
+
+        def arrive(active: np.ndarray, x: np.ndarray) -> State | None:
+            if not 3 <= len(active) <= 5:
+                return None
+            idx = np.full((1, 5), -1, dtype=np.intp)
+            idx[0, :len(active)] = active
+            valid, ro, vo, zo, w, tight = solve_taut_sets(self.sheet, R[None], self.z,
+                                                          np.zeros(1, np.intp), idx)
+            ro_x, vo_x = to_world(x)
+            near = np.linalg.norm(np.r_[ro[0] - ro_x, vo[0] - vo_x]) <= ARRIVAL_RTOL * size
+            if not (valid[0] and near):
+                return None
+            return State(members(active), members(tight[0]), ro[0], vo[0], float(zo[0]),
+                         w[0])
+
+        x0 = np.concatenate([(before.ro - frame.r_centre[0]) / size,
+                             (before.vo - frame.v_centre) / size])
+        out = descend(P, x0, arrive, -frame.z ** 2, active_tol=ARRIVAL_ACTIVE_TOL)
+        if isinstance(out, State):
+            return out, "jump"
+        if out is None:
+            return None, "lost"
+        vals = out @ (_J * out) + P[:, :4] @ out + P[:, 4]
+        ro, vo = to_world(out)
+        zo = self.z - np.sqrt(max(-float(vals.max()), 0.0)) * size
+        if not stable:
+            return None, "lost"
+        j, _ = nearest(stable, np.concatenate([ro, vo, [zo]]))
+        return from_equilibrium(stable[j], self.sheet, R, self.z), "jump"
+
+
+def make_event(step: int, frac: float, kind: EventKind, a: State | None, b: State | None
+               ) -> SimulationEvent:
+    """The event ``kind`` at ``step`` (fraction ``frac``) from state ``a`` to ``b``."""
+    nan3 = np.full(3, np.nan)
+    pa = nan3 if a is None else np.array([*a.ro, a.z])
+    pb = nan3 if b is None else np.array([*b.ro, b.z])
+    return SimulationEvent(step, frac, kind, () if a is None else a.taut,
+                           () if b is None else b.taut, pa, pb, float(pa[2] - pb[2]))
+
+
+def resolve_step(tracker: Tracker, state: State, R0: np.ndarray, R1: np.ndarray,
+                 step: int, motion: float, events: list[SimulationEvent],
+                 crossings: dict[int, tuple[float, np.ndarray]]) -> State | None:
+    """Follow the object from formation R0 (valid ``state``) to R1 through events."""
+    size = tracker.sheet.size
+    if motion == 0.0:
+        return state
+    s0 = 0.0
+    for _ in range(25):
+        ok, at_end = tracker.valid_at(state, R1)
+        if ok:
+            return at_end
+        if tracker.trackable(state):
+            lo, hi, before = tracker.crossing(state, R0, R1, s0)
+        else:                                   # degenerate (>5 taut): leave it at once
+            lo, hi, before = s0, min(1.0, s0 + 1e-6), state
+        Rh = (1 - hi) * R0 + hi * R1
+        if tracker.trackable(before) and branch(tracker.sheet, Rh[None], tracker.z,
+                                                 before.support)[3][0] <= 0.0:
+            events.append(make_event(step, hi, "lost", before, None))     # on the ground
+            return None
+        cont_tol = CONTINUATION_RTOL * size + 100.0 * (hi - lo) * motion
+        new, kind = tracker.settle(Rh, before, cont_tol)
+        if kind is not None:
+            if kind == "taut_change":
+                crossings.setdefault(step, (hi, np.array([*before.ro, before.z])))
+            else:
+                events.append(make_event(step, hi, kind, before, new))
+        if new is None:
+            return None
+        state, s0 = new, hi
+        if s0 >= 1.0:
+            return state
+    stable = fk_stable(tracker.sheet, R1, tracker.z, "fast")  # pragma: no cover - safeguard
+    if not stable:                                            # pragma: no cover
+        events.append(make_event(step, 1.0, "lost", state, None))
+        return None
+    j, _ = nearest(stable, state.point)                       # pragma: no cover
+    return from_equilibrium(stable[j], tracker.sheet, R1, tracker.z)  # pragma: no cover
+
+
+# ------------------------------------------------------------------ forward-kinematics hooks
+# The only places simulation calls full forward kinematics (a prepared FK solver for the
+# fixed sheet and hold height can replace these three bodies).
+
+def fk_result(sheet: Sheet, R: np.ndarray, z: float, method: FKMethod = "fast") -> FKResult:
+    """Forward kinematics of one formation R (N, 2)."""
+    return forward_kinematics(sheet, R, z, method=method)
+
+
+def fk_stable(sheet: Sheet, R: np.ndarray, z: float, method: FKMethod = "fast"
+              ) -> tuple[Equilibrium, ...]:
+    """Stable equilibria of one formation R (N, 2)."""
+    return fk_result(sheet, R, z, method).stable
+
+
+def fk_stable_batch(sheet: Sheet, R: np.ndarray, z: float) -> np.ndarray:
+    """Bool (B,): formation ``R[b]`` (B, N, 2) has a stable equilibrium."""
+    return np.asarray(forward_kinematics_batch(sheet, R, z).stable.any(axis=1))
