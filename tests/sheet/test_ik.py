@@ -316,8 +316,15 @@ def test_result_convention_and_budget():
     V, F = BOUNDARY_SHEET, BOUNDARY_FORMATION
     e = [q for q in forward_kinematics(Sheet(V), F, 1.0).stable if len(q.taut) == 5][0]
     r = inverse_kinematics(Sheet(V), e.object, 1.0, contact=e.contact, budget=0)
-    assert (r.success, r.status, r.certificate) == (False, "budget_exhausted", None)
-    assert "multi-start" in r.message and np.all(np.isnan(r.formation))
+    # Without the multi-start search the answer is a verified formation (the joint
+    # optimisation may reach the pair at its limit) or budget_exhausted, never unreachable.
+    if r.success:
+        res = forward_kinematics(Sheet(V), r.formation, 1.0)
+        assert any(q.status == "stable" and len(q.taut) == 5 and
+                   np.allclose(q.object, e.object, atol=1e-6) for q in res.equilibria)
+    else:
+        assert (r.status, r.certificate) == ("budget_exhausted", None)
+        assert "multi-start" in r.message and np.all(np.isnan(r.formation))
     with pytest.raises(InvalidInputError):
         inverse_kinematics(sheet, [0, 0, 0.5], 1.0, budget=-1)
 
