@@ -190,9 +190,21 @@ def _unwrap(path: np.ndarray) -> np.ndarray:
 
 
 def shortcut(checker: PoseChecker, path: np.ndarray, rng: np.random.Generator,
-             rounds: int = 60) -> np.ndarray:
+             rounds: int = 60, passes: int = 3) -> np.ndarray:
     """Shorten ``path`` by replacing sub-paths with straight SE(2) motions where valid:
-    a greedy pass from the start, then ``rounds`` random pairs."""
+    a greedy pass from the start, then ``rounds`` random pairs; repeated ``passes`` times
+    on the path with its edge midpoints added (so corners can be cut partway)."""
+    p = _shortcut_once(checker, path, rng, rounds)
+    for _ in range(passes - 1):
+        mid = (p[:-1] + p[1:]) / 2
+        dense = np.empty((len(p) + len(mid), 3))
+        dense[0::2], dense[1::2] = p, mid
+        p = _shortcut_once(checker, dense, rng, rounds)
+    return p
+
+
+def _shortcut_once(checker: PoseChecker, path: np.ndarray, rng: np.random.Generator,
+                   rounds: int) -> np.ndarray:
     p = _unwrap(path)
     out = [p[0]]
     i = 0

@@ -152,20 +152,35 @@ class _Runner:
             self.out.notes.append(f"{label}: the path found failed verification")
         return False
 
-    def pair(self, fa: Formation, fb: Formation) -> None:
+    def ends(self, f: Formation) -> tuple[np.ndarray, np.ndarray]:
+        c = self.checker(f)
+        if not hasattr(c, "ends"):
+            c.ends = (valid_headings(c, self.sc.start), valid_headings(c, self.sc.goal))
+        return c.ends
+
+    def pair(self, fa: Formation, fb: Formation, iterations: int | None = None) -> None:
         ca, cb = self.checker(fa), self.checker(fb)
-        starts, goals = valid_headings(ca, self.sc.start), valid_headings(cb, self.sc.goal)
+        starts, goals = self.ends(fa)[0], self.ends(fb)[1]
         if not len(starts) or not len(goals):
             return
         mids = _reform_states(self.sc, ca, cb, self.rng, self.budget.reform_samples)
-        for _ in range(4):
+        for attempt in range(4):
             if not len(mids) or self.left() <= 0:
                 return
-            first, k = self.search(ca, starts, mids)
-            if first is None:
-                return
-            second, _ = self.search(cb, first[-1:], goals)
-            if second is not None:
+            # Alternately: from the goal side first (the mid must reach the goal in B),
+            # or from the start side first.
+            if attempt % 2 == 0:
+                back, k = self.search(cb, goals, mids, iterations)
+                if back is None:
+                    return
+                second = back[::-1]
+                first, _ = self.search(ca, starts, second[:1], iterations)
+            else:
+                first, k = self.search(ca, starts, mids, iterations)
+                if first is None:
+                    return
+                second, _ = self.search(cb, first[-1:], goals, iterations)
+            if first is not None and second is not None:
                 pieces = [Piece(fa, first), Piece(fa, first[-1:], fb), Piece(fb, second)]
                 if self.accept(pieces):
                     self.out.candidates.append(pieces)
@@ -180,19 +195,28 @@ def search_se2(scenario: Scenario, formations: list[Formation], *, allow_crossin
     ordered pair with one formation change; returns every candidate found that
     ``accept`` (the verification) accepts."""
     run = _Runner(scenario, budget, allow_crossing, accept)
-    # A quick round over every formation, then the full budget for those still open.
     quick = max(1, budget.iterations // 5)
+    pairs = []
+    if reform:
+        ends = {id(f): tuple(len(e) > 0 for e in run.ends(f)) for f in formations}
+        pairs = [(a, b) for a in formations for b in formations
+                 if a is not b and ends[id(a)][0] and ends[id(b)][1]]
+        # First the pairs whose formations cannot do it alone (no goal / no start room).
+        pairs.sort(key=lambda p: (ends[id(p[0])][1], ends[id(p[1])][0]))
+    # Rounds: quick singles, quick pairs, full singles, full pairs; stop at the first
+    # round that finds a verified plan.
     retry = [f for f in formations if run.left() > 0 and run.single(f, quick)]
-    if not run.out.candidates:
-        for f in retry:
-            if run.left() <= 0:
-                break
-            run.single(f)
-    if reform and not run.out.candidates and len(formations) > 1:
-        for fa in formations:
-            for fb in formations:
-                if fa is not fb and run.left() > 0:
-                    run.pair(fa, fb)
+    for stage in ("quick pairs", "singles", "pairs"):
+        if run.out.candidates or run.left() <= 0:
+            break
+        if stage == "singles":
+            for f in retry:
+                if run.left() > 0:
+                    run.single(f)
+            continue
+        for a, b in pairs:
+            if run.left() > 0:
+                run.pair(a, b, quick if stage == "quick pairs" else None)
     if run.left() <= 0:
         run.out.timed_out = True
     return run.out

@@ -23,6 +23,7 @@ the compact formation only (same search, same budget); ``"disc"`` the disc-model
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import replace
 from typing import Literal
@@ -75,8 +76,10 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
     world, team = scenario.world, scenario.team
     compact = compact_formation(scenario, sheet_margin)
     crossing, notes = [], []
-    narrow = optimal_formation(team, kind="narrow", width=world.width,
-                               sheet_margin=sheet_margin)
+    # A triangle's narrowest stable formation is its compact one.
+    narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
+                                                        width=world.width,
+                                                        sheet_margin=sheet_margin)
     if narrow is not None and _min_width(narrow) < _min_width(compact) - 0.01:
         crossing.append(narrow)
     for h in _height_classes(scenario):
@@ -97,6 +100,15 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
 
 
 Library = tuple[Formation, list[Formation], list[str]]
+
+
+@functools.lru_cache(maxsize=32)
+def _library(scenario: Scenario, sheet_margin: float
+             ) -> tuple[Formation, tuple[Formation, ...], tuple[str, ...]]:
+    """:func:`formation_library`, memoised per scenario object (the optimisations of
+    eqs. 11-15 dominate a plan's time; baselines and re-plans reuse them)."""
+    compact, others, notes = formation_library(scenario, sheet_margin)
+    return compact, tuple(others), tuple(notes)
 
 
 def _min_width(f: Formation) -> float:
@@ -256,10 +268,11 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     margin = float(sheet_margin)
     budget = SearchBudget(iterations=int(iterations), time_budget=float(time_budget),
                           seed=int(seed))
+    cached = _library(scenario, margin)
+    lib: Library = (cached[0], list(cached[1]), list(cached[2]))
     if baseline == "disc":
-        return attempt(scenario, compact_formation(scenario, margin), allow_crossing=False,
-                       planner="disc", sheet_margin=margin)
-    lib = formation_library(scenario, margin)
+        return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
+                       sheet_margin=margin)
     if baseline:
         return _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=budget,
                     planner="se2-bypass", library=lib)
