@@ -84,7 +84,7 @@ def plan_command(
     if result.success:
         typer.echo(f"plan: {len(result.times)} samples, {result.duration:.2f} s, path "
                    f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}], "
-                   f"object at {result.formation.object_height:.3f} m")
+                   f"object at {result.object[:, 2].max():.3f} m")
         return 0
     typer.echo(f"no plan ({result.status}): {result.message}")
     return 1

@@ -113,6 +113,7 @@ class _Runner:
         self.t0 = time.perf_counter()
         self.out = SE2Search()
         self.checkers: dict[int, PoseChecker] = {}
+        self._ends: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def left(self) -> float:
         return self.budget.time_budget - (time.perf_counter() - self.t0)
@@ -153,10 +154,12 @@ class _Runner:
         return False
 
     def ends(self, f: Formation) -> tuple[np.ndarray, np.ndarray]:
-        c = self.checker(f)
-        if not hasattr(c, "ends"):
-            c.ends = (valid_headings(c, self.sc.start), valid_headings(c, self.sc.goal))
-        return c.ends
+        """Valid start and goal states of ``f`` (memoised)."""
+        if id(f) not in self._ends:
+            c = self.checker(f)
+            self._ends[id(f)] = (valid_headings(c, self.sc.start),
+                                 valid_headings(c, self.sc.goal))
+        return self._ends[id(f)]
 
     def pair(self, fa: Formation, fb: Formation, iterations: int | None = None) -> None:
         ca, cb = self.checker(fa), self.checker(fb)

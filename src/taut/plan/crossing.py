@@ -212,6 +212,7 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
         forms, legs, first = formation.formations, formation.legs, formation.first
     else:
         forms, first = (formation,), 0
+    legs = legs or ()
     team = scenario.team
     b = _Builder(forms[first], team.speed, team.rotation_speed, scenario.start)
     records = []
@@ -223,7 +224,7 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
             b.translate(leg.end)
             continue
         f = b.f
-        o = scenario.world.obstacle(leg.obstacle)
+        o = scenario.world.obstacle(str(leg.obstacle))
         u = leg.end - leg.start
         du = float(np.arctan2(u[1], u[0]))
         if leg.heading is not None:                         # straight offset crossing

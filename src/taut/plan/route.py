@@ -108,7 +108,7 @@ class Route:
 
     @property
     def crossed(self) -> tuple[str, ...]:
-        return tuple(leg.obstacle for leg in self.legs if leg.kind == "cross")
+        return tuple(str(leg.obstacle) for leg in self.legs if leg.kind == "cross")
 
 
 def crossable(scenario: Scenario, formation: Formation, obstacle: Obstacle, *,
@@ -346,7 +346,7 @@ def _legs(path: list[int], layers: list[_Layer], offsets: np.ndarray
         if ka != kb:
             legs.append(Leg("reform", pa, pb, None, kb))
             continue
-        oid, phi = crossing.get((a, b), (None, None))
+        oid, phi = crossing.get((a, b), (None, None))  # type: ignore[assignment]
         legs.append(Leg("cross" if oid is not None else "move", pa, pb, oid, ka, phi))
     return tuple(legs), where(path[0])[0]
 

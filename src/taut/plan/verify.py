@@ -147,7 +147,9 @@ def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
     fk0 = forward_kinematics(team.sheet, robots[0], team.hold_height)
     if not fk0.stable:
         return None, (), 0.0, "no stable rest state at the first sample"
-    guess = planned[0] if np.all(np.isfinite(planned[0])) else fk0.lowest.object
+    lowest = fk0.lowest
+    assert lowest is not None                     # fk0.stable is not empty
+    guess = planned[0] if np.all(np.isfinite(planned[0])) else lowest.object
     e0 = min(fk0.stable, key=lambda e: float(np.linalg.norm(e.object - guess)))
     obj = np.full((T, 3), np.nan)
     taut: list[tuple[int, ...]] = [()] * T
