@@ -115,8 +115,8 @@ def _extend(tree: _Tree, q: np.ndarray, checker: PoseChecker, step: float, greed
 
 def rrt_connect(checker: PoseChecker, starts: np.ndarray, goals: np.ndarray, *,
                 bounds: np.ndarray, rng: np.random.Generator, iterations: int = 4000,
-                step: float = 0.3, time_limit: float = np.inf, passage_bias: float = 0.3
-                ) -> SearchOutcome:
+                step: float = 0.3, time_limit: float = np.inf, passage_bias: float = 0.3,
+                free_bias: float = 0.5) -> SearchOutcome:
     """Bidirectional RRT from any of ``starts`` to any of ``goals`` (both ``(K, 3)``,
     assumed valid).
 
@@ -136,6 +136,9 @@ def rrt_connect(checker: PoseChecker, starts: np.ndarray, goals: np.ndarray, *,
     passage_bias : float
         Probability that a sample puts a crossable obstacle under the sheet, clear of the
         robots (:meth:`PoseChecker.passage_sample`); such samples are connected greedily.
+    free_bias : float
+        Probability that a sample is drawn in the free part of a heading slice
+        (:meth:`PoseChecker.free_sample`; the rest are uniform in ``bounds``).
 
     Returns
     -------
@@ -160,8 +163,11 @@ def rrt_connect(checker: PoseChecker, starts: np.ndarray, goals: np.ndarray, *,
     for it in range(1, iterations + 1):
         if time.perf_counter() - t0 > time_limit:
             return SearchOutcome(None, it, True)
-        q = checker.passage_sample(rng) if rng.random() < passage_bias else None
+        u = rng.random()
+        q = checker.passage_sample(rng) if u < passage_bias else None
         greedy = q is not None
+        if q is None and u < passage_bias + free_bias:
+            q = checker.free_sample(rng)
         if q is None:
             q = np.array([*rng.uniform(lo, hi), rng.uniform(-np.pi, np.pi)])
         if not checker.valid(q[None])[0]:

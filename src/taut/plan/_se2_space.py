@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+import shapely.affinity
 from shapely.ops import unary_union
 
 from . import _tol
@@ -33,7 +34,10 @@ from shapely.geometry.polygon import orient
 from .formation import Formation
 from .world import Scenario
 
-__all__ = ["PoseChecker"]
+__all__ = ["PoseChecker", "SLICES"]
+
+#: Heading slices of the free-space sampler.
+SLICES = 72
 
 
 class PoseChecker:
@@ -54,7 +58,7 @@ class PoseChecker:
         world, team = scenario.world, scenario.team
         self.formation = formation
         self.resolution = float(resolution)
-        pad = 0.5 * self.resolution + _tol.INFLATION
+        pad = self.pad = 0.5 * self.resolution + _tol.INFLATION
         c = team.clearance + pad
         robots_free = world.geometry.buffer(-c, quad_segs=16)
         grown = [o.geometry.buffer(c, quad_segs=16) for o in world.obstacles]
@@ -72,6 +76,58 @@ class PoseChecker:
         self.checks = 0
         self._near_sets(scenario, allow_crossing)
         self.passages = self._passages(scenario, c) if allow_crossing else []
+        self._blocked_geoms = [o.geometry for o in world.obstacles
+                               if not allow_crossing
+                               or o.height > formation.max_height + _tol.GEOMETRY_TOL]
+        self._slices: dict[int, object] = {}
+        hull = orient(shapely.convex_hull(shapely.multipoints(formation.robots)), 1.0)
+        self.hull_idx = np.array([int(np.argmin(np.linalg.norm(formation.robots - q, axis=1)))
+                                  for q in np.asarray(hull.exterior.coords)[:-1]])
+        self.headings = 2 * np.pi * np.arange(SLICES) / SLICES - np.pi
+
+    def _slice(self, k: int):
+        """The object positions valid at heading ``headings[k]`` (a shapely geometry):
+        every robot in the robot region, the hull clear of blocked obstacles (Minkowski
+        sums of convex shapes) and of reflex wall vertices."""
+        if k in self._slices:
+            return self._slices[k]
+        psi = float(self.headings[k])
+        d = self.formation.placed(np.zeros(2), psi)
+        region = self.robot_region
+        for off in d:
+            region = region.intersection(shapely.affinity.translate(self.robot_region,
+                                                                    -off[0], -off[1]))
+            if region.is_empty:
+                break
+        hull = d[self.hull_idx]
+        cuts = []
+        for g in self._blocked_geoms:
+            v = np.asarray(shapely.convex_hull(g).exterior.coords)[:-1]
+            cuts.append(shapely.convex_hull(shapely.multipoints(
+                (v[:, None] - hull[None]).reshape(-1, 2))))
+        for v in self.near_c[len(self.near_c) - self._n_reflex:]:
+            cuts.append(shapely.Polygon(v - hull))
+        if cuts and not region.is_empty:
+            region = region.difference(unary_union(cuts).buffer(self.pad + _tol.INFLATION))
+        shapely.prepare(region)
+        self._slices[k] = region
+        return region
+
+    def free_sample(self, rng: np.random.Generator, tries: int = 4) -> np.ndarray | None:
+        """A state sampled in the free part of a random heading slice (narrow corridors
+        are sampled where they are; None when the slice drawn is empty)."""
+        k = int(rng.integers(SLICES))
+        region = self._slice(k)
+        if region.is_empty:
+            return None
+        lo, hi = np.asarray(region.bounds[:2]), np.asarray(region.bounds[2:])
+        for _ in range(tries):
+            p = rng.uniform(lo, hi, (32, 2))
+            inside = shapely.contains_xy(region, p[:, 0], p[:, 1])
+            if inside.any():
+                q = p[int(np.argmax(inside))]
+                return np.array([q[0], q[1], self.headings[k]])
+        return None
 
     def _passages(self, scenario: Scenario, c: float) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per crossable obstacle: its centre and the points of the formation frame where
@@ -120,6 +176,7 @@ class PoseChecker:
                                       reflex])
         self.near_r = np.concatenate([[o.mec_radius for o in blocked], np.zeros(len(reflex))])
         self.near_r = self.near_r + self.radius + 2 * self.resolution
+        self._n_reflex = len(reflex)
 
     def robots(self, states: np.ndarray) -> np.ndarray:
         """Robot positions ``(K, N, 2)`` of states ``(K, 3)``."""
