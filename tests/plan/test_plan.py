@@ -127,7 +127,7 @@ def test_verification_rejects_bad_motions(paper, paper_plan):
 def test_must_bypass_tall_obstacle():
     # Wide hall: the tall box cannot be crossed but there is room beside it.
     sc = corridor([Obstacle("tall", 0.8, center=[3.0, 0.0], radius=0.2)], width=4.0)
-    r = plan(sc)
+    r = plan(sc, time_budget=600)
     assert r.success and r.crossed == () and r.bypassed == ("tall",)
     assert verify_motion(sc, r.robots, r.object).success
     d = np.linalg.norm(r.robots - [3.0, 0.0], axis=2)
@@ -139,7 +139,7 @@ def test_must_bypass_tall_obstacle():
 def test_must_fail_with_reason_blocked_by_tall_obstacle():
     # Gaps of 0.85 m beside the obstacle: a robot fits (no certificate), the team does not.
     sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.15)])
-    r = plan(sc, iterations=200)
+    r = plan(sc, iterations=200, time_budget=600)
     assert not r.success and r.status == "budget_exhausted" and r.certificate is None
     assert "'wall-ish' (0.9 m tall) cannot be crossed" in r.message
     assert "not found within the budget" in r.message
@@ -370,7 +370,7 @@ def test_formation_change_where_needed():
 def test_low_prism_is_crossed():
     box = Obstacle("box", 0.12, polygon=[[2.9, -0.12], [3.1, -0.12], [3.1, 0.08], [2.9, 0.08]])
     sc = corridor([box])
-    r = plan(sc)
+    r = plan(sc, time_budget=600)
     assert r.success and r.crossed == ("box",)
     check = verify_motion(sc, r.robots, r.object)
     assert check.success and check.min_height_margin >= sc.team.height_safety - 1e-9
