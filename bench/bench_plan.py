@@ -154,6 +154,8 @@ def main(argv: list[str] | None = None) -> int:
         x = rows[-1]
         print(f"{x['name']:<18} {x['status']:<17} se2 {x['ok_se2']!s:<5} disc "
               f"{x['ok_disc']!s:<5} {x['plan_time']:.1f} s", flush=True)
+        if args.json is not None:                    # partial results survive a stop
+            args.json.write_text(json.dumps(rows, indent=1, default=float))
     good = report(rows, args.margin_study)
     if args.json is not None:
         args.json.write_text(json.dumps(rows, indent=1, default=float))

@@ -32,7 +32,10 @@ from ._se2_space import PoseChecker
 from .formation import Formation
 from .world import Scenario
 
-__all__ = ["SearchBudget", "SE2Search", "search_se2"]
+__all__ = ["SearchBudget", "SE2Search", "search_se2", "MAX_PAIRS"]
+
+#: Most formation pairs (one formation change) searched.
+MAX_PAIRS = 6
 
 
 @dataclass(frozen=True)
@@ -204,8 +207,10 @@ def search_se2(scenario: Scenario, formations: list[Formation], *, allow_crossin
         ends = {id(f): tuple(len(e) > 0 for e in run.ends(f)) for f in formations}
         pairs = [(a, b) for a in formations for b in formations
                  if a is not b and ends[id(a)][0] and ends[id(b)][1]]
-        # First the pairs whose formations cannot do it alone (no goal / no start room).
+        # First the pairs whose formations cannot do it alone (no goal / no start room);
+        # at most MAX_PAIRS of them.
         pairs.sort(key=lambda p: (ends[id(p[0])][1], ends[id(p[1])][0]))
+        pairs = pairs[:MAX_PAIRS]
     # Rounds: quick singles, quick pairs, full singles, full pairs; stop at the first
     # round that finds a verified plan.
     retry = [f for f in formations if run.left() > 0 and run.single(f, quick)]
