@@ -30,7 +30,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..errors import ScenarioError, TautError
 from ..plan.world import Obstacle, Scenario, Team, World
-from ..sheet.model import Sheet
+from ..sheet import Sheet
 from .files import read_mapping, validate_mapping
 
 __all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]

@@ -45,3 +45,22 @@ DURATION_RTOL = 1e-9
 FORMATION_FEAS_TOL = 1e-7
 #: Forward-kinematics match of an optimised formation (times the sheet size).
 FORMATION_MATCH_RTOL = 1e-6
+#: Floor under squared lengths before a square root or a division (normalised units):
+#: keeps the eq. (10) radial distances and the eq. (14) gap term finite at degenerate
+#: iterates of the optimiser.
+SQUARE_FLOOR = 1e-12
+#: Slack (normalised units) by which every cable must be taut and every pair inside its
+#: sheet distance in the optimiser (strict versions of the constraints of eq. 15c).
+STRICT_SLACK = 1e-6
+#: Least reduced-Hessian curvature accepted as "stable" by the optimiser (normalised).
+MIN_CURVATURE = 1e-4
+#: Crossing segments are extended this fraction of the disc radius beyond tangency (m/m),
+#: so the disc is strictly clear of the crossed obstacle at their ends.
+CROSSING_OVERSHOOT = 1e-6
+#: Reflex vertices are taken from a region grown by this fraction of the disc radius, so
+#: roadmap vertices lie strictly inside the free region.
+VERTEX_INSET = 1e-4
+#: Two roadmap points closer than this are the same point (a formation change), m.
+SAME_POINT = 1e-12
+#: Turns within this of the smallest are equally good (Algorithm 2 side choice), rad.
+TURN_TIE = 1e-9

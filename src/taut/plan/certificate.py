@@ -28,6 +28,7 @@ import numpy as np
 from shapely.geometry import LineString, Point
 from shapely.ops import unary_union
 
+from . import _tol
 from .world import Scenario
 
 __all__ = ["Certificate", "find_certificate"]
@@ -100,7 +101,7 @@ def find_certificate(scenario: Scenario, directions: int = 72) -> Certificate | 
     seg = scenario.goal - scenario.start
     anchors = [o.mec_center for o in tall]
     anchors += [scenario.start + s * seg for s in np.linspace(0.1, 0.9, 17)]
-    along = seg / max(float(np.linalg.norm(seg)), 1e-12)
+    along = seg / max(float(np.linalg.norm(seg)), _tol.SAME_POINT)
     for p in anchors:
         if not scenario.world.geometry.intersects(Point(p)):
             continue

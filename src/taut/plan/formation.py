@@ -52,9 +52,8 @@ from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
 from ..errors import TautError
-from ..sheet.fk import forward_kinematics
-from ..sheet.geometry import formation_metrics
-from ..sheet.ik import ik_constraints, inverse_kinematics
+from ..sheet import (forward_kinematics, formation_metrics, ik_constraints,
+                     inverse_kinematics)
 from . import _tol
 from .world import Team
 
@@ -265,7 +264,7 @@ class _Problem:
         vo, zo, th, w, Rb = self.dec.split(z)
         l2 = np.sum((self.V - vo) ** 2, axis=1)
         d = self.zr - zo
-        rho = np.sqrt(np.maximum(l2 - d * d, 1e-12))
+        rho = np.sqrt(np.maximum(l2 - d * d, _tol.SQUARE_FLOOR))
         r = rho[:, None] * np.column_stack([np.cos(th), np.sin(th)])
         return vo, zo, th, w, Rb, l2, d, rho, r
 
@@ -281,7 +280,7 @@ class _Problem:
             iu, ju = self.pairs
             g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
             jc = (cw.crossing_height * ((zo - self.z_lo) / self.zr) ** 2
-                  + cw.crossing_gap * np.mean(self.sep ** 2 / np.maximum(g2, 1e-12)))
+                  + cw.crossing_gap * np.mean(self.sep ** 2 / np.maximum(g2, _tol.SQUARE_FLOOR)))
         return float(jt + jp + jc)
 
     def equalities(self, z: np.ndarray) -> np.ndarray:
@@ -294,7 +293,7 @@ class _Problem:
         vo, zo, th, w, Rb, l2, d, rho, r = self.geometry(z)
         iu, ju = self.pairs
         g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
-        return np.concatenate([w - MIN_SHARE, l2 - d * d - 1e-6, self.vd2 - g2,
+        return np.concatenate([w - MIN_SHARE, l2 - d * d - _tol.STRICT_SLACK, self.vd2 - g2,
                                g2 - self.sep ** 2,
                                Rb ** 2 - (r[:, 1] ** 2 if self.narrow else rho ** 2),
                                [zo - self.z_lo, self.z_hi - zo, self.r_max - Rb]])
@@ -320,7 +319,7 @@ def _curvature_constraint(team: Team, prob: _Problem, s: float):
         except TautError:
             return np.array([-1.0])
         k = float(np.min(c.curvature))
-        return np.array([-1.0 if np.isnan(k) else min(k, 1.0) - 1e-4])
+        return np.array([-1.0 if np.isnan(k) else min(k, 1.0) - _tol.MIN_CURVATURE])
     return curvature
 
 
@@ -357,7 +356,7 @@ def _problem(team: Team, kind: str, height: float, diameter: float, width: float
     prob = _Problem(V=V, zr=zr / s, z_lo=z_lo, z_hi=z_hi, sep=sep / s,
                     ds=team.side_safety / s, w_ref=(width if width is not None else 4 * s) / s,
                     r_max=1e6 if max_reach is None else (max_reach - team.clearance) / s,
-                    vd2=vd ** 2 * (1 - 1e-6), rho0=start.reach / s, crossing=crossing,
+                    vd2=vd ** 2 * (1 - _tol.STRICT_SLACK), rho0=start.reach / s, crossing=crossing,
                     weights=weights or (COMPACT if kind in ("compact", "narrow")
                                         else CostWeights()),
                     dec=_Decision(N), narrow=kind == "narrow")

@@ -47,7 +47,7 @@ DIRECTIONS = 24
 OFFSETS = 21
 #: Buffer resolution (segments per quarter circle) of the configuration space.
 QUAD_SEGS = 8
-_EPS = 1e-6
+_EPS = _tol.CROSSING_OVERSHOOT
 
 
 @dataclass(frozen=True, eq=False)
@@ -175,7 +175,7 @@ class _Layer:
         self.region = _region(scenario, R)
         shapely.prepare(self.region)
         own = [scenario.start, scenario.goal]
-        own.extend(_vertices(_region(scenario, R + 1e-4 * max(R, 1.0))))
+        own.extend(_vertices(_region(scenario, R + _tol.VERTEX_INSET * max(R, 1.0))))
         # (local in, local out, cost s, obstacle id, world heading of the formation for a
         # straight offset crossing or None for Algorithm 2)
         self.cross: list[tuple[int, int, float, str, float | None]] = []
@@ -313,7 +313,7 @@ def _graph(layers: list[_Layer], forms: list[Formation], speed: float):
             A, B = layers[k].points, layers[j].points
             # Same point in both layers: a formation change there.
             d = np.linalg.norm(A[:, None, :] - B[None, :, :], axis=2)
-            ia, ib = np.nonzero(d <= 1e-12)
+            ia, ib = np.nonzero(d <= _tol.SAME_POINT)
             rows.append(ia + offsets[k])
             cols.append(ib + offsets[j])
             wts.append(np.full(len(ia), reform_time(forms[k], forms[j], speed)))

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import Point, Polygon
 
-from ..sheet.model import Sheet
+from ..sheet import Sheet
 from .formation import optimal_formation
 from .world import Obstacle, Scenario, Team, World
 

@@ -298,7 +298,7 @@ def resample_motion(robots: np.ndarray, planned_object: np.ndarray, factor: int
     robots = np.asarray(robots, dtype=float)
     obj = np.asarray(planned_object, dtype=float)
     T = len(robots)
-    rigid = _rigid_mask(robots, 1e-9 * max(float(np.ptp(robots)), 1.0))
+    rigid = _rigid_mask(robots, _tol.RIGID_RTOL * max(float(np.ptp(robots)), 1.0))
     out_r, out_o = [robots[0]], [obj[0]]
     s = np.arange(1, factor + 1) / factor
     for t in range(T - 1):
