@@ -259,3 +259,22 @@ def test_bad_planner_options(paper):
     assert e.value.field == "sheet_margin"
     with pytest.raises(TautError):
         Team(Sheet.regular(3, 0.5), 0.4, 0.1, 0.05, 0.05, 0.0, 0.3)
+
+
+def test_cli_checks_output_paths_first_and_exits_1_without_plan(tmp_path, capsys):
+    import json
+
+    from .test_plan import _app
+    yaml = str(EXAMPLES / "paper_corridor.yaml")
+    with pytest.raises(TautError) as e:
+        _app()(args=["plan", yaml, "--json", str(tmp_path / "missing" / "p.json")],
+               standalone_mode=False)
+    assert e.value.field == "--json"
+    assert "planning" not in capsys.readouterr().err          # refused before any work
+    out = tmp_path / "p.json"
+    rc = _app()(args=["plan", yaml, "--disc-baseline", "--json", str(out)],
+                standalone_mode=False)
+    captured = capsys.readouterr()
+    data = json.loads(out.read_text())
+    assert rc == 1 and data["status"] == "no_route" and data["planner"] == "disc"
+    assert "no plan (no_route)" in captured.out and "planning" in captured.err
