@@ -207,6 +207,9 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
                        "unverified")
     cap = ("the time budget" if found.timed_out
            else f"{budget.iterations} samples per search")
+    if not tried:
+        tried = "searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
+                                        for f in forms)
     return failure(scenario, f"not found within the budget ({cap}; seed {budget.seed}): "
                    f"{tried}", planner, "budget_exhausted")
 
