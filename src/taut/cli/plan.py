@@ -7,11 +7,16 @@ from typing import Optional
 
 import typer
 
+from .._validate import as_count
+from ..errors import InvalidInputError
 from ..io.serialize import plan_to_dict, to_json
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
 
 __all__ = ["register", "plan_to_dict", "plan_command"]
+
+#: Largest search budget the command accepts, s (one hour).
+MAX_BUDGET_S = 3600.0
 
 
 def plan_command(
@@ -22,12 +27,20 @@ def plan_command(
                                        "this file (.json)."),
     animate: Optional[Path] = typer.Option(None, "--animate", help="Write an animated GIF "
                                            "(.gif)."),
-    baseline: bool = typer.Option(False, "--baseline", help="Bypass-only baseline planner."),
+    baseline: bool = typer.Option(False, "--baseline",
+                                  help="Bypass-only SE(2) baseline (same search, no crossing)."),
+    disc_baseline: bool = typer.Option(False, "--disc-baseline",
+                                       help="Bypass-only disc-model baseline."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write the summary figure "
                                         "(.png, .pdf, .svg)."),
     algorithm2: bool = typer.Option(False, "--algorithm2",
                                     help="Cross only as the paper's Algorithm 2 does (the "
                                          "obstacle passes under the object)."),
+    budget: float = typer.Option(10.0, "--budget", help="Time budget of the search, s."),
+    sheet_margin: float = typer.Option(0.01, "--sheet-margin",
+                                       help="Robot pairs stay this far inside their sheet "
+                                            "distance, m."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the SE(2) search."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
@@ -38,9 +51,19 @@ def plan_command(
     out = output_path(out, "--out", JSON_SUFFIXES)
     plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
+    if not 0 < budget <= MAX_BUDGET_S:
+        raise InvalidInputError("--budget", f"must be in (0, {MAX_BUDGET_S:g}] s, got {budget:g}")
+    if not 0 <= sheet_margin <= 1.0:
+        raise InvalidInputError("--sheet-margin", f"must be in [0, 1] m, got {sheet_margin:g}")
+    as_count(seed, "--seed", minimum=0)
+    if baseline and disc_baseline:
+        raise InvalidInputError("--baseline", "give at most one of --baseline and "
+                                "--disc-baseline")
     sc = load_plan_scenario(scenario)
     with working("plan"):
-        result = plan(sc, baseline=baseline, straight_crossings=not algorithm2)
+        result = plan(sc, baseline="disc" if disc_baseline else baseline,
+                      method="algorithm2" if algorithm2 else "se2", time_budget=budget,
+                      sheet_margin=sheet_margin, seed=seed)
     doc = plan_to_dict(result)
     if out is not None:
         out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")
@@ -53,12 +76,11 @@ def plan_command(
     if as_json:
         typer.echo(to_json(doc))
     elif result.success:
-        height = ("" if result.formation is None else
-                  f", object at {result.formation.object_height:.3f} m")
         typer.echo(f"plan: {len(result.times)} samples, {result.duration:.2f} s, path "
-                   f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}]{height}")
+                   f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}], "
+                   f"object at {result.object[:, 2].max():.3f} m")
     else:
-        typer.echo(f"no plan: {doc['reason']}")
+        typer.echo(f"no plan ({result.status}): {result.message}")
     if not result.success:
         for name, path in (("--plot", plot), ("--animate", animate)):
             if path is not None:

@@ -23,26 +23,25 @@ Schema (lengths in m, times in s, angles in rad; unknown keys are errors)::
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..errors import ScenarioError, TautError
 from ..plan.world import Obstacle, Scenario, Team, World
-from ..sheet.model import Sheet
+from ..sheet import Sheet
 from .files import read_mapping, validate_mapping
 
 __all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]
 
 Point = tuple[float, float]
-_POS = {"gt": 0, "allow_inf_nan": False}
-_NONNEG = {"ge": 0, "allow_inf_nan": False}
 
 
 class _Regular(BaseModel):
     model_config = ConfigDict(extra="forbid")
     n: int = Field(ge=3)
-    circumradius: float = Field(**_POS)
+    circumradius: float = Field(gt=0, allow_inf_nan=False)
     phase: float = Field(default=0.0, allow_inf_nan=False)
 
 
@@ -50,13 +49,13 @@ class _Team(BaseModel):
     model_config = ConfigDict(extra="forbid")
     sheet: list[Point] | None = None
     regular: _Regular | None = None
-    hold_height: float = Field(**_POS)
-    robot_radius: float = Field(**_POS)
-    height_safety: float = Field(**_NONNEG)
-    lateral_safety: float = Field(**_NONNEG)
-    speed: float = Field(**_POS)
-    rotation_speed: float = Field(**_POS)
-    mass: float | None = Field(default=None, **_POS)
+    hold_height: float = Field(gt=0, allow_inf_nan=False)
+    robot_radius: float = Field(gt=0, allow_inf_nan=False)
+    height_safety: float = Field(ge=0, allow_inf_nan=False)
+    lateral_safety: float = Field(ge=0, allow_inf_nan=False)
+    speed: float = Field(gt=0, allow_inf_nan=False)
+    rotation_speed: float = Field(gt=0, allow_inf_nan=False)
+    mass: float | None = Field(default=None, gt=0, allow_inf_nan=False)
 
     @model_validator(mode="after")
     def _one_sheet(self):
@@ -68,9 +67,9 @@ class _Team(BaseModel):
 class _Obstacle(BaseModel):
     model_config = ConfigDict(extra="forbid")
     id: str | int
-    height: float = Field(**_POS)
+    height: float = Field(gt=0, allow_inf_nan=False)
     center: Point | None = None
-    radius: float | None = Field(default=None, **_POS)
+    radius: float | None = Field(default=None, gt=0, allow_inf_nan=False)
     polygon: list[Point] | None = None
 
     @model_validator(mode="after")
@@ -111,7 +110,9 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
         if t.sheet is not None:
             sheet = Sheet(np.array(t.sheet, dtype=float))
         else:
-            sheet = Sheet.regular(t.regular.n, t.regular.circumradius, phase=t.regular.phase)
+            reg = t.regular
+            assert reg is not None                       # checked by _Team._one_sheet
+            sheet = Sheet.regular(reg.n, reg.circumradius, phase=reg.phase)
     except TautError as exc:
         raise ScenarioError("team.sheet", exc.problem) from None
     team = Team(sheet, t.hold_height, t.robot_radius, t.height_safety, t.lateral_safety,
@@ -119,8 +120,10 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
     obstacles = []
     for k, o in enumerate(raw.obstacles):
         try:
-            obstacles.append(Obstacle(str(o.id), o.height, center=o.center, radius=o.radius,
-                                      polygon=o.polygon))
+            obstacles.append(Obstacle(
+                str(o.id), o.height, radius=o.radius,
+                center=None if o.center is None else np.asarray(o.center, dtype=float),
+                polygon=None if o.polygon is None else np.asarray(o.polygon, dtype=float)))
         except TautError as exc:
             raise ScenarioError(f"obstacles[{k}]", exc.problem) from None
     try:
@@ -146,25 +149,27 @@ def plan_scenario_to_mapping(scenario: Scenario) -> dict:
     for o in scenario.world.obstacles:
         item: dict = {"id": o.id, "height": float(o.height)}
         if o.polygon is None:
+            assert o.center is not None and o.radius is not None   # a cylinder
             item.update(center=[float(x) for x in o.center], radius=float(o.radius))
         else:
             item["polygon"] = [[float(x), float(y)] for x, y in o.polygon]
         obstacles.append(item)
-    out = {
+    team_map: dict[str, Any] = {
+        "sheet": [[float(x), float(y)] for x, y in team.sheet.vertices],
+        "hold_height": team.hold_height, "robot_radius": team.robot_radius,
+        "height_safety": team.height_safety, "lateral_safety": team.lateral_safety,
+        "speed": team.speed, "rotation_speed": team.rotation_speed,
+    }
+    if team.mass is not None:
+        team_map["mass"] = team.mass
+    out: dict[str, Any] = {
         "name": scenario.name,
         "free_space": [[float(x), float(y)] for x, y in scenario.world.free_space],
         "obstacles": obstacles,
         "start": [float(x) for x in scenario.start],
         "goal": [float(x) for x in scenario.goal],
-        "team": {
-            "sheet": [[float(x), float(y)] for x, y in team.sheet.vertices],
-            "hold_height": team.hold_height, "robot_radius": team.robot_radius,
-            "height_safety": team.height_safety, "lateral_safety": team.lateral_safety,
-            "speed": team.speed, "rotation_speed": team.rotation_speed,
-        },
+        "team": team_map,
     }
-    if team.mass is not None:
-        out["team"]["mass"] = team.mass
     if scenario.name is None:
         del out["name"]
     return out

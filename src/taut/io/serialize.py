@@ -154,13 +154,17 @@ def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
 
 
 def plan_to_dict(r: PlanResult) -> dict[str, Any]:
-    """JSON form of a plan: ``success``, ``reason``, ``times`` [T], ``robots`` [T][N][2],
-    ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``, ``bypassed``, plus
-    ``path_length`` (m) and ``duration`` (s) (null on failure)."""
+    """JSON form of a plan: ``success``, ``status``, ``message``, ``reason`` (deprecated:
+    ``message`` on failure, null on success), ``planner``, ``times`` [T], ``robots``
+    [T][N][2], ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``, ``bypassed``,
+    plus ``path_length`` (m) and ``duration`` (s) (null on failure)."""
     message = _attr(r, "message", "reason")
     return {
         "success": bool(r.success),
+        "status": getattr(r, "status", "ok" if r.success else "no_route"),
+        "message": message or "",
         "reason": message if not r.success else None,
+        "planner": getattr(r, "planner", None),
         "times": [float(t) for t in r.times],
         "robots": np.asarray(r.robots, dtype=float).tolist(),
         "object": np.asarray(r.object, dtype=float).tolist(),

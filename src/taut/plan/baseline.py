@@ -1,23 +1,31 @@
-"""Bypass-only baseline: the formation never crosses an obstacle (2-D planning as in the
-planning paper's benchmark, ref. [21]). It uses the most compact stable all-taut formation
-(the one with the most room to pass beside obstacles) and the same route search, timing
-and verification as the crossing planner."""
+"""Bypass-only baselines (2-D planning as in the planning paper's benchmark, ref. [21]).
+
+* :func:`plan_baseline` (``"disc"``): the formation is a disc covering every heading, routed
+  on the visibility roadmap, never crossing (the baseline of issue 4);
+* ``plan(scenario, baseline="se2")``: the SE(2) search with crossing disabled (same search,
+  budget and compact formation as the crossing planner).
+
+Both use the most compact stable all-taut formation (the most room to pass beside
+obstacles) and the same timing and verification as the crossing planner.
+"""
 
 from __future__ import annotations
 
+from . import _tol
 from .result import PlanResult, attempt, compact_formation
 from .world import Scenario
 
 __all__ = ["plan_baseline"]
 
 
-def plan_baseline(scenario: Scenario) -> PlanResult:
-    """Bypass-only plan of ``scenario``.
+def plan_baseline(scenario: Scenario, *, sheet_margin: float = _tol.SHEET_MARGIN
+                  ) -> PlanResult:
+    """Disc-model bypass-only plan of ``scenario``.
 
     Raises
     ------
     PlanningError
         The team cannot hold the object at all.
     """
-    return attempt(scenario, compact_formation(scenario), allow_crossing=False,
-                   planner="baseline")
+    return attempt(scenario, compact_formation(scenario, sheet_margin), allow_crossing=False,
+                   planner="disc", sheet_margin=sheet_margin)

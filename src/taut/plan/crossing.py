@@ -33,8 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _tol
 from .formation import Formation, crossing_pairs, offset_crossings
-from ..sheet.fk import forward_kinematics
+from ..sheet import forward_kinematics
 from .route import Leg, Route
 from .world import Scenario
 
@@ -212,6 +213,7 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
         forms, legs, first = formation.formations, formation.legs, formation.first
     else:
         forms, first = (formation,), 0
+    legs = legs or ()
     team = scenario.team
     b = _Builder(forms[first], team.speed, team.rotation_speed, scenario.start)
     records = []
@@ -223,7 +225,7 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
             b.translate(leg.end)
             continue
         f = b.f
-        o = scenario.world.obstacle(leg.obstacle)
+        o = scenario.world.obstacle(str(leg.obstacle))
         u = leg.end - leg.start
         du = float(np.arctan2(u[1], u[0]))
         if leg.heading is not None:                         # straight offset crossing
@@ -242,7 +244,7 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
             continue
         pairs = crossing_pairs(f, o.mec_radius + team.clearance)
         best = abs(pairs[0][2])
-        cands = [p for p in pairs if abs(abs(p[2]) - best) <= 1e-9]
+        cands = [p for p in pairs if abs(abs(p[2]) - best) <= _tol.TURN_TIE]
         h = b.h[-1]
         a_in, a_out, turn = min(cands, key=lambda p: abs(_wrap(du - p[0] - h)))
         t0 = b.t[-1]

@@ -48,12 +48,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
 from ..errors import TautError
-from ..sheet.fk import forward_kinematics
-from ..sheet.geometry import formation_metrics
-from ..sheet.ik import ik_constraints, inverse_kinematics
+from ..sheet import (forward_kinematics, formation_metrics, ik_constraints,
+                     inverse_kinematics)
+from . import _tol
 from .world import Team
 
 __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
@@ -129,10 +130,11 @@ class Formation:
     def n(self) -> int:
         return int(self.robots.shape[0])
 
-    def placed(self, centre: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    def placed(self, centre: ArrayLike, heading: ArrayLike) -> np.ndarray:
         """Robots (..., N, 2) with the object's projection at ``centre`` (..., 2) and the
         formation turned by ``heading`` (...) radians."""
-        c, s = np.cos(heading)[..., None], np.sin(heading)[..., None]
+        h = np.asarray(heading, dtype=float)
+        c, s = np.cos(h)[..., None], np.sin(h)[..., None]
         x, y = self.robots[:, 0], self.robots[:, 1]
         return np.stack([c * x - s * y, s * x + c * y], axis=-1) + np.asarray(centre)[..., None, :]
 
@@ -210,17 +212,170 @@ def offset_crossings(formation: Formation, clearance: float, directions: int = 3
     return a[ok], lo[k, cols][ok], hi[k, cols][ok]
 
 
+@dataclass(frozen=True)
+class _Decision:
+    """Layout of the decision vector of eq. (15), in sheet-size units: contact
+    :math:`\\mathbf{v}_o` (2), :math:`z_o` (1), angles :math:`\\theta_i` (N), shares
+    :math:`w_i` (N), auxiliary radius :math:`\\bar R` (1)."""
+
+    n: int
+
+    @property
+    def length(self) -> int:
+        return 3 + 2 * self.n + 1
+
+    def split(self, z: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarray, float]:
+        """(contact, z_o, angles, weights, R_bar) of ``z``."""
+        n = self.n
+        return z[:2], float(z[2]), z[3:3 + n], z[3 + n:3 + 2 * n], float(z[-1])
+
+    def pack(self, contact: np.ndarray, zo: float, angles: np.ndarray, weights: np.ndarray,
+             radius: float) -> np.ndarray:
+        return np.concatenate([contact, [zo], angles, weights, [radius]])
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """Normalised data of eq. (15) for one team and request (lengths / sheet size)."""
+
+    V: np.ndarray            # sheet vertices (N, 2)
+    zr: float                # holding height
+    z_lo: float              # lowest admissible object height (15b)
+    z_hi: float              # highest (MIN_DEPTH_FRACTION below the hands)
+    sep: float               # least robot gap (robots apart, obstacle through; 15b)
+    ds: float                # side safety
+    w_ref: float             # free-space width normalising eq. (13)
+    r_max: float             # bound on the auxiliary radius (eq. 13 as a constraint)
+    vd2: np.ndarray          # squared admissible robot distances per pair (sheet margin)
+    rho0: np.ndarray         # nominal radial distances (IK at the centroid)
+    crossing: bool
+    weights: CostWeights
+    dec: _Decision
+    narrow: bool = False     # R_bar bounds |y_i| (half-width), not the radius
+
+    @property
+    def pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.triu_indices(self.dec.n, 1)
+
+    def geometry(self, z: np.ndarray):
+        """(contact, z_o, angles, weights, R_bar, squared cable-projection lengths
+        :math:`l_i^2`, hand drop :math:`z_r - z_o`, radial distances :math:`\\rho_i`,
+        robot positions (N, 2)) of decision vector ``z`` (eq. 10)."""
+        vo, zo, th, w, Rb = self.dec.split(z)
+        l2 = np.sum((self.V - vo) ** 2, axis=1)
+        d = self.zr - zo
+        rho = np.sqrt(np.maximum(l2 - d * d, _tol.SQUARE_FLOOR))
+        r = rho[:, None] * np.column_stack([np.cos(th), np.sin(th)])
+        return vo, zo, th, w, Rb, l2, d, rho, r
+
+    def cost(self, z: np.ndarray) -> float:
+        """:math:`J = J_t + J_p + J_c` (eqs. 11-14)."""
+        vo, zo, th, w, Rb, l2, d, rho, r = self.geometry(z)
+        cw, n = self.weights, self.dec.n
+        jt = cw.transport * np.mean((rho - self.rho0) ** 2) + cw.load_share * np.sum(
+            (w - 1 / n) ** 2)
+        jp = cw.passable * ((2 * Rb + 2 * self.ds) / self.w_ref) ** 2
+        jc = 0.0
+        if self.crossing:
+            iu, ju = self.pairs
+            g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
+            jc = (cw.crossing_height * ((zo - self.z_lo) / self.zr) ** 2
+                  + cw.crossing_gap * np.mean(self.sep ** 2 / np.maximum(g2, _tol.SQUARE_FLOOR)))
+        return float(jt + jp + jc)
+
+    def equalities(self, z: np.ndarray) -> np.ndarray:
+        """:math:`\\sum w_i = 1`, :math:`\\sum w_i v_i = v_o`, :math:`\\sum w_i r_i = 0`."""
+        vo, zo, th, w, Rb, l2, d, rho, r = self.geometry(z)
+        return np.concatenate([[w.sum() - 1.0], w @ self.V - vo, w @ r])
+
+    def inequalities(self, z: np.ndarray) -> np.ndarray:
+        """(15b)-(15c) as ``g(z) >= 0``."""
+        vo, zo, th, w, Rb, l2, d, rho, r = self.geometry(z)
+        iu, ju = self.pairs
+        g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
+        return np.concatenate([w - MIN_SHARE, l2 - d * d - _tol.STRICT_SLACK, self.vd2 - g2,
+                               g2 - self.sep ** 2,
+                               Rb ** 2 - (r[:, 1] ** 2 if self.narrow else rho ** 2),
+                               [zo - self.z_lo, self.z_hi - zo, self.r_max - Rb]])
+
+    def admissible(self, z: np.ndarray) -> bool:
+        tol = _tol.FORMATION_FEAS_TOL
+        return bool(np.abs(self.equalities(z)).max() <= tol
+                    and self.inequalities(z).min() >= -tol)
+
+    def from_ik(self, ik, s: float) -> np.ndarray:
+        """Decision vector of an IK solution (lengths divided by the sheet size ``s``)."""
+        return self.dec.pack(ik.contact / s, ik.object[2] / s, ik.angles, ik.weights,
+                             ik.reach.max() / s * 1.01)
+
+
+def _curvature_constraint(team: Team, prob: _Problem, s: float):
+    """Positive reduced-Hessian curvature (a stable rest state; used for N <= 4)."""
+    def curvature(z: np.ndarray) -> np.ndarray:
+        vo, zo, th, w, _ = prob.dec.split(z)
+        try:
+            c = ik_constraints(team.sheet, [0.0, 0.0, zo * s], team.hold_height, th, w,
+                               contact=vo * s)
+        except TautError:
+            return np.array([-1.0])
+        k = float(np.min(c.curvature))
+        return np.array([-1.0 if np.isnan(k) else min(k, 1.0) - _tol.MIN_CURVATURE])
+    return curvature
+
+
+def _nominal_ik(team: Team, heights: np.ndarray):
+    """First IK solution at the sheet centroid among object ``heights`` (m)."""
+    for zo in heights:
+        try:
+            return inverse_kinematics(team.sheet, [0.0, 0.0, zo], team.hold_height)
+        except TautError:
+            continue
+    return None
+
+
+def _problem(team: Team, kind: str, height: float, diameter: float, width: float | None,
+             max_reach: float | None, weights: CostWeights | None, sheet_margin: float):
+    """The normalised problem and its nominal IK start, or None when infeasible."""
+    sheet, zr = team.sheet, team.hold_height
+    s, N = sheet.size, sheet.n
+    crossing = kind == "crossing" and height > 0
+    z_lo = max(height + team.height_safety if crossing else 0.0, team.height_safety,
+               1e-3 * zr) / s
+    z_hi = (1 - MIN_DEPTH_FRACTION) * zr / s
+    if z_lo > z_hi:
+        return None, None
+    start = _nominal_ik(team, np.linspace(z_lo, z_hi, 7) * s)
+    if start is None:
+        return None, None
+    V = sheet.vertices / s
+    iu, ju = np.triu_indices(N, 1)
+    vd = np.linalg.norm(V[iu] - V[ju], axis=1) - sheet_margin / s
+    if np.any(vd <= 0):
+        return None, None
+    sep = max(2 * team.robot_radius, (diameter + 2 * team.side_safety) if crossing else 0.0)
+    prob = _Problem(V=V, zr=zr / s, z_lo=z_lo, z_hi=z_hi, sep=sep / s,
+                    ds=team.side_safety / s, w_ref=(width if width is not None else 4 * s) / s,
+                    r_max=1e6 if max_reach is None else (max_reach - team.clearance) / s,
+                    vd2=vd ** 2 * (1 - _tol.STRICT_SLACK), rho0=start.reach / s, crossing=crossing,
+                    weights=weights or (COMPACT if kind in ("compact", "narrow")
+                                        else CostWeights()),
+                    dec=_Decision(N), narrow=kind == "narrow")
+    return prob, start
+
+
 def optimal_formation(team: Team, *, kind: str = "crossing", height: float = 0.0,
                       diameter: float = 0.0, width: float | None = None,
-                      max_reach: float | None = None, weights: CostWeights | None = None
-                      ) -> Formation | None:
+                      max_reach: float | None = None, weights: CostWeights | None = None,
+                      sheet_margin: float = 0.0) -> Formation | None:
     """Solve the rebuilt eq. (15) for one formation.
 
     Parameters
     ----------
     team : Team
-    kind : {"crossing", "compact"}
-        ``compact``: minimise the size (bypassing); ``crossing``: eqs. 11-14 in full.
+    kind : {"crossing", "compact", "narrow"}
+        ``compact``: minimise the size (bypassing); ``crossing``: eqs. 11-14 in full;
+        ``narrow``: minimise the width across the formation's x axis (bypassing in
+        corridors: eq. 13 with the half-width in place of the radius).
     height : float
         Tallest obstacle to cross, m (0: none); the object ends at least
         ``height + team.height_safety`` high (15b).
@@ -232,121 +387,65 @@ def optimal_formation(team: Team, *, kind: str = "crossing", height: float = 0.0
         Hard bound on :attr:`Formation.reach`, m (e.g. half the corridor width): the
         passable-area requirement of eq. (13) as a constraint (15c).
     weights : CostWeights, optional
+    sheet_margin : float
+        Every robot pair stays this far inside its sheet distance, m (robustness to robot
+        position error; 0: the paper's constraint).
 
     Returns
     -------
     Formation or None
         None when no formation meets the constraints.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from taut.sheet import Sheet
+    >>> from taut.plan import Team, optimal_formation
+    >>> team = Team(Sheet.regular(3, 1 / np.sqrt(3)), hold_height=0.5, robot_radius=0.15,
+    ...             height_safety=0.05, lateral_safety=0.05, speed=0.1, rotation_speed=0.3)
+    >>> f = optimal_formation(team, kind="crossing", height=0.2, diameter=0.3)
+    >>> round(f.max_height, 6), bool(f.max_diameter >= 0.3 - 1e-9)
+    (0.2, True)
     """
-    sheet, zr = team.sheet, team.hold_height
-    s = sheet.size
-    N = sheet.n
-    V = sheet.vertices / s
-    w_ref = (width if width is not None else 4 * s) / s
-    cw = weights or (COMPACT if kind == "compact" else CostWeights())
-    crossing = kind == "crossing" and height > 0
-    ds = team.side_safety / s
-    zr_n = zr / s
-    z_lo = max(height + team.height_safety if crossing else 0.0, team.height_safety,
-               1e-3 * zr) / s
-    z_hi = (1 - MIN_DEPTH_FRACTION) * zr_n
-    if z_lo > z_hi:
+    prob, start = _problem(team, kind, height, diameter, width, max_reach, weights,
+                           float(sheet_margin))
+    if prob is None:
         return None
-    sep = max(2 * team.robot_radius, (diameter + 2 * team.side_safety) if crossing else 0.0) / s
-    iu, ju = np.triu_indices(N, 1)
-    vd2 = np.sum((V[iu] - V[ju]) ** 2, axis=1) * (1 - 1e-6)
-    r_max = 1e6 if max_reach is None else (max_reach - team.clearance) / s
-
-    # Nominal all-taut formation (IK at the centroid contact) as start and reference.
-    start = None
-    for zo in np.linspace(z_lo, z_hi, 7) * s:
-        try:
-            ik = inverse_kinematics(sheet, [0.0, 0.0, zo], zr)
-        except TautError:
-            continue
-        start = ik
-        break
-    if start is None:
-        return None
-    rho0 = start.reach / s
-
-    def parts(z):
-        vo, zo, th, w, Rb = z[:2], z[2], z[3:3 + N], z[3 + N:3 + 2 * N], z[-1]
-        l2 = np.sum((V - vo) ** 2, axis=1)
-        d = zr_n - zo
-        rho = np.sqrt(np.maximum(l2 - d * d, 1e-12))
-        r = rho[:, None] * np.column_stack([np.cos(th), np.sin(th)])
-        return vo, zo, th, w, Rb, l2, d, rho, r
-
-    def cost(z):
-        vo, zo, th, w, Rb, l2, d, rho, r = parts(z)
-        jt = cw.transport * np.mean((rho - rho0) ** 2) + cw.load_share * np.sum((w - 1 / N) ** 2)
-        jp = cw.passable * ((2 * Rb + 2 * ds) / w_ref) ** 2
-        jc = 0.0
-        if crossing:
-            g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
-            jc = (cw.crossing_height * ((zo - z_lo) / zr_n) ** 2
-                  + cw.crossing_gap * np.mean(sep ** 2 / np.maximum(g2, 1e-12)))
-        return float(jt + jp + jc)
-
-    def eq(z):
-        vo, zo, th, w, Rb, l2, d, rho, r = parts(z)
-        return np.concatenate([[w.sum() - 1.0], w @ V - vo, w @ r])
-
-    def ineq(z):
-        vo, zo, th, w, Rb, l2, d, rho, r = parts(z)
-        g2 = np.sum((r[iu] - r[ju]) ** 2, axis=1)
-        return np.concatenate([w - MIN_SHARE, l2 - d * d - 1e-6, vd2 - g2, g2 - sep ** 2,
-                               Rb ** 2 - rho ** 2, [zo - z_lo, z_hi - zo, r_max - Rb]])
-
-    cons = [{"type": "eq", "fun": eq}, {"type": "ineq", "fun": ineq}]
-    if N <= 4:
-        def curvature(z):
-            vo, zo, th, w = z[:2], z[2], z[3:3 + N], z[3 + N:3 + 2 * N]
-            try:
-                c = ik_constraints(sheet, [0.0, 0.0, zo * s], zr, th, w, contact=vo * s)
-            except TautError:
-                return np.array([-1.0])
-            k = float(np.min(c.curvature))
-            return np.array([-1.0 if np.isnan(k) else min(k, 1.0) - 1e-4])
-        cons.append({"type": "ineq", "fun": curvature})
-    def from_ik(ik) -> np.ndarray:
-        return np.concatenate([ik.contact / s, [ik.object[2] / s], ik.angles, ik.weights,
-                               [ik.reach.max() / s * 1.01]])
-
-    def admissible(z) -> bool:
-        return bool(np.abs(eq(z)).max() <= 1e-7 and ineq(z).min() >= -1e-7)
-
+    s = team.sheet.size
+    cons = [{"type": "eq", "fun": prob.equalities}, {"type": "ineq", "fun": prob.inequalities}]
+    if prob.dec.n <= 4:
+        cons.append({"type": "ineq", "fun": _curvature_constraint(team, prob, s)})
     try:
-        res = minimize(cost, from_ik(start), method="SLSQP", constraints=cons,
-                       options={"maxiter": 200, "ftol": 1e-10})
-        z = res.x
+        z = minimize(prob.cost, prob.from_ik(start, s), method="SLSQP", constraints=cons,
+                     options={"maxiter": 200, "ftol": 1e-10}).x
     except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - defensive
-        z = np.full(3 + 2 * N + 1, np.nan)
-    if np.all(np.isfinite(z)) and admissible(z):
-        out = _finish(team, z, N, s, cost(z), kind)
+        z = np.full(prob.dec.length, np.nan)
+    if np.all(np.isfinite(z)) and prob.admissible(z):
+        out = _finish(team, z, prob.dec, s, prob.cost(z), kind)
         if out is not None:
             return out
     # Fallback when SLSQP stalls: the lowest admissible nominal IK formation (the
     # smallest one that meets every constraint), without the cost's refinements.
-    for zo in np.linspace(z_lo, z_hi, 25) * s:
-        try:
-            z = from_ik(inverse_kinematics(sheet, [0.0, 0.0, zo], zr))
-        except TautError:
+    for zo in np.linspace(prob.z_lo, prob.z_hi, 25) * s:
+        ik = _nominal_ik(team, np.array([zo]))
+        if ik is None:
             continue
-        if admissible(z):
-            out = _finish(team, z, N, s, cost(z), kind)
+        z = prob.from_ik(ik, s)
+        if prob.admissible(z):
+            out = _finish(team, z, prob.dec, s, prob.cost(z), kind)
             if out is not None:
                 return out
     return None
 
 
-def _finish(team: Team, z: np.ndarray, N: int, s: float, cost: float, kind: str
+def _finish(team: Team, z: np.ndarray, dec: _Decision, s: float, cost: float, kind: str
             ) -> Formation | None:
     """Re-derive the formation exactly from (v_o, z_o, angles) and accept it only when
     forward kinematics finds it as a stable all-taut equilibrium."""
     sheet, zr = team.sheet, team.hold_height
-    vo, zo, th = z[:2] * s, z[2] * s, z[3:3 + N]
+    N = dec.n
+    contact, zn, th, _, _ = dec.split(z)
+    vo, zo = contact * s, zn * s
     try:
         c = ik_constraints(sheet, [0.0, 0.0, zo], zr, th, contact=vo)
     except TautError:
@@ -358,7 +457,7 @@ def _finish(team: Team, z: np.ndarray, N: int, s: float, cost: float, kind: str
         return None
     target = np.array([0.0, 0.0, zo])
     match = [e for e in fk.stable if len(e.taut) == N
-             and np.linalg.norm(e.object - target) <= 1e-6 * s]
+             and np.linalg.norm(e.object - target) <= _tol.FORMATION_MATCH_RTOL * s]
     if not match:
         return None
     e = match[0]
@@ -369,5 +468,6 @@ def _finish(team: Team, z: np.ndarray, N: int, s: float, cost: float, kind: str
     robots.setflags(write=False)
     w = np.zeros(N)
     w[list(e.taut)] = e.weights
-    return Formation(robots, e.height, e.contact, w, kind, m.size, float(m.max_obstacle_height),
-                     m.min_distance, m.max_obstacle_diameter, reach, float(cost))
+    return Formation(robots, e.height, e.contact, w, kind, m.size,
+                     float(m.max_obstacle_height or 0.0), m.min_distance,
+                     m.max_obstacle_diameter, reach, float(cost))

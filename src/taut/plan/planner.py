@@ -1,39 +1,51 @@
-"""Top-level planner with obstacle crossing (planning paper Sec. IV, Fig. 4).
+"""Front end of the planners: :func:`plan` (planning paper Sec. IV, Fig. 4, and issue 14).
 
-1. Formations: the compact one (bypassing) and, for each obstacle-height class (the
-   distinct obstacle heights, at most ``MAX_CLASSES`` of them), the optimal crossing
-   formation of eqs. (11)-(15) for every obstacle up to that height.
-2. Each formation is routed with crossing allowed (obstacles it can cross may lie on the
-   route, the rest are bypassed), and so is each crossing formation paired with the
-   compact one (the team changes formation in place where needed: compact to squeeze past
-   obstacles, high to cross them); every candidate is timed with Algorithm 2 and
-   verified; the bypass-only baseline plan is one more candidate.
-   Crossings are the paper's Algorithm 2 and, unless ``straight_crossings=False``, also
-   straight offset crossings (no turn over the obstacle; see
-   :func:`~taut.plan.formation.offset_crossings`).
-3. The fastest verified candidate wins; among equally fast ones a crossing plan is
-   preferred, as in the paper. Because the baseline is a candidate, the planner succeeds
-   whenever the baseline does and is never slower to the goal.
+Methods (one private module each):
 
-If nothing verifies, the result is a failure whose reason says why bypassing and each
-crossing attempt failed.
+``"se2"`` (default)
+    The team is a rigid body in SE(2) per formation of a small library (the compact one
+    and, per obstacle-height class, the optimal crossing formation of eqs. 11-15); a
+    seeded RRT-Connect searches each, then pairs with one formation change
+    (:mod:`taut.plan._se2`). Low obstacles pass under the sheet between any two robots at
+    any heading. When no SE(2) candidate verifies, the disc-model roadmap plan and the
+    SE(2) bypass baseline are tried too, so the planner succeeds wherever either baseline
+    does. Failures carry a certificate (status ``refuted``) or say the budget ran out
+    (``budget_exhausted``).
+``"roadmap"``
+    The disc-model roadmap of :func:`~taut.plan.route.find_route` with Algorithm 2 and
+    straight offset crossings (the planner of issue 4).
+``"algorithm2"``
+    The same roadmap with the paper's Algorithm 2 only (paper-faithful mode).
+
+Baselines (``baseline=``): ``"se2"`` (or True) the SE(2) search with crossing disabled and
+the compact formation only (same search, same budget); ``"disc"`` the disc-model bypass.
 """
 
 from __future__ import annotations
 
+import functools
+from dataclasses import replace
+from typing import Literal
+
 import numpy as np
 
 from ..errors import InvalidInputError
-from .baseline import plan_baseline
+from . import _tol
+from ._se2 import SearchBudget, search_se2
+from ._se2_motion import Piece, sample_pieces
+from .certificate import find_certificate
 from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
-from .result import PlanResult, attempt, compact_formation, failure
+from .result import PlanResult, _summary, attempt, compact_formation, failure, relabel
 from .route import crossable
+from .verify import verify_motion
 from .world import Scenario
 
-__all__ = ["plan", "MAX_CLASSES"]
+__all__ = ["plan", "formation_library", "MAX_CLASSES"]
 
 #: Most obstacle-height classes for which a crossing formation is optimised.
 MAX_CLASSES = 4
+
+Method = Literal["se2", "roadmap", "algorithm2"]
 
 
 def _height_classes(scenario: Scenario) -> list[float]:
@@ -44,18 +56,190 @@ def _height_classes(scenario: Scenario) -> list[float]:
     return heights
 
 
-def plan(scenario: Scenario, *, baseline: bool = False, straight_crossings: bool = True
-         ) -> PlanResult:
+def _why_not_crossable(scenario: Scenario, h: float, ids: str) -> str:
+    team = scenario.team
+    if h + team.height_safety >= (1 - MIN_DEPTH_FRACTION) * team.hold_height:
+        why = (f"the object hangs below the hands ({team.hold_height:.3g} m), so it "
+               f"cannot clear {h:.3g} m plus the height safety")
+    else:
+        why = ("no stable all-taut formation lifts the object that high with room "
+               "between the robots")
+    return f"obstacle {ids} ({h:.3g} m tall) cannot be crossed: {why}"
+
+
+def formation_library(scenario: Scenario, sheet_margin: float = 0.0
+                      ) -> tuple[Formation, list[Formation], list[str]]:
+    """The compact formation; the others (the narrow one when it differs, and the crossing
+    formations, one per obstacle-height class, eqs. 11-15, preferring one that fits the
+    widest passage); and why some height classes have none."""
+    world, team = scenario.world, scenario.team
+    compact = compact_formation(scenario, sheet_margin)
+    crossing, notes = [], []
+    # A triangle's narrowest stable formation is its compact one.
+    narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
+                                                        width=world.width,
+                                                        sheet_margin=sheet_margin)
+    if narrow is not None and _min_width(narrow) < _min_width(compact) - 0.01:
+        crossing.append(narrow)
+    for h in _height_classes(scenario):
+        group = [o for o in world.obstacles if o.height <= h]
+        diameter = max(o.diameter for o in group)
+        f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
+                              width=world.width, max_reach=0.49 * world.width,
+                              sheet_margin=sheet_margin)
+        if f is None:
+            f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
+                                  width=world.width, sheet_margin=sheet_margin)
+        if f is None:
+            notes.append(_why_not_crossable(
+                scenario, h, ", ".join(repr(o.id) for o in group if o.height == h)))
+            continue
+        crossing.append(f)
+    return compact, crossing, notes
+
+
+Library = tuple[Formation, list[Formation], list[str]]
+
+
+@functools.lru_cache(maxsize=32)
+def _library(scenario: Scenario, sheet_margin: float
+             ) -> tuple[Formation, tuple[Formation, ...], tuple[str, ...]]:
+    """:func:`formation_library`, memoised per scenario object (the optimisations of
+    eqs. 11-15 dominate a plan's time; baselines and re-plans reuse them)."""
+    compact, others, notes = formation_library(scenario, sheet_margin)
+    return compact, tuple(others), tuple(notes)
+
+
+def _min_width(f: Formation) -> float:
+    """Least width of the robots' hull over all directions, m."""
+    a = np.linspace(0, np.pi, 180, endpoint=False)
+    proj = f.robots @ np.stack([-np.sin(a), np.cos(a)])
+    return float(np.ptp(proj, axis=0).min())
+
+
+def _roadmap(scenario: Scenario, straight: bool, sheet_margin: float, planner: str,
+             library: Library) -> PlanResult:
+    """The disc-model roadmap planner of issue 4 (see ``method="roadmap"``)."""
+    world = scenario.world
+    compact, crossing, notes = library
+    best = attempt(scenario, compact, allow_crossing=False, planner="disc",
+                   sheet_margin=sheet_margin)
+    reasons = list(notes) if best.success else [f"bypassing: {best.message}", *notes]
+    candidates: list[Formation] = []
+    if any(crossable(scenario, compact, o, straight=straight) is None for o in world.obstacles):
+        candidates.append(compact)
+    crossing = [f for f in crossing if f.kind == "crossing"]
+    candidates += crossing
+    combos: list = list(candidates)
+    if crossing:
+        combos.append([compact, *crossing])
+    for f in combos:
+        r = attempt(scenario, f, allow_crossing=True, planner=planner,
+                    straight_crossings=straight, sheet_margin=sheet_margin)
+        if r.success and any(c.kind == "straight" for c in r.crossings):
+            # The route search does not cost the turn into a straight crossing's heading;
+            # Algorithm 2 alone (a subset of the edges) may be faster in time.
+            r2 = attempt(scenario, f, allow_crossing=True, planner=planner,
+                         straight_crossings=False, sheet_margin=sheet_margin)
+            if r2.success and r2.duration < r.duration:
+                r = r2
+        if not r.success:
+            if isinstance(f, Formation):
+                reasons.append(f"crossing with the object at {f.object_height:.3g} m: "
+                               f"{r.message}")
+            continue
+        rtol = _tol.DURATION_RTOL
+        if not best.success or r.duration <= best.duration * (1 + rtol):
+            if not best.success or r.duration < best.duration * (1 - rtol) or r.crossed:
+                best = r
+    if best.success:
+        return relabel(best, planner)
+    return failure(scenario, "; ".join(dict.fromkeys(reasons)) or "no plan", planner)
+
+
+def _finish_se2(scenario: Scenario, pieces: list[Piece], planner: str, sheet_margin: float
+                ) -> PlanResult:
+    """Sample, verify and package one SE(2) candidate."""
+    m = sample_pieces(scenario, pieces)
+    if m.message is not None:
+        return failure(scenario, f"plan rejected: {m.message}", planner, "unverified")
+    check = verify_motion(scenario, m.robots, m.object, sheet_margin=sheet_margin)
+    if not check.success:
+        return failure(scenario, f"plan rejected by verification: {check.message}", planner,
+                       "unverified")
+    import shapely
+    hulls = shapely.convex_hull(shapely.multipoints(m.robots))
+    crossed = tuple(o.id for o in scenario.world.obstacles
+                    if shapely.intersects(hulls, o.geometry).any())
+    bypassed = tuple(o.id for o in scenario.world.obstacles if o.id not in crossed)
+    forms = tuple(dict.fromkeys(p.formation for p in pieces))
+    main = max(forms, key=lambda f: f.object_height)
+    return PlanResult(True, "ok", _summary(m.duration, m.path_length, crossed), m.times,
+                      m.robots, check.object, check.taut, m.heading, crossed, bypassed,
+                      m.path_length, m.duration, main, (), planner, check, forms,
+                      sheet_margin=sheet_margin, scenario=scenario)
+
+
+def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
+         budget: SearchBudget, planner: str, library: Library) -> PlanResult:
+    """One SE(2) search (crossing planner or its bypass baseline) and its best plan."""
+    compact, others, notes = library
+    forms = [compact, *others]
+    results: list[PlanResult] = []
+
+    def accept(pieces: list[Piece]) -> bool:
+        results.append(_finish_se2(scenario, pieces, planner, sheet_margin))
+        return results[-1].success
+
+    found = search_se2(scenario, forms, allow_crossing=allow_crossing, budget=budget,
+                       accept=accept)
+    good = [r for r in results if r.success]
+    if good:
+        return min(good, key=lambda r: r.duration)
+    cert = find_certificate(scenario)
+    if cert is not None:
+        return failure(scenario, cert.message, planner, "refuted", cert)
+    rejected = list(dict.fromkeys(r.message for r in results))
+    tried = "; ".join([*found.notes, *notes, *rejected])
+    if results and not found.timed_out and len(results) == len(found.notes):
+        return failure(scenario, f"every candidate failed verification: {tried}", planner,
+                       "unverified")
+    cap = ("the time budget" if found.timed_out
+           else f"{budget.iterations} samples per search")
+    if not tried:
+        tried = "searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
+                                        for f in forms)
+    return failure(scenario, f"not found within the budget ({cap}; seed {budget.seed}): "
+                   f"{tried}", planner, "budget_exhausted")
+
+
+def plan(scenario: Scenario, *, method: Method = "se2",
+         baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
+         sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float = 10.0,
+         iterations: int = 3000, seed: int = 0) -> PlanResult:
     """Plan the transport of the object from ``scenario.start`` to ``scenario.goal``.
 
     Parameters
     ----------
     scenario : Scenario
-    baseline : bool
-        Plan with the bypass-only baseline instead.
+    method : {"se2", "roadmap", "algorithm2"}
+        See the module docstring.
+    baseline : bool or {"se2", "disc"}
+        Plan with a bypass-only baseline instead (True: ``"se2"``).
     straight_crossings : bool
-        Allow straight offset crossings besides the paper's Algorithm 2 (False: crossings
-        are Algorithm 2 only, every crossed obstacle passes under the object).
+        ``method="roadmap"`` only: also allow straight offset crossings.
+    sheet_margin : float
+        Every robot pair stays this far inside its sheet distance, m (default 0.01 m:
+        robots off by at most 5 mm each never tear the sheet).
+    time_budget : float
+        Wall-clock cap of the SE(2) search, s (the crossing search gets 70 % of it; when it
+        fails, the disc roadmap and then the SE(2) bypass search with the full budget, as
+        the baseline runs it, are tried, so a failure can take about 1.7 times this).
+    iterations : int
+        Samples per RRT-Connect run of the SE(2) search.
+    seed : int
+        Seed of the SE(2) search (plans are reproducible for a given seed and budget, as
+        long as the time cap is not what stops the search).
 
     Returns
     -------
@@ -66,65 +250,52 @@ def plan(scenario: Scenario, *, baseline: bool = False, straight_crossings: bool
     ------
     PlanningError
         The team cannot hold the object at all.
+
+    Examples
+    --------
+    >>> from taut.io.plan_scenario import load_plan_scenario      # doctest: +SKIP
+    >>> r = plan(load_plan_scenario("examples/plan/paper_corridor.yaml"))  # doctest: +SKIP
+    >>> r.success, r.status, r.crossed                             # doctest: +SKIP
+    (True, 'ok', ('1', '2'))
     """
     if not isinstance(scenario, Scenario):
         raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
+    if method not in ("se2", "roadmap", "algorithm2"):
+        raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
+                                          f"{method!r}")
+    if baseline not in (False, True, "se2", "disc"):
+        raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
+    if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
+        raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
+    if not (time_budget > 0) or int(iterations) < 1:
+        raise InvalidInputError("time_budget", "time_budget and iterations must be positive")
+    margin = float(sheet_margin)
+    budget = SearchBudget(iterations=int(iterations), time_budget=float(time_budget),
+                          seed=int(seed))
+    cached = _library(scenario, margin)
+    lib: Library = (cached[0], list(cached[1]), list(cached[2]))
+    if baseline == "disc":
+        return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
+                       sheet_margin=margin)
     if baseline:
-        return plan_baseline(scenario)
-    world, team = scenario.world, scenario.team
-    compact = compact_formation(scenario)
-    best = plan_baseline(scenario)
-    reasons = [] if best.success else [f"bypassing: {best.reason}"]
-    candidates = []
-    if any(crossable(scenario, compact, o, straight=straight_crossings) is None
-           for o in world.obstacles):
-        candidates.append(compact)
-    for h in _height_classes(scenario):
-        group = [o for o in world.obstacles if o.height <= h]
-        diameter = max(o.diameter for o in group)
-        # Prefer a formation that fits the widest passage (eq. 13 as a constraint).
-        f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
-                              width=world.width, max_reach=0.49 * world.width)
-        if f is None:
-            f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
-                                  width=world.width)
-        if f is None:
-            ids = ", ".join(repr(o.id) for o in group if o.height == h)
-            if h + team.height_safety >= (1 - MIN_DEPTH_FRACTION) * team.hold_height:
-                why = (f"the object hangs below the hands ({team.hold_height:.3g} m), so it "
-                       f"cannot clear {h:.3g} m plus the height safety")
-            else:
-                why = ("no stable all-taut formation lifts the object that high with room "
-                       "between the robots")
-            reasons.append(f"obstacle {ids} ({h:.3g} m tall) cannot be crossed: {why}")
-            continue
-        candidates.append(f)
-    # Single formations, then the compact one together with the crossing formations (the
-    # team may change formation where a crossing one does not fit).
-    mixes = [f for f in candidates if f is not compact]
-    combos: list = list(candidates)
-    if mixes:
-        combos.append([compact, *mixes])
-    for f in combos:
-        r = attempt(scenario, f, allow_crossing=True, planner="crossing",
-                    straight_crossings=straight_crossings)
-        if r.success and any(c.kind == "straight" for c in r.crossings):
-            # The route search does not cost the turn into a straight crossing's heading;
-            # Algorithm 2 alone (a subset of the edges) may be faster in time.
-            r2 = attempt(scenario, f, allow_crossing=True, planner="crossing",
-                         straight_crossings=False)
-            if r2.success and r2.duration < r.duration:
-                r = r2
-        if not r.success:
-            if isinstance(f, Formation):
-                reasons.append(f"crossing with the object at {f.object_height:.3g} m: "
-                               f"{r.reason}")
-            continue
-        if not best.success or r.duration <= best.duration * (1 + 1e-9):
-            if not best.success or r.duration < best.duration * (1 - 1e-9) or r.crossed:
-                best = r
-    if best.success:
-        if best.planner == "baseline":
-            best = PlanResult(**{**best.__dict__, "planner": "crossing"})
+        return _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=budget,
+                    planner="se2-bypass", library=lib)
+    if method != "se2":
+        return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
+                        lib)
+    full = budget                 # the SE(2) bypass fallback runs exactly as the baseline
+    first = replace(budget, time_budget=0.7 * budget.time_budget)
+    best = _se2(scenario, allow_crossing=True, sheet_margin=margin, budget=first,
+                planner="crossing", library=lib)
+    if best.success or best.status == "refuted":
         return best
-    return failure(scenario, "; ".join(dict.fromkeys(reasons)) or "no plan", "crossing")
+    # Fallbacks that make the planner succeed wherever a baseline does: the disc roadmap,
+    # and the SE(2) search without crossing (the baseline's own search).
+    alt = _roadmap(scenario, True, margin, "crossing", lib)
+    if alt.success:
+        return alt
+    alt = _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=full,
+               planner="crossing", library=lib)
+    if alt.success:
+        return alt
+    return best

@@ -1,21 +1,54 @@
-"""The plan result and the step shared by both planners: route a given formation, time it
-(Algorithm 2 on crossings) and verify it with the quasi-static model."""
+"""The plan result and the step shared by the roadmap planners: route a given formation,
+time it (Algorithm 2 on crossings) and verify it with the quasi-static model."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._outcome import check_status, deprecated_alias
 from ..errors import PlanningError
+from . import _tol
+from .certificate import Certificate
 from .crossing import CrossingRecord, motion_from_legs
 from .formation import Formation, optimal_formation
 from .route import find_route
 from .verify import Verification, verify_motion
 from .world import Scenario
 
-__all__ = ["PlanResult", "attempt", "compact_formation", "failure"]
+__all__ = ["PlanResult", "Robustness", "attempt", "compact_formation", "failure"]
+
+
+@dataclass(frozen=True, eq=False)
+class Robustness:
+    """Seeded Monte Carlo of a plan under robot position error (:meth:`PlanResult.robustness`).
+
+    Attributes
+    ----------
+    sigma : float
+        Position error, m (radius of the disc, or the standard deviation per axis).
+    noise : {"disc", "gaussian"}
+        Every robot displaced uniformly within a disc of radius ``sigma``, or by a normal
+        error of standard deviation ``sigma`` per axis, independently per sample.
+    trials : int
+    tear_probability : float
+        Fraction of trials in which some robot pair was beyond its sheet distance.
+    drop_probability : float
+        Fraction of trials in which, at some checked sample, the lowest rest state of the
+        perturbed formation was below the height safety over an obstacle beneath the
+        sheet or over the ground (forward kinematics at the tightest samples).
+    worst_extension : float
+        Largest (robot distance - sheet distance) seen, m (negative: never taut).
+    """
+
+    sigma: float
+    noise: str
+    trials: int
+    tear_probability: float
+    drop_probability: float
+    worst_extension: float
 
 
 @dataclass(frozen=True, eq=False)
@@ -26,8 +59,13 @@ class PlanResult:
     ----------
     success : bool
         True only for a plan that passed :func:`~taut.plan.verify.verify_motion`.
-    reason : str or None
-        Why planning failed (None on success).
+    status : {"ok", "refuted", "budget_exhausted", "no_route", "unverified"}
+        ``refuted``: a certificate proves no plan exists (see ``certificate``);
+        ``budget_exhausted``: none found within the search budget (no claim either way);
+        ``no_route``: the roadmap planners' search space holds no route; ``unverified``:
+        candidates were found but none passed verification.
+    message : str
+        What was found, or why not.
     times : ndarray, shape (T,)
         Sample times, s.
     robots : ndarray, shape (T, N, 2)
@@ -47,15 +85,22 @@ class PlanResult:
     formation : Formation or None
         The formation holding the object highest (the crossing one, if any).
     crossings : tuple of CrossingRecord
-    planner : {"crossing", "baseline"}
+        Algorithm 2 / straight crossings of the roadmap planners (empty for SE(2) plans).
+    planner : str
+        ``"crossing"`` (the SE(2) planner with crossing), ``"se2-bypass"`` (its baseline),
+        ``"disc"`` (the disc-model bypass baseline), ``"roadmap"``, ``"algorithm2"``.
     verification : Verification or None
     formations : tuple of Formation
-        Every formation used, in order of first use (more than one when the team changes
-        formation on the way).
+        Every formation used, in order of first use.
+    certificate : Certificate or None
+        Why no plan exists, when that is proved.
+    sheet_margin : float
+        The margin every robot pair keeps inside its sheet distance, m.
     """
 
     success: bool
-    reason: str | None
+    status: str
+    message: str
     times: np.ndarray
     robots: np.ndarray
     object: np.ndarray
@@ -70,17 +115,51 @@ class PlanResult:
     planner: str
     verification: Verification | None = None
     formations: tuple[Formation, ...] = ()
+    certificate: Certificate | None = None
+    sheet_margin: float = 0.0
+    scenario: Scenario | None = None
+
+    def __post_init__(self) -> None:
+        check_status(self.status)
+
+    reason = deprecated_alias("message", "reason",
+                              transform=lambda self, m: None if self.success else m)
+
+    def robustness(self, sigma: float = _tol.POSITION_ACCURACY, trials: int = 200, *,
+                   noise: str = "disc", seed: int = 0) -> Robustness:
+        """Probability of failure under robot position error (seeded Monte Carlo).
+
+        Parameters
+        ----------
+        sigma : float
+            Position error, m.
+        trials : int
+        noise : {"disc", "gaussian"}
+            See :class:`Robustness`.
+        seed : int
+
+        Returns
+        -------
+        Robustness
+        """
+        from .robustness import monte_carlo
+        if not self.success or self.scenario is None:
+            raise PlanningError("plan", "robustness needs a successful plan")
+        return monte_carlo(self.scenario, self, sigma, trials, noise=noise, seed=seed)
 
 
-def failure(scenario: Scenario, reason: str, planner: str) -> PlanResult:
+def failure(scenario: Scenario, message: str, planner: str, status: str = "no_route",
+            certificate: Certificate | None = None) -> PlanResult:
     """A failed plan with empty trajectories."""
     n = scenario.team.n
-    return PlanResult(False, reason, np.zeros(0), np.zeros((0, n, 2)), np.zeros((0, 3)), (),
-                      np.zeros(0), (), tuple(o.id for o in scenario.world.obstacles),
-                      float("nan"), float("nan"), None, (), planner)
+    return PlanResult(False, status, message, np.zeros(0), np.zeros((0, n, 2)),
+                      np.zeros((0, 3)), (), np.zeros(0), (),
+                      tuple(o.id for o in scenario.world.obstacles), float("nan"),
+                      float("nan"), None, (), planner, certificate=certificate,
+                      scenario=scenario)
 
 
-def compact_formation(scenario: Scenario) -> Formation:
+def compact_formation(scenario: Scenario, sheet_margin: float = 0.0) -> Formation:
     """The most compact stable all-taut formation (for bypassing).
 
     Raises
@@ -89,7 +168,8 @@ def compact_formation(scenario: Scenario) -> Formation:
         ``team``: no formation can hold the object at all.
     """
     team = scenario.team
-    f = optimal_formation(team, kind="compact", width=scenario.world.width)
+    f = optimal_formation(team, kind="compact", width=scenario.world.width,
+                          sheet_margin=sheet_margin)
     if f is None:
         raise PlanningError("team", "cannot hold the object: no formation keeps every cable "
                             f"taut and the object stable at least {team.height_safety:g} m "
@@ -99,23 +179,36 @@ def compact_formation(scenario: Scenario) -> Formation:
 
 
 def attempt(scenario: Scenario, formation: Formation | Sequence[Formation], *,
-            allow_crossing: bool, planner: str, straight_crossings: bool = True
-            ) -> PlanResult:
-    """Route ``formation`` (or several, changing between them), time the route and verify
-    it; a failed plan carries the reason."""
+            allow_crossing: bool, planner: str, straight_crossings: bool = True,
+            sheet_margin: float = 0.0) -> PlanResult:
+    """Route ``formation`` (or several, changing between them) on the disc-model roadmap,
+    time the route and verify it; a failed plan carries the reason."""
     route = find_route(scenario, formation, allow_crossing=allow_crossing,
                        straight_crossings=straight_crossings)
-    if not route.found:
-        return failure(scenario, route.reason or "no route", planner)
+    if not route.success:
+        return failure(scenario, route.message, planner)
     motion = motion_from_legs(scenario, route)
-    check = verify_motion(scenario, motion.robots, motion.object)
-    if not check.ok:
-        return failure(scenario, f"plan rejected by verification: {check.reason}", planner)
+    check = verify_motion(scenario, motion.robots, motion.object, sheet_margin=sheet_margin)
+    if not check.success:
+        return failure(scenario, f"plan rejected by verification: {check.message}", planner,
+                       "unverified")
     crossed = tuple(dict.fromkeys(route.crossed))
     bypassed = tuple(o.id for o in scenario.world.obstacles if o.id not in crossed)
     used = tuple(dict.fromkeys([route.first] + [leg.formation for leg in route.legs]))
     forms = tuple(route.formations[k] for k in used)
     main = max(forms, key=lambda f: f.object_height)
-    return PlanResult(True, None, motion.times, motion.robots, check.object, check.taut,
-                      motion.heading, crossed, bypassed, motion.path_length, motion.duration,
-                      main, motion.crossings, planner, check, forms)
+    return PlanResult(True, "ok", _summary(motion.duration, motion.path_length, crossed),
+                      motion.times, motion.robots, check.object, check.taut, motion.heading,
+                      crossed, bypassed, motion.path_length, motion.duration, main,
+                      motion.crossings, planner, check, forms, sheet_margin=sheet_margin,
+                      scenario=scenario)
+
+
+def _summary(duration: float, length: float, crossed: Sequence[str]) -> str:
+    return (f"plan: {duration:.2f} s to the goal, path {length:.3f} m, crossed "
+            f"[{', '.join(crossed)}]")
+
+
+def relabel(result: PlanResult, planner: str) -> PlanResult:
+    """The same result under another planner name."""
+    return replace(result, planner=planner)

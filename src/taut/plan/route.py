@@ -34,6 +34,8 @@ from shapely.geometry import Point
 from shapely.geometry.polygon import orient
 from shapely.ops import unary_union
 
+from .._outcome import check_status, deprecated_alias
+from . import _tol
 from .formation import Formation, crossing_pairs, offset_crossings
 from .world import Obstacle, Scenario
 
@@ -45,7 +47,7 @@ DIRECTIONS = 24
 OFFSETS = 21
 #: Buffer resolution (segments per quarter circle) of the configuration space.
 QUAD_SEGS = 8
-_EPS = 1e-6
+_EPS = _tol.CROSSING_OVERSHOOT
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,9 +77,10 @@ class Route:
 
     Attributes
     ----------
-    found : bool
-    reason : str or None
-        Why no route exists (when ``found`` is False).
+    success : bool
+    status : {"ok", "no_route"}
+    message : str
+        Why no route exists, or a summary.
     legs : tuple of Leg
     cost : float
         Graph cost, s (translation time plus the turns at crossed obstacles and the
@@ -88,16 +91,24 @@ class Route:
         Index of the formation at the start.
     """
 
-    found: bool
-    reason: str | None
+    success: bool
+    status: str
+    message: str
     legs: tuple[Leg, ...] = ()
     cost: float = float("inf")
     formations: tuple[Formation, ...] = ()
     first: int = 0
 
+    def __post_init__(self) -> None:
+        check_status(self.status)
+
+    found = deprecated_alias("success", "found")
+    reason = deprecated_alias("message", "reason",
+                              transform=lambda self, m: None if self.success else m)
+
     @property
     def crossed(self) -> tuple[str, ...]:
-        return tuple(leg.obstacle for leg in self.legs if leg.kind == "cross")
+        return tuple(str(leg.obstacle) for leg in self.legs if leg.kind == "cross")
 
 
 def crossable(scenario: Scenario, formation: Formation, obstacle: Obstacle, *,
@@ -106,10 +117,10 @@ def crossable(scenario: Scenario, formation: Formation, obstacle: Obstacle, *,
     Algorithm 2 or, with ``straight``, a straight offset crossing), else the reason it
     cannot."""
     team = scenario.team
-    if obstacle.height > formation.max_height + 1e-12:
+    if obstacle.height > formation.max_height + _tol.ANGLE_TOL:
         return (f"obstacle {obstacle.id!r} is {obstacle.height:.3g} m tall, the formation "
                 f"clears at most {formation.max_height:.3g} m")
-    if obstacle.diameter > formation.max_diameter + 1e-12:
+    if obstacle.diameter > formation.max_diameter + _tol.ANGLE_TOL:
         return (f"obstacle {obstacle.id!r} is {obstacle.diameter:.3g} m wide, at most "
                 f"{max(formation.max_diameter, 0):.3g} m fits between the robots")
     c = obstacle.mec_radius + team.clearance
@@ -164,7 +175,7 @@ class _Layer:
         self.region = _region(scenario, R)
         shapely.prepare(self.region)
         own = [scenario.start, scenario.goal]
-        own.extend(_vertices(_region(scenario, R + 1e-4 * max(R, 1.0))))
+        own.extend(_vertices(_region(scenario, R + _tol.VERTEX_INSET * max(R, 1.0))))
         # (local in, local out, cost s, obstacle id, world heading of the formation for a
         # straight offset crossing or None for Algorithm 2)
         self.cross: list[tuple[int, int, float, str, float | None]] = []
@@ -262,47 +273,29 @@ def reform_time(a: Formation, b: Formation, speed: float) -> float:
     return float(np.linalg.norm(b.robots - a.robots, axis=1).max()) / speed
 
 
-def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *,
-               allow_crossing: bool = True, straight_crossings: bool = True) -> Route:
-    """Shortest-time route of the object's projection from start to goal.
+def _no_route(message: str) -> Route:
+    return Route(False, "no_route", message)
 
-    Parameters
-    ----------
-    scenario : Scenario
-    formation : Formation or sequence of Formation
-        The formation(s) the team may use. With several, the roadmap has one layer per
-        formation and the team may change formation in place wherever both fit (a
-        ``"reform"`` leg, costed by :func:`reform_time`); it may start and end in any.
-    allow_crossing : bool
-        False gives the bypass-only baseline.
-    straight_crossings : bool
-        Also allow straight offset crossings (False: the paper's Algorithm 2 only).
 
-    Returns
-    -------
-    Route
-        ``found`` False with a reason when the start or goal has no room for the formation
-        or no route connects them.
-    """
-    team = scenario.team
-    forms = [formation] if isinstance(formation, Formation) else list(formation)
-    layers = [_Layer(scenario, f, allow_crossing, straight_crossings) for f in forms]
-    R = min(f.reach for f in forms)
+def _ends_message(layers: list[_Layer], scenario: Scenario, R: float) -> str | None:
+    """Why start or goal has no room for any formation (None when both have)."""
     if all(L.region.is_empty for L in layers):
-        return Route(False, f"the formation (reach {R:.3g} m) does not fit anywhere in the "
-                            "free space")
+        return f"the formation (reach {R:.3g} m) does not fit anywhere in the free space"
     for name, p in (("start", scenario.start), ("goal", scenario.goal)):
         if not any(L.region.covers(Point(p)) for L in layers):
-            return Route(False, f"no room for the formation (reach {R:.3g} m) at the {name}")
-    if len(layers) > 1:
-        for k, L in enumerate(layers):
-            L.add_shared([M.own for j, M in enumerate(layers) if j != k])
+            return f"no room for the formation (reach {R:.3g} m) at the {name}"
+    return None
+
+
+def _graph(layers: list[_Layer], forms: list[Formation], speed: float):
+    """Sparse graph of every layer, the virtual source/sink and the formation changes;
+    returns (csr graph, layer offsets, source, sink)."""
     offsets = np.cumsum([0] + [len(L.points) for L in layers])
     n = int(offsets[-1]) + 2                        # + virtual source and sink
     src, sink = n - 2, n - 1
     rows, cols, wts = [], [], []
     for k, L in enumerate(layers):
-        r, c, w = L.edges(team.speed)
+        r, c, w = L.edges(speed)
         rows.append(r + offsets[k])
         cols.append(c + offsets[k])
         wts.append(w)
@@ -320,26 +313,22 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
             A, B = layers[k].points, layers[j].points
             # Same point in both layers: a formation change there.
             d = np.linalg.norm(A[:, None, :] - B[None, :, :], axis=2)
-            ia, ib = np.nonzero(d <= 1e-12)
-            t = reform_time(forms[k], forms[j], team.speed)
+            ia, ib = np.nonzero(d <= _tol.SAME_POINT)
             rows.append(ia + offsets[k])
             cols.append(ib + offsets[j])
-            wts.append(np.full(len(ia), t))
+            wts.append(np.full(len(ia), reform_time(forms[k], forms[j], speed)))
     rows_a, cols_a = np.concatenate(rows).astype(int), np.concatenate(cols).astype(int)
-    wts_a = np.maximum(np.concatenate(wts), 1e-12)
+    wts_a = np.maximum(np.concatenate(wts), _tol.MIN_EDGE_COST)
     graph = coo_matrix((wts_a, (rows_a, cols_a)), shape=(n, n)).tocsr()
-    dist, pred = dijkstra(graph, directed=True, indices=src, return_predecessors=True)
-    if not np.isfinite(dist[sink]):
-        why = "no route: the formation cannot pass between the obstacles and walls"
-        reasons = list(dict.fromkeys(r for L in layers for r in L.reasons))
-        if reasons:
-            why += " and cannot cross (" + "; ".join(reasons) + ")"
-        return Route(False, why)
-    path = [int(pred[sink])]
-    while path[-1] != src:
-        path.append(int(pred[path[-1]]))
-    path = path[::-1][1:]
-    layer_of = np.searchsorted(offsets, np.arange(n - 2), side="right") - 1
+    return graph, offsets, src, sink
+
+
+def _legs(path: list[int], layers: list[_Layer], offsets: np.ndarray
+          ) -> tuple[tuple[Leg, ...], int]:
+    """Legs of a graph path (global node indices, source and sink removed) and the index
+    of the first formation."""
+    n = int(offsets[-1])
+    layer_of = np.searchsorted(offsets, np.arange(n), side="right") - 1
 
     def where(g: int) -> tuple[int, int]:
         k = int(layer_of[g])
@@ -350,7 +339,6 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
         for a, b, _, oid, phi in L.cross:
             crossing[(offsets[k] + a, offsets[k] + b)] = (oid, phi)
             crossing[(offsets[k] + b, offsets[k] + a)] = (oid, phi)
-    k0, i0 = where(path[0])
     legs = []
     for a, b in zip(path[:-1], path[1:]):
         (ka, ia), (kb, ib) = where(a), where(b)
@@ -358,6 +346,54 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
         if ka != kb:
             legs.append(Leg("reform", pa, pb, None, kb))
             continue
-        oid, phi = crossing.get((a, b), (None, None))
+        oid, phi = crossing.get((a, b), (None, None))  # type: ignore[assignment]
         legs.append(Leg("cross" if oid is not None else "move", pa, pb, oid, ka, phi))
-    return Route(True, None, tuple(legs), float(dist[sink]), tuple(forms), k0)
+    return tuple(legs), where(path[0])[0]
+
+
+def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *,
+               allow_crossing: bool = True, straight_crossings: bool = True) -> Route:
+    """Shortest-time route of the object's projection from start to goal on the disc-model
+    roadmap (module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    formation : Formation or sequence of Formation
+        The formation(s) the team may use. With several, the roadmap has one layer per
+        formation and the team may change formation in place wherever both fit (a
+        ``"reform"`` leg, costed by :func:`reform_time`); it may start and end in any.
+    allow_crossing : bool
+        False gives the disc-model bypass baseline.
+    straight_crossings : bool
+        Also allow straight offset crossings (False: the paper's Algorithm 2 only).
+
+    Returns
+    -------
+    Route
+        ``success`` False (status ``no_route``) with a message when the start or goal has
+        no room for the formation or no route connects them.
+    """
+    team = scenario.team
+    forms = [formation] if isinstance(formation, Formation) else list(formation)
+    layers = [_Layer(scenario, f, allow_crossing, straight_crossings) for f in forms]
+    why = _ends_message(layers, scenario, min(f.reach for f in forms))
+    if why is not None:
+        return _no_route(why)
+    if len(layers) > 1:
+        for k, L in enumerate(layers):
+            L.add_shared([M.own for j, M in enumerate(layers) if j != k])
+    graph, offsets, src, sink = _graph(layers, forms, team.speed)
+    dist, pred = dijkstra(graph, directed=True, indices=src, return_predecessors=True)
+    if not np.isfinite(dist[sink]):
+        why = "no route: the formation cannot pass between the obstacles and walls"
+        reasons = list(dict.fromkeys(r for L in layers for r in L.reasons))
+        if reasons:
+            why += " and cannot cross (" + "; ".join(reasons) + ")"
+        return _no_route(why)
+    path = [int(pred[sink])]
+    while path[-1] != src:
+        path.append(int(pred[path[-1]]))
+    legs, first = _legs(path[::-1][1:], layers, offsets)
+    return Route(True, "ok", f"route of {len(legs)} legs, {float(dist[sink]):.2f} s", legs,
+                 float(dist[sink]), tuple(forms), first)

@@ -15,7 +15,7 @@ import numpy as np
 from shapely.geometry import Point, Polygon
 
 from .._validate import as_count
-from ..sheet.model import Sheet
+from ..sheet import Sheet
 from .formation import optimal_formation
 from .world import Obstacle, Scenario, Team, World
 
@@ -86,7 +86,7 @@ def generate_scenario(seed: int, n_robots: int | None = None) -> Scenario:
     start = start_c + (line[1] - line[0]) / along[0] * keep_out
     goal = goal_c - (line[-1] - line[-2]) / along[-1] * keep_out
     obstacles: list[Obstacle] = []
-    geoms = []
+    geoms: list[Polygon] = []
     want = int(rng.integers(1, 5))
     for _ in range(200):
         if len(obstacles) >= want:

@@ -19,7 +19,15 @@ from .._validate import as_array, as_nonnegative, as_points, as_positive
 from ..errors import InvalidInputError, PlanningError
 from ..sheet.model import Sheet, check_hold_height
 
-__all__ = ["Obstacle", "World", "Team", "Scenario", "CIRCLE_SEGMENTS"]
+__all__ = ["Obstacle", "World", "Team", "Scenario", "UnknownObstacleError", "CIRCLE_SEGMENTS"]
+
+
+class UnknownObstacleError(InvalidInputError, KeyError):
+    """:meth:`World.obstacle` was asked for an id no obstacle has (a ``KeyError`` too, for
+    code written against the old behaviour)."""
+
+    def __str__(self) -> str:                  # KeyError would quote the message
+        return f"{self.field}: {self.problem}"
 
 #: Segments per quarter circle used to turn a circular obstacle into a shapely polygon
 #: (the polygon is circumscribed, so it contains the true circle).
@@ -160,11 +168,18 @@ class World:
         object.__setattr__(self, "_width", 2.0 * float(radius))
 
     def obstacle(self, oid: str) -> Obstacle:
-        """The obstacle with this id."""
+        """The obstacle with this id.
+
+        Raises
+        ------
+        UnknownObstacleError
+            No obstacle has this id (also a ``KeyError``, as before).
+        """
         for o in self.obstacles:
             if o.id == oid:
                 return o
-        raise KeyError(oid)
+        known = ", ".join(repr(o.id) for o in self.obstacles) or "none"
+        raise UnknownObstacleError("oid", f"no obstacle {oid!r} (known: {known})")
 
     @property
     def width(self) -> float:

@@ -1,6 +1,7 @@
-"""Figures of transport plans, after the planning paper's Figs. 8-10: top view with paths
-and obstacles, object height over time against the obstacles beneath it, entering/exiting
-side angles during crossings, inter-robot distances; and an animated GIF."""
+"""Figures of transport plans, after the planning paper's Figs. 8-10: top view with robot
+footprints, sheet outlines and the object's path, object height over time against the
+obstacles beneath it, entering/exiting side angles during Algorithm 2 crossings, robot
+pair distances against their sheet limits; and an animated GIF."""
 
 from __future__ import annotations
 
@@ -50,32 +51,29 @@ def _beneath(scenario: Scenario, r: PlanResult) -> np.ndarray:
     return out
 
 
-def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
-    """Four-panel summary figure of a successful plan (PNG/PDF by extension)."""
-    r = result
-    fig, axs = plt.subplots(2, 2, figsize=(12, 8))
-    ax = axs[0, 0]
+def _top_view(ax, scenario: Scenario, r: PlanResult) -> None:
+    """Walls, obstacles, robot paths, footprints and sheet outlines, the object's path."""
     draw_world(ax, scenario)
     for i in range(r.robots.shape[1]):
-        ax.plot(r.robots[:, i, 0], r.robots[:, i, 1], lw=0.8, label=f"robot {i + 1}")
-    ax.plot(r.object[:, 0], r.object[:, 1], "k--", lw=1, label="object")
-    step = max(1, len(r.times) // 12)
-    for t in range(0, len(r.times), step):
-        ax.add_patch(PolygonPatch(r.robots[t], closed=True, fill=False, ec="tab:blue",
-                                  lw=0.4, alpha=0.6))
-    ax.set_title(f"top view: crossed {list(r.crossed)}, {r.duration:.1f} s")
+        ax.plot(r.robots[:, i, 0], r.robots[:, i, 1], lw=0.6, alpha=0.7, label=f"robot {i + 1}")
+    ax.plot(r.object[:, 0], r.object[:, 1], "k-", lw=1.4, label="object")
+    step = max(1, len(r.times) // 10)
+    for t in [*range(0, len(r.times), step), len(r.times) - 1]:
+        hull = shapely.convex_hull(shapely.multipoints(r.robots[t]))
+        ax.add_patch(PolygonPatch(np.asarray(hull.exterior.coords), closed=True,
+                                  fc="tab:blue", alpha=0.08, ec="tab:blue", lw=0.5))
+        for p in r.robots[t]:
+            ax.add_patch(Circle(p, scenario.team.robot_radius, fill=False, ec="tab:blue",
+                                lw=0.4, alpha=0.6))
+    ax.set_title(f"top view: crossed {list(r.crossed)}, {r.duration:.1f} s, "
+                 f"{r.path_length:.2f} m")
     ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    ax = axs[0, 1]
-    ax.plot(r.times, r.object[:, 2], label="object height (model)")
-    ax.fill_between(r.times, 0, _beneath(scenario, r), color="0.6", step="mid",
-                    label="obstacle beneath the sheet")
-    ax.axhline(scenario.team.hold_height, color="k", ls=":", lw=0.8, label="hold height")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("height [m]")
-    ax.legend(fontsize=7)
-    ax.set_title("object height vs obstacles")
-    ax = axs[1, 0]
-    for c in r.crossings:
+
+
+def _sides(ax, r: PlanResult) -> None:
+    """Entering/exiting side angles during Algorithm 2 crossings (empty otherwise)."""
+    alg2 = [c for c in r.crossings if c.kind == "algorithm2"]
+    for c in alg2:
         sel = (r.times >= c.times[0]) & (r.times <= c.times[4])
         ent = np.degrees(np.angle(np.exp(1j * (r.heading[sel] + c.entering - c.direction))))
         ext = np.degrees(np.angle(np.exp(1j * (r.heading[sel] + c.exiting - c.direction
@@ -84,24 +82,58 @@ def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
         ax.plot(r.times[sel], ext, "--", label=f"{c.obstacle}: exiting side")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("angle to travel axis [deg]")
-    ax.set_title("entering/exiting sides during crossings")
-    if r.crossings:
+    ax.set_title("entering/exiting sides (Algorithm 2 crossings)")
+    if alg2:
         ax.legend(fontsize=7)
-    ax = axs[1, 1]
+    else:
+        ax.text(0.5, 0.5, "no Algorithm 2 crossing in this plan", ha="center",
+                va="center", transform=ax.transAxes, fontsize=9, color="0.4")
+
+
+def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
+    """Pairwise robot distances against their sheet limits (and the margin)."""
     n = r.robots.shape[1]
+    V = scenario.team.sheet.vertices
     iu, ju = np.triu_indices(n, 1)
     d = np.linalg.norm(r.robots[:, iu] - r.robots[:, ju], axis=2)
+    limit = np.linalg.norm(V[iu] - V[ju], axis=1)
+    ratio = d / limit
     for k in range(len(iu)):
-        ax.plot(r.times, d[:, k], lw=0.8, label=f"|r{iu[k] + 1} - r{ju[k] + 1}|")
+        ax.plot(r.times, ratio[:, k], lw=0.8, label=f"|r{iu[k] + 1} - r{ju[k] + 1}|")
+    ax.axhline(1.0, color="k", lw=1.0, label="sheet limit")
+    if r.sheet_margin > 0:
+        ax.axhline(1.0 - r.sheet_margin / limit.min(), color="k", ls=":", lw=0.8,
+                   label=f"margin {r.sheet_margin * 1e3:.0f} mm (shortest pair)")
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("distance [m]")
-    ax.set_title("inter-robot distances")
-    ax.ticklabel_format(axis="y", useOffset=False)
-    lo, hi = float(d.min()), float(d.max())
-    pad = max(0.05 * (hi - lo), 0.02 * max(hi, 1e-9))      # rigid formations: flat lines
-    ax.set_ylim(lo - pad, hi + pad)
+    ax.set_ylabel("robot distance / sheet distance")
+    ax.set_title(f"pair distances vs sheet limits (least slack "
+                 f"{(limit[None] - d).min() * 1e3:.1f} mm)")
+    ax.set_ylim(min(0.0, float(ratio.min()) - 0.05), 1.08)
     if len(iu) <= 10:
-        ax.legend(fontsize=6)
+        ax.legend(fontsize=6, ncol=2)
+
+
+def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
+    """Four-panel summary figure of a successful plan (PNG/PDF by extension): top view
+    with robot footprints, sheet outlines and the object's path; object height against
+    the obstacles beneath the sheet; entering/exiting sides of Algorithm 2 crossings;
+    pairwise robot distances against their sheet limits."""
+    r = result
+    fig, axs = plt.subplots(2, 2, figsize=(12, 8))
+    _top_view(axs[0, 0], scenario, r)
+    ax = axs[0, 1]
+    ax.plot(r.times, r.object[:, 2], label="object height (model)")
+    ax.fill_between(r.times, 0, _beneath(scenario, r), color="0.6", step="mid",
+                    label="tallest obstacle beneath the sheet")
+    ax.plot(r.times, _beneath(scenario, r) + scenario.team.height_safety, color="0.3",
+            ls="--", lw=0.7, label="+ height safety")
+    ax.axhline(scenario.team.hold_height, color="k", ls=":", lw=0.8, label="hold height")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("height [m]")
+    ax.legend(fontsize=7)
+    ax.set_title("object height vs obstacles beneath")
+    _sides(axs[1, 0], r)
+    _distances(axs[1, 1], scenario, r)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
