@@ -87,6 +87,8 @@ def regular_team(n: int, *, radius: float = 1000.0, hold_height: float = 1000.0,
     centre = np.zeros(2) + 0.05 * radius          # off the symmetry centre
     target = (*centre, 0.5 * hold_height)
     ik = inverse_kinematics(sheet, target, hold_height)
+    if not ik.success:                 # regular teams are always reachable there; guard anyway
+        raise InvalidInputError("n", f"no formation for a regular {n}-gon team: {ik.message}")
     rng = np.random.default_rng(seed)
     formation = centre + 0.8 * (ik.formation - centre)
     formation = formation + rng.uniform(-0.01, 0.01, formation.shape) * radius

@@ -41,6 +41,9 @@ def _default_formation(sc: SheetScenario) -> np.ndarray:
     depth = min(0.5 * float(np.linalg.norm(sc.sheet.vertices - vo, axis=1).min()),
                 0.5 * sc.hold_height)
     ik = inverse_kinematics(sc.sheet, (*vo, sc.hold_height - depth), sc.hold_height)
+    if not ik.success:
+        raise InvalidInputError("formation", "missing, and no all-taut formation holds the "
+                                f"object under the sheet's centroid ({ik.message})")
     return ik.formation
 
 

@@ -327,9 +327,11 @@ def _nominal_ik(team: Team, heights: np.ndarray):
     """First IK solution at the sheet centroid among object ``heights`` (m)."""
     for zo in heights:
         try:
-            return inverse_kinematics(team.sheet, [0.0, 0.0, zo], team.hold_height)
-        except TautError:
+            ik = inverse_kinematics(team.sheet, [0.0, 0.0, zo], team.hold_height)
+        except TautError:              # e.g. the object at or above the hold height
             continue
+        if ik.success:                 # unreachable / budget exhausted: try the next height
+            return ik
     return None
 
 
