@@ -10,7 +10,7 @@ limits are FASTKIT's (eqs. 10-16) unless overridden. Errors are :class:`taut.err
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 import typer
@@ -22,13 +22,16 @@ from ._cdpr_common import MODEL_HELP, Vec3, Vec6, load_robot, pose_vector, speed
 from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 
+if TYPE_CHECKING:
+    from ..cdpr import ModeName
+
 __all__ = ["add_commands"]
 
 #: Largest differential-evolution iteration count `deploy` accepts (8 takes about a minute).
 MAX_DEPLOY_ITERATIONS = 1000
 
 
-def _twist_set(model: str, pose: Any, rpy: Any, mode: str, moving: Any, base_speed: float,
+def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, base_speed: float,
                yaw_rate: float, cable_speed: float, stabilisers: bool, as_json: bool,
                plot: Optional[Path]) -> None:
     from ..cdpr import MotionLimits, available_twist_set, twist_capacities
@@ -154,8 +157,8 @@ def add_commands(sub: typer.Typer) -> None:
         if mode not in ("task", "navigation"):
             raise InvalidInputError("mode", f"must be task or navigation, got {mode!r}")
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
-        _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed,
-                   stabilisers, as_json, plot)
+        _twist_set(model, pose, rpy, "task" if mode == "task" else "navigation", moving,
+                   base_speed, yaw_rate, cable_speed, stabilisers, as_json, plot)
 
     @sub.command("deploy")
     def deploy_cmd(

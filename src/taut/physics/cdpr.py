@@ -19,7 +19,8 @@ import numpy as np
 
 from .._outcome import check_status
 from .._validate import as_array, as_positive
-from ..cdpr import CableRobot, distribute_tensions, rotation_matrices, tipping_moments
+from ..cdpr import (CableRobot, TensionMethod, distribute_tensions, rotation_matrices,
+                    tipping_moments)
 from ..cdpr.kinematics import as_poses
 from ..errors import InvalidInputError
 from . import _tol
@@ -249,7 +250,8 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
                         check_status("ok" if ok else "unverified"), msg)
 
 
-def check_tipping_grid(robot: CableRobot, poses: Any, *, method: str = "lp_min_sum",
+def check_tipping_grid(robot: CableRobot, poses: Any, *,
+                       method: TensionMethod = "lp_min_sum",
                        tipping: bool = False, friction: float = _tol.FLOOR_FRICTION,
                        duration: float = _tol.CDPR_DURATION,
                        progress: Callable[[int, int], None] | None = None
