@@ -314,8 +314,8 @@ def test_no_shell_completion_offered(capsys):
 def test_plan_baseline_plot_says_why_not(capsys, tmp_path):
     target = tmp_path / "x.png"
     code, out, err = run(capsys, "plan", ROOT / "examples" / "plan" / "paper_corridor.yaml",
-                         "--baseline", "--plot", target)
-    assert code == 1 and out.startswith("no plan: ")
+                         "--disc-baseline", "--plot", target)
+    assert code == 1 and out.startswith("no plan (no_route): ")
     assert err == f"taut: --plot: {target} not written: there is no plan to draw\n"
     assert not target.exists()
 
@@ -324,8 +324,9 @@ def test_plan_json_is_a_flag_like_every_other(capsys, tmp_path):
     """`plan --json` prints JSON on stdout (like fk, ik, cdpr ...); --out writes a file."""
     out_file = tmp_path / "p.json"
     code, out, _ = run(capsys, "plan", ROOT / "examples" / "plan" / "paper_corridor.yaml",
-                       "--baseline", "--json", "--out", out_file)
+                       "--disc-baseline", "--json", "--out", out_file)
     assert code == 1
     doc = json.loads(out)
     assert doc == json.loads(out_file.read_text())
-    assert doc["success"] is False and doc["reason"].startswith("no route")
+    assert doc["success"] is False and doc["status"] == "no_route"
+    assert doc["reason"] == doc["message"] and doc["message"]

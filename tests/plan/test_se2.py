@@ -266,15 +266,16 @@ def test_cli_checks_output_paths_first_and_exits_1_without_plan(tmp_path, capsys
 
     from .test_plan import _app
     yaml = str(EXAMPLES / "paper_corridor.yaml")
+    (tmp_path / "file").write_text("x")
     with pytest.raises(TautError) as e:
-        _app()(args=["plan", yaml, "--json", str(tmp_path / "missing" / "p.json")],
+        _app()(args=["plan", yaml, "--out", str(tmp_path / "file" / "p.json")],
                standalone_mode=False)
-    assert e.value.field == "--json"
-    assert "planning" not in capsys.readouterr().err          # refused before any work
+    assert e.value.field == "--out"
+    assert capsys.readouterr().err == ""                      # refused before any work
     out = tmp_path / "p.json"
-    rc = _app()(args=["plan", yaml, "--disc-baseline", "--json", str(out)],
+    rc = _app()(args=["plan", yaml, "--disc-baseline", "--out", str(out)],
                 standalone_mode=False)
     captured = capsys.readouterr()
     data = json.loads(out.read_text())
     assert rc == 1 and data["status"] == "no_route" and data["planner"] == "disc"
-    assert "no plan (no_route)" in captured.out and "planning" in captured.err
+    assert "no plan (no_route)" in captured.out

@@ -71,7 +71,7 @@ def test_example1_statuses(reference):
     assert status == {(1, 2, 3): "stable", (1, 3, 4): "stable",
                       (1, 2, 3, 4): "not_equilibrium"}
     w = as_table(r)[(1, 2, 3, 4)].weights
-    np.testing.assert_allclose(w, [1.03, -0.48, 0.95, -0.51], atol=0.01)   # DESIGN.md Sec. 3
+    np.testing.assert_allclose(w, [1.03, -0.48, 0.95, -0.51], atol=0.01)   # docs/sheet_kinematics.md §3
 
 
 def test_example1_not_equilibrium_state_can_descend(reference):

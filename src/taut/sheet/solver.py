@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array, as_positive
+from .._validate import as_array, as_positive, require_nonempty
 from ..errors import InvalidInputError
 from ._candidates import hull_candidates, padded_small_subsets
 from ._finalize import _min_eig_family, _weights_family
@@ -297,7 +297,7 @@ class FKSolver:
                                         self.method)
         N = self.sheet.n
         if check:
-            Rb = as_array(formations, "formations", ndim=3)
+            Rb = require_nonempty(as_array(formations, "formations", ndim=3), "formations")
             if Rb.shape[1:] != (N, 2):
                 check_formations(self.sheet, Rb)    # raises the shape error
             mass = _check_mass(mass)
