@@ -83,9 +83,9 @@ def test_a_killed_worker_loses_and_duplicates_nothing(fk_spec, tmp_path, same_ro
     spec = fk_spec(scale={"range": [0.5, 1.0], "num": 30}, stretch_angle=[0, 30, 60, 90, 120, 150],
                    stretch=1.25)                      # 180 points, 12 chunks
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=":0", silence_logs=logging.ERROR) as cluster, \
-            distributed.Client(cluster) as client:
-        pids = list(client.run(os.getpid).values())
+                                  dashboard_address=":0", silence_logs=logging.ERROR) as cluster:
+        with distributed.Client(cluster) as client:   # closed before the sweep's own client
+            pids = list(client.run(os.getpid).values())
         killed = []
 
         def kill_one(done, total):

@@ -239,7 +239,7 @@ def _execute(spec: SweepSpec, bounds: list[tuple[int, int]], todo: list[int],
                 if isinstance(exc, TautError):
                     raise
                 raise _WorkerFailure(f"chunk {index[fut.key]} failed on the cluster "
-                                     f"({type(exc).__name__})") from None
+                                     f"({type(exc).__name__}: {exc})") from None
             yield index[fut.key], cols
     finally:
         cluster = getattr(client, "cluster", None)
