@@ -95,28 +95,37 @@ def _solve_group(ctx: _Context, forms: np.ndarray, hold: float, mass: float | No
             except InfeasibleFormationError:
                 out["feasible"][r] = False
                 continue
-            _store(one, 0, out, r)
+            _store_all(one, out, np.array([r]))
         return
-    for k, r in enumerate(rows):
-        _store(res, k, out, r)
+    _store_all(res, out, rows)
 
 
-def _store(res: Any, k: int, out: Columns, r: int) -> None:
-    status = res.status[k]
-    out["n_equilibria"][r] = int(np.sum((status == 0) | (status == 1)))
-    out["n_stable"][r] = int(np.sum(status == 0))
-    out["n_saddle"][r] = int(np.sum(status == 1))
-    out["n_states"][r] = int(res.count[k])
-    stable = np.flatnonzero(status == 0)
-    if stable.size == 0:
+def _store_all(res: Any, out: Columns, rows: np.ndarray) -> None:
+    """Every row of a batch at once: counts, and the lowest stable state of each formation."""
+    status = res.status                                   # (B, K), -1 padding
+    out["n_equilibria"][rows] = np.sum((status == 0) | (status == 1), axis=1)
+    out["n_stable"][rows] = np.sum(status == 0, axis=1)
+    out["n_saddle"][rows] = np.sum(status == 1, axis=1)
+    out["n_states"][rows] = res.count
+    if status.shape[1] == 0:
         return
-    low = stable[np.argmin(res.object[k, stable, 2])]
-    taut = np.flatnonzero(res.taut[k, low])
-    out["lowest_height"][r] = res.object[k, low, 2]
-    out["lowest_taut"][r] = ",".join(str(int(i)) for i in taut)
-    out["min_share"][r] = float(res.weights[k, low, taut].min())
+    z = np.where(status == 0, res.object[..., 2], np.inf)
+    low = np.argmin(z, axis=1)
+    b = np.flatnonzero(np.isfinite(z[np.arange(len(low)), low]))
+    if b.size == 0:
+        return
+    lb = low[b]
+    taut = res.taut[b, lb]                                # (b, N) bool
+    out["lowest_height"][rows[b]] = res.object[b, lb, 2]
+    out["min_share"][rows[b]] = np.min(np.where(taut, res.weights[b, lb], np.inf), axis=1)
     if res.tensions is not None:
-        out["max_tension"][r] = float(res.tensions[k, low, taut].max())
+        out["max_tension"][rows[b]] = np.max(np.where(taut, res.tensions[b, lb], -np.inf),
+                                             axis=1)
+    codes = taut @ (1 << np.arange(taut.shape[1], dtype=np.int64))
+    uniq, first = np.unique(codes, return_index=True)
+    names = {int(c): ",".join(str(i) for i in np.flatnonzero(taut[f]))
+             for c, f in zip(uniq, first)}
+    out["lowest_taut"][rows[b]] = [names[int(c)] for c in codes]
 
 
 def _run(ctx: _Context, cols: Columns, seeds: np.ndarray) -> Columns:
