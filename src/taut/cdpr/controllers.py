@@ -18,6 +18,7 @@ with the seeded encoder offsets): the paper's ongoing work adds cameras for the 
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Literal
 
@@ -100,15 +101,15 @@ class Measurement:
     speed: np.ndarray
 
 
-class Controller:
+class Controller(ABC):
     """Interface: ``mode`` ("torque" or "speed") and ``command(ctx, k, meas)`` -> (B, m)."""
 
     name: ClassVar[str] = "controller"
     mode: ClassVar[CommandMode] = "torque"
 
+    @abstractmethod
     def command(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
         """Motor torques (N m) or speed set-points (rad/s) at control step ``k``."""
-        raise NotImplementedError
 
     def describe(self) -> dict[str, Any]:
         """Name and gains, JSON-friendly."""

@@ -11,7 +11,7 @@ Keys (SI, motor side): ``cable_stiffness`` (EA, N), ``cable_damping`` (N s),
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from pydantic import BaseModel, ConfigDict
 
@@ -24,20 +24,22 @@ __all__ = ["load_cdpr_dynamics", "dynamics_from_mapping"]
 
 class _Dynamics(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    cable_stiffness: float = 2.0e4
-    cable_damping: float = 50.0
-    drum_diameter: float = 0.08
-    gear_ratio: float = 5.0
-    efficiency: float = 0.7
-    motor_torque_limit: float = 0.6
-    motor_speed_limit: float = 250.0
-    rotor_inertia: float = 4.5e-5
-    friction_static: float = 0.02
-    friction_coulomb: float = 0.015
-    friction_viscous: float = 2.0e-5
-    stribeck_speed: float = 5.0
-    drive_speed_gain: float = 0.027
-    drive_integral_gain: float = 4.0
+    # Defaults live in DynamicsModel only: a key left out keeps its default there; an
+    # explicit null reaches DynamicsModel and is refused by its own checks.
+    cable_stiffness: Optional[float] = None
+    cable_damping: Optional[float] = None
+    drum_diameter: Optional[float] = None
+    gear_ratio: Optional[float] = None
+    efficiency: Optional[float] = None
+    motor_torque_limit: Optional[float] = None
+    motor_speed_limit: Optional[float] = None
+    rotor_inertia: Optional[float] = None
+    friction_static: Optional[float] = None
+    friction_coulomb: Optional[float] = None
+    friction_viscous: Optional[float] = None
+    stribeck_speed: Optional[float] = None
+    drive_speed_gain: Optional[float] = None
+    drive_integral_gain: Optional[float] = None
 
 
 class _Section(BaseModel):
@@ -53,7 +55,7 @@ def dynamics_from_mapping(data: dict[str, Any] | None) -> DynamicsModel:
     if data is None:
         return DynamicsModel()
     raw = validate_mapping(_Section, {"dynamics": data})
-    return DynamicsModel(**raw.dynamics.model_dump())
+    return DynamicsModel(**raw.dynamics.model_dump(exclude_unset=True))
 
 
 def load_cdpr_dynamics(source: str | Path) -> DynamicsModel:
