@@ -16,7 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._dyn_tol import EVENT_TENSION_TOL
+from ._tol import EVENT_TENSION_TOL
 
 _jit = numba.njit(cache=True)
 

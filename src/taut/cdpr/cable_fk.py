@@ -8,7 +8,7 @@ Method: batched Levenberg-Marquardt least squares on the length equations
 of eq. 1. Every sample starts from ``initial_guess`` (default: centre of the desired
 workspace, level); samples that do not converge are restarted from seeded random poses in
 the frame box. A result is ``success`` only when the largest length residual is below
-``taut.cdpr._dyn_tol.FK_RESIDUAL_TOL``; inconsistent lengths (no pose has them) end as
+``taut.cdpr._tol.FK_RESIDUAL_TOL``; inconsistent lengths (no pose has them) end as
 ``not_converged`` with the least-squares pose and its residual, never as a silent answer.
 With ``all_solutions=True`` every start is run and distinct zero-residual poses are counted
 (``n_solutions``): more than one means the lengths admit several assembly modes.
@@ -24,7 +24,7 @@ import numpy as np
 from .._validate import as_array
 from ..errors import InvalidInputError
 from ._bases import as_base_poses, moved_exits
-from ._dyn_tol import FK_MAX_ITER, FK_POLISH_TOL, FK_RESIDUAL_TOL, FK_SAME_SOLUTION
+from ._tol import FK_MAX_ITER, FK_POLISH_TOL, FK_RESIDUAL_TOL, FK_SAME_SOLUTION
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
 

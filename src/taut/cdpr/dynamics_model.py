@@ -148,7 +148,7 @@ class DynamicsModel:
         >>> float(d.friction(np.array(0.0)))
         0.0
         """
-        from ._dyn_tol import FRICTION_SPEED_WIDTH
+        from ._tol import FRICTION_SPEED_WIDTH
         w = np.asarray(speed, dtype=float)
         level = self.friction_coulomb + (self.friction_static - self.friction_coulomb) * \
             np.exp(-(w / self.stribeck_speed) ** 2)

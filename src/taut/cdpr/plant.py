@@ -14,7 +14,7 @@ then the configuration with the new velocities, the rotation on SO(3) by the exp
 without losses its energy error stays bounded (no drift), which the tests check over 2 s. It
 is stable while ``omega_max h < 2`` for the stiffest mode ``omega_max`` of the linearised
 platform-cable-rotor system; :func:`stiffest_mode` computes it, and a step with
-``omega_max h > taut.cdpr._dyn_tol.STABILITY_OMEGA_H`` is refused before the run.
+``omega_max h > taut.cdpr._tol.STABILITY_OMEGA_H`` is refused before the run.
 
 Energy: with no damping, friction or efficiency loss and constant motor torques the model is
 conservative up to one term: the strain energy ``EA (L - L0)^2 / (2 L0)`` of a cable whose
@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ._dyn_tol import EQUILIBRIUM_FORCE_TOL
+from ._tol import EQUILIBRIUM_FORCE_TOL
 from .cable_fk import so3_exp
 from .dynamics_model import DynamicsModel
 from .kinematics import rotation_matrices

@@ -16,7 +16,7 @@ import numpy as np
 from .._validate import (MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded,
                          as_nonnegative, as_positive)
 from ..errors import InvalidInputError, InvalidTrajectoryError
-from ._dyn_tol import MAX_REFERENCE_SPEED
+from ._tol import MAX_REFERENCE_SPEED
 from .kinematics import as_poses
 from .model import CableRobot
 

@@ -17,7 +17,7 @@ import numpy as np
 from .._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
                          as_nonnegative, as_positive)
 from ..errors import InvalidInputError
-from ._dyn_tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H
+from ._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H
 from .cable_fk import rpy_from_matrices
 from .controllers import (ControlContext, Controller, Measurement, TorqueController,
                           VelocityController)
@@ -180,7 +180,7 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
     """Run the compiled loop; returns records (n/rec_every, Brec, 12 + 3m), per-plant
     summaries (B, 6) and the first diverged step per plant (-1 if none)."""
     from ._sim_kernel import run
-    from ._dyn_tol import FRICTION_SPEED_WIDTH
+    from ._tol import FRICTION_SPEED_WIDTH
     pl, s, ctx, geo, d = setup.plant, setup.state, setup.ctx, setup.geo, setup.dyn
     n, m, B = len(setup.times), setup.robot.m, pl.B
     if isinstance(controller, VelocityController):

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from .._outcome import check_status
-from ._dyn_tol import EVENT_TENSION_TOL
+from ._tol import EVENT_TENSION_TOL
 from .cable_fk import rpy_from_matrices
 from .controllers import Controller
 from .monitors import ControlEvent, episodes, tipping_margins
@@ -128,7 +128,7 @@ def _edge_names(robot: Any) -> tuple[str, ...]:
 
 def _first_bad(setup: Any, xc: np.ndarray) -> int:
     lo, hi = setup.robot.bounds
-    from ._dyn_tol import DIVERGENCE_MARGIN
+    from ._tol import DIVERGENCE_MARGIN
     bad = ~np.all(np.isfinite(xc) & (xc > lo - DIVERGENCE_MARGIN) & (xc < hi + DIVERGENCE_MARGIN),
                   axis=1)
     return int(np.argmax(bad)) if bad.any() else len(xc)

@@ -94,7 +94,7 @@ def add_simulate(sub: typer.Typer) -> None:
         from ..io.cdpr_reference import read_reference_csv
         from ..io.files import write_json
         from ..io.serialize import to_json
-        from ..io.serialize_cdpr_sim import control_result_to_dict
+        from ..io.serialize import control_result_to_dict
 
         robot = load_robot(model, stabilisers)
         dyn = load_cdpr_dynamics(model)

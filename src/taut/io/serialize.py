@@ -19,6 +19,7 @@ import numpy as np
 if TYPE_CHECKING:                                  # imported lazily: keep `taut --help` fast
     from ..cdpr.deploy import DeploymentResult
     from ..cdpr.model import CableRobot
+    from ..cdpr.sim import ControlResult, MonteCarloResult
     from ..cdpr.tension import TensionResult
     from ..cdpr.twist import TwistCapacities
     from ..cdpr.workspace import WorkspaceResult
@@ -30,7 +31,8 @@ if TYPE_CHECKING:                                  # imported lazily: keep `taut
 __all__ = ["to_json", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dict",
            "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",
            "wrench_set_to_dict", "workspace_to_dict", "twist_set_to_dict",
-           "deployment_to_dict", "equilibria_check_to_dict"]
+           "deployment_to_dict", "equilibria_check_to_dict", "control_result_to_dict",
+           "monte_carlo_to_dict"]
 
 _MISSING = object()
 
@@ -283,3 +285,41 @@ def equilibria_check_to_dict(check: Any) -> dict[str, Any]:
                     "moved": float(s.moved), "time_s": float(s.time)}
                    for s in check.states],
     }
+
+
+# --- cable robot control simulation (field names as in taut.cdpr.ControlResult) ---
+
+
+def _rounded_list(a: np.ndarray, digits: int = 9) -> Any:
+    return np.round(np.asarray(a, dtype=float), digits).tolist()
+
+
+def control_result_to_dict(r: "ControlResult") -> dict[str, Any]:
+    """Every field of the result; arrays as nested lists (SI units)."""
+    return {
+        "success": bool(r.success), "status": r.status, "message": r.message,
+        "controller": r.controller,
+        "times": _rounded_list(r.times), "poses": _rounded_list(r.poses), "reference": _rounded_list(r.reference),
+        "tracking_error": _rounded_list(r.tracking_error, 12),
+        "orientation_error": _rounded_list(r.orientation_error, 12),
+        "tensions": _rounded_list(r.tensions, 6), "motor_torques": _rounded_list(r.motor_torques, 9),
+        "motor_speeds": _rounded_list(r.motor_speeds, 6), "tipping_margin": _rounded_list(r.tipping_margin, 6),
+        "base_poses": _rounded_list(r.base_poses),
+        "events": [{"kind": e.kind, "index": e.index, "name": e.name, "start": e.start,
+                    "end": e.end, "worst": e.worst, "limit": e.limit} for e in r.events],
+        "t_min": _rounded_list(r.t_min), "t_max": _rounded_list(r.t_max),
+        "cable_names": list(r.cable_names), "edge_names": list(r.edge_names),
+        "slack_time": r.slack_time, "worst_over_tension": r.worst_over_tension,
+        "worst_under_tension": r.worst_under_tension,
+    }
+
+
+def monte_carlo_to_dict(r: "MonteCarloResult") -> dict[str, Any]:
+    """Per-run arrays as lists."""
+    out: dict[str, Any] = {"controller": r.controller, "message": r.message}
+    for name in ("max_tracking_error", "rms_tracking_error", "min_tension", "max_tension",
+                 "slack_time", "worst_over_tension", "min_tipping_margin"):
+        out[name] = _rounded_list(getattr(r, name))
+    out["success"] = [bool(x) for x in r.success]
+    out["status"] = [str(x) for x in r.status]
+    return out

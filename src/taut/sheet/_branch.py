@@ -22,7 +22,7 @@ from scipy.optimize import linprog
 from ._descent import descend
 from ._kernel import (CURVATURE_TOL, TAUT_TOL, WEIGHT_TOL, Frame, height_ok,
                       reduced_hessian_min_eig, solve_candidates, taut_masks)
-from ._tol_motion import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL,
+from ._tol import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL,
                           EVENT_STEP_TOL, SUBSETS_UP_TO, SUPPORT_RANK_RTOL)
 from .fk import forward_kinematics, forward_kinematics_batch
 from .model import Sheet

@@ -44,7 +44,7 @@ from typing import Literal
 import numpy as np
 from scipy.optimize import linprog
 
-from ._tol_motion import CERTIFICATE_MIN_MARGIN, RELAX_COS_SLACK, SPACING_MARGIN
+from ._tol import CERTIFICATE_MIN_MARGIN, RELAX_COS_SLACK, SPACING_MARGIN
 
 __all__ = ["IKCertificate", "CertificateKind", "depth_certificate", "radial_certificate",
            "triangle_certificate", "closure_lp_certificate", "verify_certificate",

@@ -28,7 +28,7 @@ from scipy.optimize import linprog, minimize
 
 from ._ik_weights import closure_directions
 from ._kernel import Frame, reduced_hessian_min_eig
-from ._tol_motion import (BOUNDARY_RTOL, EQUATION_RTOL, MIN_CURVATURE, MIN_WEIGHT)
+from ._tol import (BOUNDARY_RTOL, EQUATION_RTOL, MIN_CURVATURE, MIN_WEIGHT)
 
 __all__ = ["robots", "curvature", "check_solution", "joint_optimise", "multistart_search",
            "Candidate"]

@@ -57,7 +57,7 @@ from ._ik_results import IKConstraints, IKResult
 from ._ik_search import (Candidate, check_solution, curvature, joint_optimise,
                          multistart_search)
 from ._ik_weights import closure_directions, maxent_weights
-from ._tol_motion import DEFAULT_BUDGET, VERIFY_RTOL
+from ._tol import DEFAULT_BUDGET, VERIFY_RTOL
 from .fk import _check_mass, _check_sheet, forward_kinematics
 from .model import Sheet, check_hold_height
 from .results import GRAVITY
