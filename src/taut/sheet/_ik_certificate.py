@@ -11,7 +11,7 @@ divided by the sheet size), robot ``i`` stands at :math:`\\mathbf{r}_i = \\rho_i
   \\mathbf{v}_j|`, i.e. :math:`\\cos(\\theta_i - \\theta_j) \\ge c_{ij} = (\\rho_i^2 +
   \\rho_j^2 - D_{ij}^2) / (2 \\rho_i \\rho_j)`.
 
-Four certificates, each checkable by :func:`verify_certificate` from the target alone:
+Five certificates, each checkable by :func:`verify_certificate` from the target alone:
 
 ``depth``
     The object is not strictly between the hands and a cable's full length below them:
@@ -34,6 +34,11 @@ Four certificates, each checkable by :func:`verify_certificate` from the target 
     W` has :math:`y^T M w = \\sum_k w_k g_k > 0`, so some cable cannot be balanced. The
     certificate stores ``y`` and ``lam``; the cosine bounds are loosened by
     RELAX_COS_SLACK so rounding only enlarges the relaxation.
+``closure_branch``
+    A tighter relaxation, branched: the closure seen from every cable's own frame with the
+    other cables' angles confined to arcs, the angle space split into boxes until each box
+    is refuted by one pair limit or by that relaxation (:mod:`taut.sheet._ik_branch`); the
+    certificate stores the tree of splits and each leaf's multipliers.
 """
 
 from __future__ import annotations
@@ -44,13 +49,16 @@ from typing import Literal
 import numpy as np
 from scipy.optimize import linprog
 
+from ._ik_branch import BranchProof, branch_proof, verify_branch_proof
 from ._tol import CERTIFICATE_MIN_MARGIN, RELAX_COS_SLACK, SPACING_MARGIN
 
 __all__ = ["IKCertificate", "CertificateKind", "depth_certificate", "radial_certificate",
            "triangle_certificate", "closure_lp_certificate", "verify_certificate",
+           "closure_branch_certificate",
            "pair_cosine_limits"]
 
-CertificateKind = Literal["depth", "radial_spacing", "triangle", "closure_lp"]
+CertificateKind = Literal["depth", "radial_spacing", "triangle", "closure_lp",
+                          "closure_branch"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,7 +67,7 @@ class IKCertificate:
 
     Attributes
     ----------
-    kind : {"depth", "radial_spacing", "triangle", "closure_lp"}
+    kind : {"depth", "radial_spacing", "triangle", "closure_lp", "closure_branch"}
     message : str
         One line in words.
     pair : tuple of int, or None
@@ -71,6 +79,8 @@ class IKCertificate:
     margin : float
         How strictly the proof holds (normalised units; >= 0, 0 only for an object at
         exactly the holding height).
+    proof : BranchProof, or None
+        The refutation tree of a ``closure_branch`` proof (:mod:`taut.sheet._ik_branch`).
     """
 
     kind: CertificateKind
@@ -79,6 +89,7 @@ class IKCertificate:
     multipliers: np.ndarray | None = field(default=None, repr=False)
     direction: np.ndarray | None = field(default=None, repr=False)
     margin: float = 0.0
+    proof: BranchProof | None = field(default=None, repr=False)
 
 
 def pair_cosine_limits(V: np.ndarray, rho: np.ndarray) -> np.ndarray:
@@ -192,6 +203,20 @@ def closure_lp_certificate(V: np.ndarray, rho: np.ndarray) -> IKCertificate | No
         margin=margin)
 
 
+def closure_branch_certificate(V: np.ndarray, rho: np.ndarray, max_boxes: int
+                               ) -> IKCertificate | None:
+    """The branched frame relaxation (module docstring), within ``max_boxes`` boxes."""
+    proof = branch_proof(V, rho, max_boxes=max_boxes)
+    if proof is None:
+        return None
+    return IKCertificate(
+        "closure_branch", "no all-taut formation exists for this target and contact: "
+        f"every arrangement of the cable directions ({proof.boxes} boxes of angles "
+        "examined) either puts a robot pair beyond its sheet distance or leaves the "
+        "horizontal pulls unbalanced for every load share of this contact point",
+        margin=CERTIFICATE_MIN_MARGIN, proof=proof)
+
+
 def verify_certificate(cert: IKCertificate, V: np.ndarray, rho: np.ndarray,
                        depth: float, lengths: np.ndarray) -> bool:
     """Re-check a certificate from the target data alone (normalised V (N, 2) with the
@@ -206,6 +231,8 @@ def verify_certificate(cert: IKCertificate, V: np.ndarray, rho: np.ndarray,
         from ._ik_weights import maxent_weights
         w = maxent_weights(V, np.zeros(2), 1.0)
         return len(rho) == 3 and triangle_certificate(V, rho, w) is not None
+    if cert.kind == "closure_branch":
+        return cert.proof is not None and verify_branch_proof(cert.proof, V, rho)
     y, lam = cert.multipliers, cert.direction
     if y is None or lam is None or np.any(y < 0) or abs(y.sum() - 1.0) > 1e-12:
         return False

@@ -33,9 +33,11 @@ Choice within the family (the papers are silent; our documented objective):
    horizontal balance (closed form through a weighted geometric median);
 3. if that formation is infeasible or unstable, weights and angles are optimised jointly
    (SLSQP) for the same alignment with every condition as a constraint;
-4. if that fails too: a certificate of unreachability is sought (:mod:`._ik_certificate`),
-   and failing one, a multi-start search over the structure of the problem, pair limits
-   included at equality (:mod:`._ik_search`).
+4. if that fails too: a cheap certificate of unreachability is sought (exact triangle for
+   N = 3, LP relaxation; :mod:`._ik_certificate`); failing one, (a) a few starts of a
+   multi-start search over the structure of the problem, (b) the branch-and-bound proof
+   over the cable angles (:mod:`._ik_branch`), (c) the rest of the multi-start search
+   (pair limits included at equality, :mod:`._ik_search`).
 
 Every answer is verified with forward kinematics: it has a stable equilibrium with every
 cable taut at the target (within VERIFY_RTOL of the sheet size). With ``reference`` (e.g.
@@ -51,13 +53,14 @@ import numpy as np
 
 from .._validate import as_array, as_finite_scalar, as_positive
 from ..errors import InvalidInputError
-from ._ik_certificate import (IKCertificate, closure_lp_certificate, depth_certificate,
-                              radial_certificate, triangle_certificate)
+from ._ik_certificate import (IKCertificate, closure_branch_certificate,
+                              closure_lp_certificate, depth_certificate, radial_certificate,
+                              triangle_certificate)
 from ._ik_results import IKConstraints, IKResult
 from ._ik_search import (Candidate, check_solution, curvature, joint_optimise,
                          multistart_search)
 from ._ik_weights import closure_directions, maxent_weights
-from ._tol import DEFAULT_BUDGET, VERIFY_RTOL
+from ._tol import DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_SEARCHES, VERIFY_RTOL
 from .fk import _check_mass, _check_sheet, forward_kinematics
 from .model import Sheet, check_hold_height
 from .results import GRAVITY
@@ -330,7 +333,8 @@ def _failure(sheet: Sheet, t: _Target, status: str, message: str,
 def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float, *,
                        contact: object | None = None, heading: float = 0.0,
                        reference: object | None = None, mass: float | None = None,
-                       budget: int = DEFAULT_BUDGET, seed: int = 0) -> IKResult:
+                       budget: int = DEFAULT_BUDGET, seed: int = 0,
+                       branch_boxes: int = DEFAULT_BRANCH_BOXES) -> IKResult:
     """Robot formation that holds the object stably at ``object_position`` with every
     virtual cable taut (planning paper eq. 10; docs/sheet_kinematics.md §6).
 
@@ -357,6 +361,9 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
         Multi-start searches (step 4) before giving up with ``budget_exhausted``.
     seed : int
         Seed of the multi-start search (answers are deterministic for a given seed).
+    branch_boxes : int
+        Boxes of cable angles (one LP each) the branch-and-bound unreachability proof may
+        examine (step 4b) before IK gives up with ``budget_exhausted``; 0 skips the proof.
 
     Returns
     -------
@@ -386,6 +393,8 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
     t = _target(sheet, object_position, hold_height, contact)
     heading = as_finite_scalar(heading, "heading")
     budget = int(as_positive(budget, "budget")) if budget != 0 else 0
+    branch_boxes = (int(as_positive(branch_boxes, "branch_boxes")) if branch_boxes != 0
+                    else 0)
     ref_n = None
     if reference is not None:
         ref_n = (as_array(reference, "reference", shape=(sheet.n, 2)) - t.p[:2]) / t.scale
@@ -393,11 +402,11 @@ def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float
             or radial_certificate(t.V, t.rho, t.scale))
     if cert is not None:
         return _failure(sheet, t, "unreachable", cert.message, cert, 0)
-    return _search(sheet, t, heading, ref_n, mass, budget, seed)
+    return _search(sheet, t, heading, ref_n, mass, (budget, branch_boxes), seed)
 
 
 def _search(sheet: Sheet, t: _Target, heading: float, ref_n: np.ndarray | None,
-            mass: float | None, budget: int, seed: int) -> IKResult:
+            mass: float | None, budgets: tuple[int, int], seed: int) -> IKResult:
     """Steps 1-4 of the module docstring on a target with real reaches."""
     w = maxent_weights(sheet.vertices, t.vo, t.scale)
     phi = _preferred_directions(t, heading, ref_n)
@@ -414,11 +423,23 @@ def _search(sheet: Sheet, t: _Target, heading: float, ref_n: np.ndarray | None,
         ok, R, *_ = check_solution(t.V, t.rho, wt, th)
         return ok and _verified(sheet, t, t.p[:2] + t.scale * R)
 
-    found, tried = multistart_search(t.V, t.rho, w, phi, accept, budget=budget, seed=seed)
+    budget, boxes = budgets
+    early = min(budget, EARLY_SEARCHES)
+    found, tried = multistart_search(t.V, t.rho, w, phi, accept, budget=early, seed=seed)
+    if found is None:
+        cert = closure_branch_certificate(t.V, t.rho, boxes) if boxes else None
+        if cert is not None:
+            return _failure(sheet, t, "unreachable", "no stable all-taut formation exists "
+                            f"for this target and contact: {cert.message}", cert,
+                            runs + tried)
+        found, more = multistart_search(t.V, t.rho, w, phi, accept, budget=budget - early,
+                                        seed=seed + 1)
+        tried += more
     if found is not None:
         return _success(sheet, t, found, mass, runs + tried)
     return _failure(sheet, t, "budget_exhausted", "no stable all-taut formation found and "
                     f"no proof that none exists: closed-form closure, {runs} joint "
-                    f"optimisation(s), {tried} multi-start feasibility search(es) and the "
-                    "LP relaxation of the closing conditions (feasible) were tried",
+                    f"optimisation(s), {tried} multi-start feasibility search(es), the "
+                    "LP relaxation of the closing conditions (feasible) and the "
+                    f"branch-and-bound proof ({boxes} angle boxes) were tried",
                     None, runs + tried)
