@@ -83,7 +83,7 @@ def test_branch_budget_zero_reports_budget_exhausted():
     """Without the proof (branch_boxes=0) the same target is honestly budget_exhausted."""
     case = DATA["targets"][0]
     r = inverse_kinematics(Sheet(case["vertices"]), case["object"], 1.0,
-                           contact=case["contact"], budget=2, branch_boxes=0)
+                           contact=case["contact"], budget=1, branch_boxes=0)
     assert (r.status, r.certificate) == ("budget_exhausted", None)
     assert "branch-and-bound" in r.message
 

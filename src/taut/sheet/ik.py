@@ -34,10 +34,11 @@ Choice within the family (the papers are silent; our documented objective):
 3. if that formation is infeasible or unstable, weights and angles are optimised jointly
    (SLSQP) for the same alignment with every condition as a constraint;
 4. if that fails too: a cheap certificate of unreachability is sought (exact triangle for
-   N = 3, LP relaxation; :mod:`._ik_certificate`); failing one, (a) a few starts of a
-   multi-start search over the structure of the problem, (b) the branch-and-bound proof
-   over the cable angles (:mod:`._ik_branch`), (c) the rest of the multi-start search
-   (pair limits included at equality, :mod:`._ik_search`).
+   N = 3, LP relaxation; :mod:`._ik_certificate`); failing one, (a) a short
+   branch-and-bound proof over the cable angles (:mod:`._ik_branch`), (b) a few starts of
+   a multi-start search over the structure of the problem, (c) the full branch-and-bound
+   proof, (d) the rest of the multi-start search (pair limits included at equality,
+   :mod:`._ik_search`).
 
 Every answer is verified with forward kinematics: it has a stable equilibrium with every
 cable taut at the target (within VERIFY_RTOL of the sheet size). With ``reference`` (e.g.
@@ -60,7 +61,8 @@ from ._ik_results import IKConstraints, IKResult
 from ._ik_search import (Candidate, check_solution, curvature, joint_optimise,
                          multistart_search)
 from ._ik_weights import closure_directions, maxent_weights
-from ._tol import DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_SEARCHES, VERIFY_RTOL
+from ._tol import (DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_BRANCH_BOXES, EARLY_SEARCHES,
+                   VERIFY_RTOL)
 from .fk import _check_mass, _check_sheet, forward_kinematics
 from .model import Sheet, check_hold_height
 from .results import GRAVITY
@@ -425,9 +427,12 @@ def _search(sheet: Sheet, t: _Target, heading: float, ref_n: np.ndarray | None,
 
     budget, boxes = budgets
     early = min(budget, EARLY_SEARCHES)
-    found, tried = multistart_search(t.V, t.rho, w, phi, accept, budget=early, seed=seed)
+    cert = closure_branch_certificate(t.V, t.rho, min(boxes, EARLY_BRANCH_BOXES))
+    found, tried = (None, 0) if cert is not None else multistart_search(
+        t.V, t.rho, w, phi, accept, budget=early, seed=seed)
     if found is None:
-        cert = closure_branch_certificate(t.V, t.rho, boxes) if boxes else None
+        if cert is None and boxes > EARLY_BRANCH_BOXES:
+            cert = closure_branch_certificate(t.V, t.rho, boxes)
         if cert is not None:
             return _failure(sheet, t, "unreachable", "no stable all-taut formation exists "
                             f"for this target and contact: {cert.message}", cert,
