@@ -153,3 +153,27 @@ def test_ik_of_a_stable_fk_state_is_verified_or_certified(seed, n, pick, heading
     assert len(e.taut) < n, "an all-taut state's own target was refused"
     assert r.status == "unreachable", r.message
     assert verify_certificate(r.certificate, *normalised(sheet, e.object, e.contact))
+
+
+@pytest.mark.slow
+def test_every_answer_is_verified_or_certified_on_150_fk_targets():
+    """The benchmark's claim on fresh targets (seed 99, N = 3..12): no budget_exhausted,
+    every formation confirmed by FK, every certificate confirmed by the re-check."""
+    rng = np.random.default_rng(99)
+    outcomes = []
+    while len(outcomes) < 150:
+        n = int(rng.integers(3, 13))
+        sheet, R = random_team(n, rng)
+        stable = forward_kinematics(sheet, R, 1.0).stable
+        if not stable:
+            continue
+        e = stable[int(rng.integers(len(stable)))]
+        r = inverse_kinematics(sheet, e.object, 1.0, contact=e.contact,
+                               heading=float(rng.uniform(-np.pi, np.pi)))
+        if r.success:
+            assert verified_by_fk(sheet, r.formation, e.object, e.contact)
+        else:
+            assert r.status == "unreachable" and len(e.taut) < n, r.message
+            assert verify_certificate(r.certificate, *normalised(sheet, e.object, e.contact))
+        outcomes.append(r.status)
+    assert outcomes.count("ok") >= 140
