@@ -8,8 +8,13 @@ enough that the object stays above the ground) and counts, per noise decade, the
 whose forward kinematics has a stable state ("ok"), only unstable ones ("nostable") or
 none ("none"). Every team here has a stable rest state physically.
 
+With ``--compare`` it also solves every team with ``method="subsets"`` and with the
+numpy backend, and counts per decade the teams where "fast" and "subsets" (compiled) or
+the compiled and numpy "fast" disagree on the stable taut sets, with the largest object
+difference between agreeing answers (relative to the sheet size).
+
 Usage: ``python bench/stress_fk_degenerate.py [--teams 500] [--seed 3] [--n-min 4]
-[--n-max 30]``.
+[--n-max 30] [--compare]``.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from collections import Counter
 import numpy as np
 
 from taut.errors import TautError
-from taut.sheet import Sheet, forward_kinematics
+from taut.sheet import FKSolver, Sheet, forward_kinematics
 
 
 def main() -> None:
@@ -29,7 +34,9 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--n-min", type=int, default=4)
     ap.add_argument("--n-max", type=int, default=30)
+    ap.add_argument("--compare", action="store_true")
     args = ap.parse_args()
+    worst: Counter = Counter()
     rng = np.random.default_rng(args.seed)
     counts: Counter = Counter()
     for _ in range(args.teams):
@@ -43,11 +50,33 @@ def main() -> None:
         except TautError:
             continue
         kind = "ok" if res.stable else ("nostable" if res.equilibria else "none")
-        counts[(int(np.floor(np.log10(noise))), kind)] += 1
-    print("noise decade   ok  nostable  none")
+        dec = int(np.floor(np.log10(noise)))
+        counts[(dec, kind)] += 1
+        if args.compare:
+            _compare(Sheet(V), R, res, dec, counts, worst)
+    print("noise decade   ok  nostable  none" + ("  fast!=subsets  numba!=numpy  worst"
+                                                   if args.compare else ""))
     for dec in sorted({d for d, _ in counts}):
-        print(f"1e{dec:<4d}     {counts[(dec, 'ok')]:5d} {counts[(dec, 'nostable')]:9d} "
-              f"{counts[(dec, 'none')]:5d}")
+        line = (f"1e{dec:<4d}     {counts[(dec, 'ok')]:5d} {counts[(dec, 'nostable')]:9d} "
+                f"{counts[(dec, 'none')]:5d}")
+        if args.compare:
+            line += (f" {counts[(dec, 'methods')]:14d} {counts[(dec, 'backends')]:13d}"
+                     f"  {worst[dec]:.1e}")
+        print(line)
+
+
+def _compare(sheet: Sheet, R: np.ndarray, res, dec: int, counts: Counter,
+             worst: Counter) -> None:
+    """Count disagreements of "subsets" and of the numpy backend with ``res``."""
+    z = res.hold_height
+    other = {"methods": FKSolver(sheet, z, method="subsets").solve(R),
+             "backends": FKSolver(sheet, z, backend="numpy").solve(R)}
+    for name, o in other.items():
+        if [e.taut for e in o.stable] != [e.taut for e in res.stable]:
+            counts[(dec, name)] += 1
+            continue
+        for a, b in zip(res.stable, o.stable):
+            worst[dec] = max(worst[dec], float(np.abs(a.object - b.object).max()) / sheet.size)
 
 
 if __name__ == "__main__":

@@ -50,9 +50,19 @@ __all__ = ["forward_kinematics", "forward_kinematics_batch", "Method", "METHODS"
 Method = Literal["fast", "exhaustive", "subsets"]
 METHODS: tuple[str, ...] = ("fast", "exhaustive", "subsets")
 
-#: Up to this many robots every small subset (N = 8: 182 candidates) is cheaper than a
-#: convex hull, for one formation and for batches alike (measured).
-SMALL_TEAM = 8
+#: Up to this many robots every small subset is the candidate set (N = 12: 1,507
+#: candidates), as in the compiled kernel (``solver.COMPILED_MAX_N``): both backends
+#: then try the same candidates. Complete, and unlike the hull it needs no decision on
+#: (nearly) degenerate lifted points -- near a similar copy, with (nearly) collinear or
+#: coincident robots the numpy hull path missed states the subsets find.
+SMALL_TEAM = 12
+#: Above this many robots the hull path may read stationary points off the facet normals
+#: (``_candidates._stationary_from_normals``). Up to it (``solver.KERNEL_MAX_N``) the
+#: compiled kernel handles the team and solves every upper-hull face by the Lagrange
+#: system; the numpy path does the same there, so the two backends try the same
+#: candidates (on teams with nearly coincident robots the shortcut reported other
+#: non-equilibria than the kernel).
+SHORTCUT_ABOVE = 30
 #: Candidate systems solved per block when every formation shares one candidate table.
 TABLE_BLOCK = 65_536
 #: Hull candidates: run the maximiser scan before the projection test when it touches at
@@ -115,12 +125,13 @@ def _candidates(frame: Frame, sheet: Sheet, method: str
     independent = True
     stationary: list[Stationary] = []
     for b in range(B):
-        hc = hull_candidates(frame.P[b], pairs)
+        hc = hull_candidates(frame.P[b], pairs, shortcut=N > SHORTCUT_ABOVE)
         if hc.stationary is not None:
             hc.stationary.form[:] = b
             stationary.append(hc.stationary)
         if hc.subsets:
-            independent &= hc.independent
+            # Up to SHORTCUT_ABOVE the kernel screens every system; so does this path.
+            independent &= hc.independent and N > SHORTCUT_ABOVE
         for s, idx in hc.subsets.items():
             per_size.setdefault(s, []).append((np.full(len(idx), b, dtype=np.intp), idx))
     groups = {s: (np.concatenate([f for f, _ in parts]), np.vstack([i for _, i in parts]))
@@ -165,22 +176,21 @@ def similar_copy(vertices: np.ndarray, formations: np.ndarray
 def _snap_near_similar(sheet: Sheet, R: np.ndarray, hold_height: float, method: str,
                        c: Classified) -> Classified:
     """Formations within ``SNAP_TOL`` (relative) of a similar copy of the sheet, but not
-    exactly one, and without a stable state: solve the copy instead.
+    exactly one: solve the copy instead (when the copy has a stable state).
 
     Such formations are within float64 resolution of the FK paper's Lemma 2
     configuration (lifted points on a 2-plane): the rest state's taut set is decided by a
-    thickness of ~1e-10 and its 4- and 5-cable systems are numerically singular, so the
-    candidates can miss it. The copy is solved exactly (every cable taut at the Lemma 2
-    point); positions move by at most the snap distance, below ``SNAP_TOL`` times the
-    sheet size, and the taut set is the one within that tolerance.
+    thickness of ~1e-10, its 4- and 5-cable systems are numerically singular, the
+    candidates can miss it, and where they find it they name one physical state by many
+    taut sets (objects within ~1e-8 of each other; docs/sheet_fk_solver.md, "Next to a
+    similar copy"). The copy is solved exactly (every cable taut at the Lemma 2 point,
+    minimum-norm non-negative load shares); every method and backend gives that one
+    answer. Positions move by about the snap distance, below ``SNAP_TOL`` times the sheet
+    size.
     """
     B = R.shape[0]
-    stable = np.zeros(B, dtype=bool)
-    stable[c.form[c.status == STATUS_STABLE]] = True
-    todo = np.flatnonzero(~stable)
-    if len(todo) == 0:
-        return c
-    copies, scale, dist = similar_copy(sheet.vertices, R[todo])
+    todo = np.arange(B)
+    copies, scale, dist = similar_copy(sheet.vertices, R)
     near = ((dist > SNAP_MIN * sheet.size) & (dist <= SNAP_TOL * sheet.size)
             & (scale <= 1.0))
     if not near.any():
@@ -301,8 +311,7 @@ def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, 
         Algorithm (see module docstring). All return the same equilibria, except within
         ``SNAP_TOL`` (1e-7 of the sheet size) of a similar copy of the sheet (the FK
         paper's Lemma 2 configuration), where float64 cannot resolve the taut set: there
-        "fast" and "subsets" solve the copy when the formation itself shows no stable
-        state, and the paper's Algorithm 1 ("exhaustive") may find nothing.
+        "fast" and "subsets" solve the copy (docs/sheet_fk_solver.md), and the paper's Algorithm 1 ("exhaustive") may find nothing.
 
     Returns
     -------

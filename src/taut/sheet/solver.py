@@ -182,7 +182,7 @@ class FKSolver:
         else:                                       # the hot path, inlined
             out = np.empty((len(self._table), self._width))
             k, stable, pending = sk.solve_formation(R, *self._args, out)
-            if k > 0 and stable and not pending:
+            if k > 0 and stable and not pending and not self._near_copy(R):
                 rows = out[:k]
             else:
                 rows = None if k < 0 else self._finish(R, out[:k], stable, pending)
@@ -202,14 +202,11 @@ class FKSolver:
     def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int
                 ) -> np.ndarray:
         """Rows of ``R`` after the kernel: weight families resolved (``pending`` rows),
-        snapped to a similar copy of the sheet when nothing is stable."""
+        snapped to a similar copy of the sheet next to one."""
         if pending:
-            stable = self._resolve_families(R, rows)
-        if stable == 0:
-            snapped = self._snap(R)
-            if snapped is not None:
-                return snapped
-        return rows
+            self._resolve_families(R, rows)
+        snapped = self._snap(R)
+        return rows if snapped is None else snapped
 
     def _kernel(self, R: np.ndarray) -> tuple[np.ndarray, int] | None:
         """Kernel rows of ``R`` with weight families resolved, and the number of stable
@@ -259,15 +256,22 @@ class FKSolver:
                       else sk.STABLE if min_eig > CURVATURE_TOL else sk.SADDLE)
         return int(np.count_nonzero(rows[:, 0] == sk.STABLE))
 
+    def _near_copy(self, R: np.ndarray) -> bool:
+        """Cheap compiled screen: ``R`` may be within ``SNAP_TOL`` of a similar copy of
+        the sheet (but not exactly one), so :meth:`_snap` must look at it."""
+        size = self.sheet.size
+        scale, dist = sk.similar_fit(R, self._A)
+        slack = 1.0 + SCREEN_SLACK
+        return bool(SNAP_MIN * size / slack < dist <= SNAP_TOL * size * slack
+                    and scale <= slack)
+
     def _snap(self, R: np.ndarray) -> np.ndarray | None:
         """``fk._snap_near_similar`` for one formation: the rows of the similar copy of
-        the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state."""
-        size = self.sheet.size
-        scale, dist = sk.similar_fit(R, self._A)        # cheap screen first
-        slack = 1.0 + SCREEN_SLACK
-        if not (SNAP_MIN * size / slack < dist <= SNAP_TOL * size * slack
-                and scale <= slack):
+        the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state
+        (whether or not ``R`` itself shows one: docs/sheet_fk_solver.md)."""
+        if not self._near_copy(R):
             return None
+        size = self.sheet.size
         copies, scales, dists = similar_copy(self.sheet.vertices, R[None])
         if not (SNAP_MIN * size < dists[0] <= SNAP_TOL * size and scales[0] <= 1.0):
             return None
@@ -332,8 +336,8 @@ class FKSolver:
 
     def _fix_batch(self, Rb: np.ndarray, rows: np.ndarray, form: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
-        """Resolve weight families and snap formations without a stable state, per
-        formation (both rare), keeping rows grouped by formation in order."""
+        """Resolve weight families and snap formations next to a similar copy of the
+        sheet, per formation (both rare), keeping rows grouped by formation in order."""
         B = len(Rb)
         pending = np.flatnonzero(rows[:, 0] == sk.PENDING) if len(rows) else rows[:0, 0]
         for b in np.unique(form[pending.astype(np.intp)]) if len(pending) else ():
@@ -341,11 +345,7 @@ class FKSolver:
             block = rows[sel]
             self._resolve_families(Rb[b], block)
             rows[sel] = block
-        has_stable = np.zeros(B, dtype=bool)
-        has_stable[form[rows[:, 0] == sk.STABLE]] = True
-        todo = np.flatnonzero(~has_stable)
-        if len(todo) == 0:
-            return rows, form
+        todo = np.arange(B)
         copies, scale, dist = similar_copy(self.sheet.vertices, Rb[todo])
         size = self.sheet.size
         near = (dist > SNAP_MIN * size) & (dist <= SNAP_TOL * size) & (scale <= 1.0)
