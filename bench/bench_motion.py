@@ -275,12 +275,12 @@ def main() -> None:
     ap.add_argument("--only", choices=["ik", "sim", "vvcm"], help="run one part")
     ap.add_argument("--steps-only", action="store_true", help="only the step-rate table")
     args = ap.parse_args()
+    if args.steps_only:
+        bench_step_rate({4: 300, 8: 30, 20: 3}, 3)
+        return
     if args.only in (None, "ik"):
         bench_ik(80 if args.quick else args.ik_targets)
     if args.only == "ik":
-        return
-    if args.steps_only:
-        bench_step_rate({4: 300, 8: 30, 20: 3}, 3)
         return
     if args.only in (None, "sim"):
         bench_step_rate({4: 300 if args.quick else 1000, 8: 30 if args.quick else 150,
