@@ -50,6 +50,12 @@ def _load_kernel() -> ModuleType:
         sk = _small_kernel
     return sk
 
+def _batch_kernel() -> ModuleType:
+    """taut.sheet._batch_kernel (imported with numba on first use)."""
+    from . import _batch_kernel as bk
+    return bk
+
+
 Backend = Literal["auto", "numba", "numpy"]
 _BACKENDS = ("auto", "numba", "numpy")
 
@@ -306,7 +312,7 @@ class FKSolver:
         Rb = np.ascontiguousarray(Rb)
         if self._hull:
             return self._solve_batch_hull(Rb, mass)
-        rows, form, bad = sk.solve_formations(
+        rows, form, bad = _batch_kernel().solve_formations_ws(
             Rb, self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
             self.hold_height, self._lim2)
         if bad >= 0:
