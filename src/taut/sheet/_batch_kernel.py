@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import jit
-from ._small_kernel import (INFEASIBLE, _candidates, _classify_row,
-                            _frame, _write_row, feasible)
+from ._small_kernel import (INFEASIBLE, _candidates, _classify_row, _frame, _write_row,
+                            feasible, similar_fit, solve_formation)
 
-__all__ = ["solve_formations_ws"]
+__all__ = ["solve_formations_ws", "solve_packed", "pack"]
 
 
 @jit
@@ -110,3 +110,38 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
         form[M:M + k] = b
         M += k
     return rows[:M], form[:M], -1
+
+
+def pack(Vn, A, lim2, table, sizes, scale, vcx, vcy, hold, snap):
+    """The arguments of :func:`solve_packed` for one solver: a flat float64 array (``Vn``
+    and ``A`` (N, 2) each, ``lim2`` (N, N), then ``scale, vcx, vcy, hold`` and the three
+    snap-screen bounds ``snap``) and a flat int64 array (``table`` (C, 5) then ``sizes``
+    (C,)). Two arguments instead of nine: numba's dispatch costs ~0.3 us per array."""
+    f = np.concatenate([np.ravel(Vn), np.ravel(A), np.ravel(lim2),
+                        [scale, vcx, vcy, hold], np.asarray(snap, dtype=np.float64)])
+    i = np.concatenate([np.ravel(table), np.ravel(sizes)]).astype(np.int64)
+    return np.ascontiguousarray(f, dtype=np.float64), np.ascontiguousarray(i)
+
+
+@jit
+def solve_packed(R, fpack, ipack, out):
+    """``_small_kernel.solve_formation`` of formation ``R`` (N, 2) on the packed solver
+    arguments (:func:`pack`), and, when no state is stable, the screen of ``FKSolver._snap``
+    (``_small_kernel.similar_fit``: the formation is within the snap distance of a
+    similar copy of the sheet, not larger than it). Returns ``(rows, stable_rows,
+    pending_rows, near_copy)``; rows is ``INFEASIBLE`` for a torn or non-finite ``R``."""
+    N = R.shape[0]
+    C = ipack.shape[0] // 6
+    Vn = fpack[0:2 * N].reshape(N, 2)
+    A = fpack[2 * N:4 * N].reshape(N, 2)
+    lim2 = fpack[4 * N:4 * N + N * N].reshape(N, N)
+    g = 4 * N + N * N
+    table = ipack[0:5 * C].reshape(C, 5)
+    sizes = ipack[5 * C:6 * C]
+    k, stable, pending = solve_formation(R, Vn, table, sizes, fpack[g], fpack[g + 1],
+                                         fpack[g + 2], fpack[g + 3], lim2, out)
+    near = False
+    if k >= 0 and stable == 0:
+        scale, dist = similar_fit(R, A)
+        near = fpack[g + 4] < dist <= fpack[g + 5] and scale <= fpack[g + 6]
+    return k, stable, pending, near
