@@ -35,7 +35,8 @@ sim = ts.Simulator(sheet, 1.0, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], dt=0.1)
 sim.step(velocities=np.tile([0.01, 0.0], (4, 1)))
 t4 = time.perf_counter()
 print(json.dumps({"import_s": t1 - t0, "first_solve_s": t2 - t1, "first_batch_s": t3 - t2,
-                  "first_step_s": t4 - t3, "backend": solver.backend}))
+                  "first_step_s": t4 - t3, "cpu_s": time.process_time(),
+                  "backend": solver.backend}))
 """
 
 
@@ -49,7 +50,8 @@ def main() -> None:
             files = sum(len(f) for _, _, f in os.walk(cache))
             print(f"{label:24s} import {r['import_s']:.2f} s, first solve "
                   f"{r['first_solve_s']:.2f} s, first batch {r['first_batch_s']:.2f} s, "
-                  f"first Simulator.step {r['first_step_s']:.2f} s "
+                  f"first Simulator.step {r['first_step_s']:.2f} s; process CPU "
+                  f"{r['cpu_s']:.1f} s "
                   f"({r['backend']}; {files} cache files)")
 
 

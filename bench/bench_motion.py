@@ -237,7 +237,8 @@ def bench_step_rate(steps: dict[int, int], rounds: int) -> None:
         vel = np.diff(path, axis=0) / dt                       # (rounds*T, N, 2) mm/s
         V32 = sheet.vertices.astype(np.float32)
         ours = Simulator(sheet, 1000.0, path[0], dt=dt)
-        ours.step(velocities=np.zeros((n, 2)))                  # warm-up (no motion)
+        ours.step(velocities=vel[0])                # warm-up: loads the compiled code
+        ours.step(formation=path[0])
         peers = _peer_sims(n, V32, path[0].astype(np.float32), dt)
         rates: dict[str, list[float]] = {"taut": []} | {name: [] for name, _, _ in peers}
         for k in range(rounds):
