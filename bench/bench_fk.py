@@ -14,8 +14,9 @@ that is not installed is left out):
   a shuffled order, so load from other processes hits all of them alike; the table
   gives the median over repeats (per-call times in CPU microseconds) and the spread
   (25th-75th percentile over repeats, relative). Peers whose one call would take more
-  than ``--peer-budget`` seconds (extrapolated from the previous N, x2 per robot: their
-  cost is exponential in N) are not run at that N;
+  than ``--peer-budget`` seconds (its timed warm-up call) are not run at that N; a peer
+  call over ``SLOW_CALL_S`` (N = 30) is timed on ``SLOW_REPEATS`` single calls (the
+  "calls" column counts the timed peer calls);
 * batch throughput at N = 4 and 8: ``FKSolver.solve_batch`` against a loop of the
   faster peer's calls over the same formations;
 * one N = 1000 call;
@@ -129,31 +130,39 @@ def latency(n, rng, repeats, target, budget, last_peer_time):
     solver = FKSolver(sheet, hold)
     impls = {"solve": (solver.solve, formation),
              "forward_kinematics": (lambda R: forward_kinematics(sheet, R, hold), formation)}
+    slow: set[str] = set()
     for peer in peers_for(sheet, hold):
-        if peer.name in last_peer_time:
-            # Exponential cost: extrapolate x2 per robot from the last size measured.
-            projected = last_peer_time[peer.name] * 2.0 ** (n - last_peer_time[peer.name + "_n"])
-            if projected > budget:
-                last_peer_time[peer.name + "_skipped"] = projected
-                continue
-        impls[peer.name] = (peer.call, peer.prepare(formation))
-    for fn, arg in impls.values():                 # warm up: caches, first-call costs
-        for _ in range(3):
+        arg = peer.prepare(formation)
+        one = block_time(peer.call, arg, 1)          # warm-up call, timed
+        if one > budget:
+            last_peer_time[peer.name + "_skipped"] = one
+            continue
+        if one > SLOW_CALL_S:
+            slow.add(peer.name)
+        impls[peer.name] = (peer.call, arg)
+    for k, (fn, arg) in impls.items():             # warm up: caches, first-call costs
+        for _ in range(1 if k in slow else 3):
             fn(arg)
-    calls = {k: calibrate(*v, target) for k, v in impls.items()}
+    calls = {k: 1 if k in slow else calibrate(*v, target) for k, v in impls.items()}
     times: dict[str, list[float]] = {k: [] for k in calls}
     order = list(calls)
-    for _ in range(repeats):
+    for r in range(repeats):
         rng.shuffle(order)
         for k in order:
+            if k in slow and r >= SLOW_REPEATS:
+                continue
             fn, arg = impls[k]
             times[k].append(block_time(fn, arg, calls[k]) * 1e6)
-    for peer in ("vvcm-rs", "VVCM"):
-        if peer in times:
-            last_peer_time[peer] = float(np.median(times[peer])) * 1e-6
-            last_peer_time[peer + "_n"] = n
+    for k in times:
+        last_peer_time[k + "_calls"] = calls[k] * len(times[k])
     return {k: (float(np.median(v)), float(np.percentile(v, 25)), float(np.percentile(v, 75)))
             for k, v in times.items()}
+
+
+#: A peer whose one call takes longer than this (CPU s; at N = 30 they take ~0.5-1.3 s)
+#: is timed on ``SLOW_REPEATS`` single calls, interleaved with the first repeats.
+SLOW_CALL_S = 0.2
+SLOW_REPEATS = 5
 
 
 def feasible_perturbations(sheet, formation, batch, rng):
@@ -234,7 +243,8 @@ def main(argv=None):
           f"VVCM {'installed' if VVCM else 'not installed'}")
     print("per-call CPU time, median over interleaved repeats (IQR as +-% of median)")
     head = f"{'N':>3s} {'solve us':>14s} {'fk us':>14s} {'vvcm-rs us':>16s} {'VVCM us':>16s}"
-    print(head + f" {'rs/solve':>9s} {'VVCM/solve':>10s} {'fk/solve':>9s}")
+    print(head + f" {'rs/solve':>9s} {'VVCM/solve':>10s} {'fk/solve':>9s} "
+                 f"{'calls rs/VVCM':>13s}")
     report = {"latency": [], "batch": [], "agreement": {}}
     last: dict = {}
     for n in SIZES:
@@ -253,7 +263,10 @@ def main(argv=None):
 
         print(f"{n:3d} {cell('solve', 14)} {cell('forward_kinematics', 14)} "
               f"{cell('vvcm-rs', 16)} {cell('VVCM', 16)} {ratio('vvcm-rs')} "
-              f"{ratio('VVCM'):>10s} {ratio('forward_kinematics')}")
+              f"{ratio('VVCM'):>10s} {ratio('forward_kinematics')} "
+              f"{last.get('vvcm-rs_calls', 0):>6d}/{last.get('VVCM_calls', 0):<6d}")
+        for key in ("vvcm-rs_calls", "VVCM_calls"):
+            last.pop(key, None)
         sys.stdout.flush()
         report["latency"].append({"N": n, **{k: v for k, v in t.items()}})
     sheet, formation = mm_team(1000, rng)

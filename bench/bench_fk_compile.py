@@ -7,8 +7,8 @@ Usage::
 Runs three fresh Python processes with ``NUMBA_CACHE_DIR`` pointing to a new, empty
 directory: the first compiles every kernel function (numba, ``cache=True``), the second
 and third load them from that directory. Each reports the time of ``import taut.sheet``
-and of the first ``FKSolver.solve`` and one ``solve_batch`` call (wall seconds; the
-machine may be loaded by other work, so run it twice).
+and of the first ``FKSolver.solve``, ``solve_batch`` and ``Simulator.step`` calls (wall
+seconds; the machine may be loaded by other work, so run it twice).
 """
 
 from __future__ import annotations
@@ -31,7 +31,11 @@ solver.solve([[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]]).equilibria
 t2 = time.perf_counter()
 solver.solve_batch(np.array([[[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]]] * 2))
 t3 = time.perf_counter()
+sim = ts.Simulator(sheet, 1.0, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], dt=0.1)
+sim.step(velocities=np.tile([0.01, 0.0], (4, 1)))
+t4 = time.perf_counter()
 print(json.dumps({"import_s": t1 - t0, "first_solve_s": t2 - t1, "first_batch_s": t3 - t2,
+                  "first_step_s": t4 - t3, "cpu_s": time.process_time(),
                   "backend": solver.backend}))
 """
 
@@ -45,7 +49,9 @@ def main() -> None:
             r = json.loads(out)
             files = sum(len(f) for _, _, f in os.walk(cache))
             print(f"{label:24s} import {r['import_s']:.2f} s, first solve "
-                  f"{r['first_solve_s']:.2f} s, first batch {r['first_batch_s']:.2f} s "
+                  f"{r['first_solve_s']:.2f} s, first batch {r['first_batch_s']:.2f} s, "
+                  f"first Simulator.step {r['first_step_s']:.2f} s; process CPU "
+                  f"{r['cpu_s']:.1f} s "
                   f"({r['backend']}; {files} cache files)")
 
 

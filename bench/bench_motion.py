@@ -244,7 +244,8 @@ def bench_step_rate(steps: dict[int, int], rounds: int) -> None:
         vel = np.diff(path, axis=0) / dt                       # (rounds*T, N, 2) mm/s
         V32 = sheet.vertices.astype(np.float32)
         ours = Simulator(sheet, 1000.0, path[0], dt=dt)
-        ours.step(velocities=np.zeros((n, 2)))                  # warm-up (no motion)
+        ours.step(velocities=vel[0])                # warm-up: loads the compiled code
+        ours.step(formation=path[0])
         peers = _peer_sims(n, V32, path[0].astype(np.float32), dt)
         rates: dict[str, list[float]] = {"taut": []} | {name: [] for name, _, _ in peers}
         for k in range(rounds):
@@ -283,12 +284,12 @@ def main() -> None:
     ap.add_argument("--only", choices=["ik", "sim", "vvcm"], help="run one part")
     ap.add_argument("--steps-only", action="store_true", help="only the step-rate table")
     args = ap.parse_args()
+    if args.steps_only:
+        bench_step_rate({4: 300, 8: 30, 20: 3}, 3)
+        return
     if args.only in (None, "ik"):
         bench_ik(80 if args.quick else args.ik_targets, args.ik_seed)
     if args.only == "ik":
-        return
-    if args.steps_only:
-        bench_step_rate({4: 300, 8: 30, 20: 3}, 3)
         return
     if args.only in (None, "sim"):
         bench_step_rate({4: 300 if args.quick else 1000, 8: 30 if args.quick else 150,

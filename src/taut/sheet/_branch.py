@@ -15,6 +15,7 @@ Hooks for a prepared FK solver: every per-step solve goes through :func:`solve_t
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Literal
 import numpy as np
 from scipy.optimize import linprog
@@ -24,6 +25,7 @@ from ._kernel import (CURVATURE_TOL, TAUT_TOL, WEIGHT_TOL, Frame, height_ok,
                       reduced_hessian_min_eig, solve_candidates, taut_masks)
 from ._tol import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL,
                           EVENT_STEP_TOL, SUBSETS_UP_TO, SUPPORT_RANK_RTOL)
+from ._jit import HAVE_NUMBA
 from .fk import forward_kinematics, forward_kinematics_batch
 from .model import Sheet
 from ._sim_results import EventKind, SimulationEvent
@@ -34,6 +36,15 @@ __all__ = ["State", "Tracker", "solve_taut_sets", "branch", "fk_result", "fk_sta
            "members"]
 
 _J = np.array([1.0, 1.0, -1.0, -1.0])
+_stk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._step_kernel, once loaded
+
+
+def _load_step_kernel() -> None:
+    """Import the compiled branch follower (and numba) on the first tracker using it."""
+    global _stk
+    if _stk is None:
+        from . import _step_kernel
+        _stk = _step_kernel
 FKMethod = Literal["fast", "exhaustive", "subsets"]
 
 
@@ -238,12 +249,61 @@ class Tracker:
     :func:`solve_support_one` (same tests, no batching overhead; used by the stepping
     :class:`Simulator`)."""
 
-    def __init__(self, sheet: Sheet, z: float, *, single_fast: bool = False):
+    def __init__(self, sheet: Sheet, z: float, *, single_fast: bool = False,
+                 compiled: bool | None = None):
         self.sheet, self.z = sheet, z
         self.N = sheet.n
         self.single_fast = single_fast
         self._v_centre = sheet.vertices.mean(axis=0)
-        self._Xv = (sheet.vertices - self._v_centre) / sheet.size
+        self._Xv = np.ascontiguousarray((sheet.vertices - self._v_centre) / sheet.size)
+        #: Branch following by the compiled support solve of ``_step_kernel`` (numba);
+        #: False: the numpy path (``solve_support_one`` / :func:`branch`), same answers.
+        self.compiled = HAVE_NUMBA if compiled is None else bool(compiled and HAVE_NUMBA)
+        self._args = (self._Xv, float(self._v_centre[0]), float(self._v_centre[1]),
+                      float(sheet.size), float(z))
+        self._width = 5 + 2 * self.N                      # _step_kernel.step_width(N)
+        self._supports: dict[tuple[int, ...], np.ndarray] = {}
+        self._taut_sets: dict[bytes, tuple[int, ...]] = {}
+        if self.compiled:
+            _load_step_kernel()
+
+    def _support_array(self, support: tuple[int, ...]) -> np.ndarray:
+        arr = self._supports.get(support)
+        if arr is None:
+            if len(self._supports) > 256:
+                self._supports.clear()
+            arr = self._supports[support] = np.array(support, dtype=np.int64)
+        return arr
+
+    def _row_state(self, support: tuple[int, ...], row: np.ndarray) -> State:
+        """The tracker's state from one output row of ``_step_kernel.solve_support``."""
+        N = self.N
+        mask = row[5 + N:].tobytes()
+        taut = self._taut_sets.get(mask)
+        if taut is None:
+            if len(self._taut_sets) > 1024:
+                self._taut_sets.clear()
+            taut = self._taut_sets[mask] = tuple(np.flatnonzero(row[5 + N:]).tolist())
+        return State(support, taut, row[0:2], row[2:4], float(row[4]), row[5:5 + N])
+
+    def follow(self, state: State, R: np.ndarray) -> tuple[int, SetSolution]:
+        """Re-solve ``state``'s support on formations ``R`` (T, N, 2) in order up to the
+        first one where it fails: one compiled call (``_step_kernel.follow_support``) or
+        one batched numpy solve (:func:`branch`). Returns that count ``k`` and the
+        ``SetSolution`` arrays (their first ``k`` rows are the valid states)."""
+        if not self.compiled:
+            sol = branch(self.sheet, R, self.z, state.support)
+            bad = np.flatnonzero(~sol[0])
+            return (int(bad[0]) if len(bad) else len(R)), sol
+        T, N = len(R), self.N
+        out = np.empty((T, self._width))
+        support = self._support_array(state.support)
+        k = _stk.follow_support(np.ascontiguousarray(R), *self._args, support, len(support),
+                                out)
+        valid = np.zeros(T, dtype=bool)
+        valid[:k] = True
+        return k, (valid, out[:, 0:2], out[:, 2:4], out[:, 4], out[:, 5:5 + N],
+                   out[:, 5 + N:] > 0.5)
 
     def trackable(self, state: State) -> bool:
         return 3 <= len(state.support) <= 5
@@ -251,6 +311,13 @@ class Tracker:
     def valid_at(self, state: State, R: np.ndarray) -> tuple[bool, State | None]:
         if not self.trackable(state):
             return False, None
+        if self.compiled:
+            out = np.empty(self._width)
+            support = self._support_array(state.support)
+            Xv, vcx, vcy, size, z = self._args
+            if not _stk.solve_support(R, Xv, vcx, vcy, size, z, support, len(support), out):
+                return False, None
+            return True, self._row_state(state.support, out)
         if self.single_fast:
             one = solve_support_one(self._Xv, self._v_centre, self.sheet.size, self.z, R,
                                     state.support)
@@ -271,9 +338,7 @@ class Tracker:
         while hi - lo > EVENT_STEP_TOL:
             s = np.linspace(lo, hi, 18)[1:-1]
             R = (1 - s)[:, None, None] * R0 + s[:, None, None] * R1
-            valid, ro, vo, zo, w, tight = branch(self.sheet, R, self.z, state.support)
-            bad = np.flatnonzero(~valid)
-            k = int(bad[0]) if len(bad) else len(s)
+            k, (valid, ro, vo, zo, w, tight) = self.follow(state, R)
             if k > 0:
                 lo = float(s[k - 1])
                 at_lo = State(state.support, members(tight[k - 1]), ro[k - 1], vo[k - 1],

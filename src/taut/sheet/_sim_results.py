@@ -156,3 +156,16 @@ class SimulatorState:
 
     def __post_init__(self) -> None:
         check_status(self.status)
+
+    @classmethod
+    def _resting(cls, step: int, time: float, formation: np.ndarray, obj: np.ndarray,
+                 contact: np.ndarray, taut: tuple[int, ...], weights: np.ndarray,
+                 tensions: np.ndarray | None, events: tuple[SimulationEvent, ...],
+                 message: str) -> "SimulatorState":
+        """A successful state (status ``ok``) built without the dataclass machinery
+        (``Simulator.step``'s per-step cost in control loops)."""
+        self = object.__new__(cls)
+        self.__dict__.update(step=step, time=time, formation=formation, object=obj,
+                             contact=contact, taut=taut, weights=weights, tensions=tensions,
+                             events=events, success=True, status="ok", message=message)
+        return self

@@ -34,20 +34,25 @@ Decisions where the papers are silent: events are detected at the trajectory's s
 is the descent's end point (not the nearest stable state, as vvcm-rs picks); sub-step
 positions are linear interpolations of the formations.
 
-Tracking is vectorised over chunks of steps (one batched small solve per chunk), so the
-cost per step is a few microseconds; full FK is called only at events. The same tracker
+Tracking runs over chunks of steps in one compiled call per chunk (``_step_kernel``,
+numba; or one batched numpy solve per chunk without numba), so the cost per step is a few
+microseconds; full FK is called only at events. The same tracker
 (:mod:`._branch`) drives the stateful :class:`Simulator`, one step at a time, for control
 loops (set robot velocities or formations, step, read the object).
 """
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 
 from .._validate import as_array, as_positive
 from ..errors import InvalidInputError, InvalidTrajectoryError
-from ._branch import (State, Tracker, branch, fk_result, fk_stable_batch, from_equilibrium,
+from . import _branch
+from ._branch import (State, Tracker, fk_result, fk_stable_batch, from_equilibrium,
                       make_event, members, nearest, resolve_step)
+from ._jit import HAVE_NUMBA
 from ._sim_results import EventKind, SimulationEvent, SimulationResult, SimulatorState
 from .fk import _check_mass, _check_sheet
 from .model import (GEOMETRY_RTOL, Sheet, check_formation, check_formations,
@@ -56,6 +61,20 @@ from .results import GRAVITY
 
 __all__ = ["SimulationEvent", "SimulationResult", "SimulatorState", "Simulator", "simulate",
            "EventKind"]
+
+
+Backend = Literal["auto", "numba", "numpy"]
+
+
+def _compiled(backend: object) -> bool:
+    """Whether ``backend`` selects the compiled branch follower (as ``FKSolver``'s
+    ``backend``: ``"numba"`` without numba installed is an error)."""
+    if backend not in ("auto", "numba", "numpy"):
+        raise InvalidInputError("backend", f"must be one of auto, numba, numpy; got "
+                                           f"{backend!r}")
+    if backend == "numba" and not HAVE_NUMBA:
+        raise InvalidInputError("backend", "numba is not installed (pip install numba)")
+    return backend != "numpy" and HAVE_NUMBA
 
 
 def _initial_state(sheet: Sheet, R: np.ndarray, z: float, start: object | None,
@@ -122,27 +141,26 @@ def _recover(sheet: Sheet, R: np.ndarray, z: float, t: int, chunk: int
     return from_equilibrium(lowest, sheet, R[t], z), t
 
 
-def _follow(sheet: Sheet, R: np.ndarray, z: float, state: State, t: int, chunk: int,
+def _follow(tracker: Tracker, R: np.ndarray, state: State, t: int, chunk: int,
             rec: _Record) -> tuple[State, int, bool]:
-    """Track ``state``'s support over steps t..t+chunk in one batched solve; returns the
-    last valid state, the first step not stored, and whether the chunk ended valid."""
+    """Track ``state``'s support over steps t..t+chunk in one solve (compiled, or one
+    batched numpy solve); returns the last valid state, the first step not stored, and
+    whether the chunk ended valid."""
     end = min(len(R), t + chunk)
-    valid, ro, vo, zo, w, tight = branch(sheet, R[t:end], z, state.support)
-    bad = np.flatnonzero(~valid)
-    k = int(bad[0]) if len(bad) else end - t
+    k, (valid, ro, vo, zo, w, tight) = tracker.follow(state, R[t:end])
     if k:
         rec.store_branch(t, k, ro[:k], vo[:k], zo[:k], w[:k], tight[:k])
         state = State(state.support, members(tight[k - 1]), ro[k - 1], vo[k - 1],
                       float(zo[k - 1]), w[k - 1])
-    return state, t + k, not len(bad)
+    return state, t + k, k == end - t
 
 
-def _run(sheet: Sheet, R: np.ndarray, z: float, state: State, rec: _Record,
+def _run(tracker: Tracker, R: np.ndarray, state: State, rec: _Record,
          events: list[SimulationEvent], crossings: dict[int, tuple[float, np.ndarray]]
          ) -> None:
-    """The driver loop: batched branch following, events resolved step by step."""
+    """The driver loop: chunked branch following, events resolved step by step."""
     T = len(R)
-    tracker = Tracker(sheet, z)
+    sheet, z = tracker.sheet, tracker.z
     motion = np.abs(np.diff(R, axis=0)).max(axis=(1, 2)) if T > 1 else np.zeros(0)
     t, chunk = 1, 64
     cur: State | None = state
@@ -157,7 +175,7 @@ def _run(sheet: Sheet, R: np.ndarray, z: float, state: State, rec: _Record,
             t, chunk = t_found + 1, 64
             continue
         if tracker.trackable(cur):
-            cur, t, whole = _follow(sheet, R, z, cur, t, chunk, rec)
+            cur, t, whole = _follow(tracker, R, cur, t, chunk, rec)
             if whole:
                 chunk = min(4 * chunk, 4096)
                 continue
@@ -183,7 +201,8 @@ def _outcome(events: list[SimulationEvent] | tuple[SimulationEvent, ...], lost_n
 
 
 def simulate(sheet: Sheet, formations: object, hold_height: float, *,
-             start: object | None = None, mass: float | None = None) -> SimulationResult:
+             start: object | None = None, mass: float | None = None,
+             backend: Backend = "auto") -> SimulationResult:
     """Quasi-static simulation of the object along a time series of formations.
 
     Parameters
@@ -199,6 +218,9 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
         ``formations[0]`` nearest to it (default: the lowest).
     mass : float, optional
         Object mass (kg) for the tensions :math:`F_i = w_i m g l_i / d`.
+    backend : {"auto", "numba", "numpy"}
+        Branch following by the compiled support solve (``"auto"``: when numba is
+        installed) or by the numpy path; both give the same states.
 
     Returns
     -------
@@ -229,6 +251,7 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
     """
     sheet = _check_sheet(sheet)
     mass = _check_mass(mass)
+    _compiled(backend)
     z = check_hold_height(hold_height)
     R = check_formations(sheet, as_array(formations, "formations", ndim=3))
     T, N = R.shape[:2]
@@ -239,7 +262,7 @@ def simulate(sheet: Sheet, formations: object, hold_height: float, *,
     rec.store(0, state)
     events: list[SimulationEvent] = []
     crossings: dict[int, tuple[float, np.ndarray]] = {}
-    _run(sheet, R, z, state, rec, events, crossings)
+    _run(Tracker(sheet, z, compiled=_compiled(backend)), R, state, rec, events, crossings)
     tensions = _tensions(sheet, z, mass, rec.con, rec.obj, rec.wts, rec.taut)
     taut_sets = tuple(tuple(int(i) for i in np.flatnonzero(row)) for row in rec.taut)
     events += _taut_changes(taut_sets, rec.obj, events, crossings)
@@ -288,6 +311,9 @@ class Simulator:
         Object mass (kg) for the tensions.
     dt : float
         Default time step (s) of :meth:`step` with velocities (1/30, as the peers').
+    backend : {"auto", "numba", "numpy"}
+        As in :func:`simulate`: the compiled branch follower (one compiled call per step
+        without events) or the numpy path; both give the same states.
 
     Raises
     ------
@@ -314,22 +340,24 @@ class Simulator:
 
     def __init__(self, sheet: Sheet, hold_height: float, formation: object, *,
                  start: object | None = None, mass: float | None = None,
-                 dt: float = 1.0 / 30.0) -> None:
+                 dt: float = 1.0 / 30.0, backend: Backend = "auto") -> None:
         self.sheet = _check_sheet(sheet)
         self.mass = _check_mass(mass)
         self.hold_height = check_hold_height(hold_height)
         self.dt = as_positive(dt, "dt")
         R = check_formation(self.sheet, as_array(formation, "formation",
                                                  shape=(self.sheet.n, 2)))
-        self._tracker = Tracker(self.sheet, self.hold_height, single_fast=True)
-        self._iu, self._ju = np.triu_indices(self.sheet.n, 1)
+        self._tracker = Tracker(self.sheet, self.hold_height, single_fast=True,
+                                compiled=_compiled(backend))
         limit = self.sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * self.sheet.size
-        self._limit2 = limit[self._iu, self._ju] ** 2
+        self._limit2 = np.ascontiguousarray(limit * limit)          # (N, N)
+        self._iu, self._ju = np.triu_indices(self.sheet.n, 1)
         self._cur: State | None = _initial_state(self.sheet, R, self.hold_height, start,
                                                  "formation")
         self._R = R.copy()
         self._velocities = np.zeros_like(R)
         self._steps, self._time = 0, 0.0
+        self._messages: dict[tuple[int, ...], str] = {}
         self._state = self._snapshot(())
         self.initial = self._state
 
@@ -349,20 +377,44 @@ class Simulator:
             return SimulatorState(self._steps, self._time, self._R.copy(), np.full(3, np.nan),
                                   np.full(2, np.nan), (), np.zeros(N), None, events, False,
                                   "diverged", "object lost (no stable rest state)")
-        obj = np.array([*s.ro, s.z])
-        taut = np.zeros(N, dtype=bool)
-        taut[list(s.taut)] = True
-        ten = _tensions(self.sheet, self.hold_height, self.mass, s.vo, obj, s.w, taut)
-        return SimulatorState(self._steps, self._time, self._R.copy(), obj, s.vo.copy(),
-                              s.taut, s.w.copy(), ten, events, True, "ok",
-                              f"object resting on cables {[i + 1 for i in s.taut]}")
+        obj = np.empty(3)
+        obj[:2] = s.ro
+        obj[2] = s.z
+        ten = None
+        if self.mass is not None:
+            taut = np.zeros(N, dtype=bool)
+            taut[list(s.taut)] = True
+            ten = _tensions(self.sheet, self.hold_height, self.mass, s.vo, obj, s.w, taut)
+        message = self._messages.get(s.taut)
+        if message is None:
+            if len(self._messages) > 1024:
+                self._messages.clear()
+            message = self._messages[s.taut] = (f"object resting on cables "
+                                                f"{[i + 1 for i in s.taut]}")
+        return SimulatorState._resting(self._steps, self._time, self._R.copy(), obj,
+                                       s.vo.copy(), s.taut, s.w.copy(), ten, events, message)
 
     def _next_formation(self, formation: object | None, velocities: object | None,
-                        dt: float | None) -> tuple[np.ndarray, float]:
+                        dt: float | None) -> tuple[np.ndarray, float, float]:
+        """The next formation, the step's duration and its largest coordinate motion."""
         if formation is not None and velocities is not None:
             raise InvalidInputError("formation", "give a formation or velocities, not both")
         step_dt = self.dt if dt is None else as_positive(dt, "dt")
         N = self.sheet.n
+        if formation is None and self._tracker.compiled:
+            # The control-loop path: velocities checked and applied in one compiled call
+            # (a non-finite or tearing result takes the validating path below).
+            v = velocities
+            if v is not None and not (type(v) is np.ndarray and v.dtype == np.float64
+                                      and v.shape == (N, 2)):
+                v = as_array(v, "velocities", shape=(N, 2))
+            vel = self._velocities if v is None else v
+            R1 = np.empty((N, 2))
+            ok, motion = _branch._stk.feasible_step(self._R, vel, step_dt, self._limit2, R1)
+            if ok:
+                if v is not None:
+                    self._velocities = vel.copy()
+                return R1, step_dt, motion
         if formation is not None:
             R1 = as_array(formation, "formation", shape=(N, 2))
         else:
@@ -370,9 +422,9 @@ class Simulator:
                 self._velocities = as_array(velocities, "velocities", shape=(N, 2))
             R1 = self._R + self._velocities * step_dt
         gap = R1[self._iu] - R1[self._ju]
-        if np.any(np.einsum("pk,pk->p", gap, gap) > self._limit2):   # the precomputed test
+        if np.any(np.einsum("pk,pk->p", gap, gap) > self._limit2[self._iu, self._ju]):
             check_formation(self.sheet, R1)      # raises with the pair named (and the step)
-        return R1, step_dt
+        return R1, step_dt, float(np.abs(R1 - self._R).max())
 
     def step(self, formation: object | None = None, *, velocities: object | None = None,
              dt: float | None = None) -> SimulatorState:
@@ -398,7 +450,7 @@ class Simulator:
         InvalidInputError, InfeasibleFormationError
             Bad input, or a formation that would tear the sheet (the state is unchanged).
         """
-        R1, step_dt = self._next_formation(formation, velocities, dt)
+        R1, step_dt, motion = self._next_formation(formation, velocities, dt)
         self._steps += 1
         self._time += step_dt
         events: list[SimulationEvent] = []
@@ -410,7 +462,6 @@ class Simulator:
                 events.append(make_event(self._steps, 0.0, "recovered", None, self._cur))
         else:
             crossings: dict[int, tuple[float, np.ndarray]] = {}
-            motion = float(np.abs(R1 - self._R).max())
             self._cur = resolve_step(self._tracker, before, self._R, R1, self._steps, motion,
                                      events, crossings)
             if self._cur is not None and self._cur.taut != before.taut and not events:
@@ -418,6 +469,6 @@ class Simulator:
                                             (1.0, np.array([*self._cur.ro, self._cur.z])))
                 events.append(SimulationEvent(self._steps, frac, "taut_change", before.taut,
                                               self._cur.taut, where.copy(), where.copy(), 0.0))
-        self._R = R1.copy()
+        self._R = R1
         self._state = self._snapshot(tuple(events))
         return self._state

@@ -41,6 +41,7 @@ __all__ = ["FKSolver", "Backend", "COMPILED_MAX_N", "HAVE_NUMBA"]
 HAVE_NUMBA = (importlib.util.find_spec("numba") is not None
               and not os.environ.get("TAUT_DISABLE_NUMBA"))
 sk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._small_kernel, once loaded
+bk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._batch_kernel, once loaded
 
 
 def _load_kernel() -> ModuleType:
@@ -49,6 +50,15 @@ def _load_kernel() -> ModuleType:
         from . import _small_kernel
         sk = _small_kernel
     return sk
+
+def _batch_kernel() -> ModuleType:
+    """taut.sheet._batch_kernel (imported with numba on first use)."""
+    global bk
+    if bk is None:
+        from . import _batch_kernel
+        bk = _batch_kernel
+    return bk
+
 
 Backend = Literal["auto", "numba", "numpy"]
 _BACKENDS = ("auto", "numba", "numpy")
@@ -101,6 +111,7 @@ class FKSolver:
 
     __slots__ = ("sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
                  "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
+                 "_fpack", "_ipack", "_out_shape",
                  "__weakref__")
 
     def __init__(self, sheet: Sheet | ArrayLike, hold_height: float, *,
@@ -139,8 +150,12 @@ class FKSolver:
         self._width = 12 + 3 * N                   # _small_kernel.row_width(N)
         self._args = (self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
                       self.hold_height, self._lim2)
+        self._out_shape = (len(table), self._width)
         if self.backend == "numba":
             _load_kernel()
+            self._fpack, self._ipack = _batch_kernel().pack(
+                self._Vn, self._A, self._lim2, self._table, self._sizes, self._scale,
+                self._vcx, self._vcy, self.hold_height, _snap_screen(self._scale))
 
     def __repr__(self) -> str:
         return (f"FKSolver(N={self.sheet.n}, hold_height={self.hold_height:g}, "
@@ -179,13 +194,13 @@ class FKSolver:
             R = np.array(formation, dtype=np.float64, order="C")
         if self._hull:
             rows = self._rows(R)
-        else:                                       # the hot path, inlined
-            out = np.empty((len(self._table), self._width))
-            k, stable, pending = sk.solve_formation(R, *self._args, out)
-            if k > 0 and stable and not pending and not self._near_copy(R):
+        else:                                       # the hot path, one compiled call
+            out = np.empty(self._out_shape)
+            k, stable, pending, near = bk.solve_packed(R, self._fpack, self._ipack, out)
+            if not near and ((stable and not pending) or k == 0):
                 rows = out[:k]
             else:
-                rows = None if k < 0 else self._finish(R, out[:k], stable, pending)
+                rows = None if k < 0 else self._finish(R, out[:k], stable, pending, near)
         if rows is None:
             check_formation(self.sheet, R)          # raises with the usual message
             return _forward_numpy(self.sheet, R, self.hold_height, mass, self.method)
@@ -199,14 +214,19 @@ class FKSolver:
             return None
         return self._finish(R, *found, 0)
 
-    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int
-                ) -> np.ndarray:
+    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int,
+                near: bool | None = None) -> np.ndarray:
         """Rows of ``R`` after the kernel: weight families resolved (``pending`` rows),
-        snapped to a similar copy of the sheet next to one."""
+        snapped to a similar copy of the sheet next to one, whether or not a state is stable
+        (docs/sheet_fk_solver.md; ``near``: the result of the snap screen when the kernel
+        already ran it)."""
         if pending:
             self._resolve_families(R, rows)
-        snapped = self._snap(R)
-        return rows if snapped is None else snapped
+        if near is not False:
+            snapped = self._snap(R, screened=near is True)
+            if snapped is not None:
+                return snapped
+        return rows
 
     def _kernel(self, R: np.ndarray) -> tuple[np.ndarray, int] | None:
         """Kernel rows of ``R`` with weight families resolved, and the number of stable
@@ -256,22 +276,17 @@ class FKSolver:
                       else sk.STABLE if min_eig > CURVATURE_TOL else sk.SADDLE)
         return int(np.count_nonzero(rows[:, 0] == sk.STABLE))
 
-    def _near_copy(self, R: np.ndarray) -> bool:
-        """Cheap compiled screen: ``R`` may be within ``SNAP_TOL`` of a similar copy of
-        the sheet (but not exactly one), so :meth:`_snap` must look at it."""
-        size = self.sheet.size
-        scale, dist = sk.similar_fit(R, self._A)
-        slack = 1.0 + SCREEN_SLACK
-        return bool(SNAP_MIN * size / slack < dist <= SNAP_TOL * size * slack
-                    and scale <= slack)
-
-    def _snap(self, R: np.ndarray) -> np.ndarray | None:
+    def _snap(self, R: np.ndarray, screened: bool = False) -> np.ndarray | None:
         """``fk._snap_near_similar`` for one formation: the rows of the similar copy of
-        the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state
-        (whether or not ``R`` itself shows one: docs/sheet_fk_solver.md)."""
-        if not self._near_copy(R):
-            return None
+        the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state,
+        whether or not ``R`` itself shows one (docs/sheet_fk_solver.md; ``screened``: the
+        cheap screen, ``_snap_screen``, already passed)."""
         size = self.sheet.size
+        if not screened:
+            scale, dist = sk.similar_fit(R, self._A)    # cheap screen first
+            lo, hi, top = _snap_screen(size)
+            if not (lo < dist <= hi and scale <= top):
+                return None
         copies, scales, dists = similar_copy(self.sheet.vertices, R[None])
         if not (SNAP_MIN * size < dists[0] <= SNAP_TOL * size and scales[0] <= 1.0):
             return None
@@ -310,7 +325,7 @@ class FKSolver:
         Rb = np.ascontiguousarray(Rb)
         if self._hull:
             return self._solve_batch_hull(Rb, mass)
-        rows, form, bad = sk.solve_formations(
+        rows, form, bad = bk.solve_formations_ws(
             Rb, self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
             self.hold_height, self._lim2)
         if bad >= 0:
@@ -364,6 +379,13 @@ class FKSolver:
         rows, form = np.vstack(all_rows), np.concatenate(all_form)
         order = np.argsort(form, kind="stable")
         return rows[order], form[order]
+
+
+def _snap_screen(size: float) -> tuple[float, float, float]:
+    """Bounds of the snap screen on ``similar_fit``'s distance (low, high) and scale
+    (high): ``SNAP_MIN``/``SNAP_TOL`` of the sheet size widened by ``SCREEN_SLACK``."""
+    slack = 1.0 + SCREEN_SLACK
+    return SNAP_MIN * size / slack, SNAP_TOL * size * slack, slack
 
 
 def _formation_array(formation: ArrayLike, sheet: Sheet) -> np.ndarray:
