@@ -29,7 +29,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..errors import ScenarioError, TautError
-from ..plan.world import Obstacle, Scenario, Team, World
+from ..plan.world import MAX_TEAM_ROBOTS, Obstacle, Scenario, Team, World
 from ..sheet import Sheet
 from .files import read_mapping, validate_mapping
 
@@ -112,9 +112,15 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
         else:
             reg = t.regular
             assert reg is not None                       # checked by _Team._one_sheet
+            if reg.n > MAX_TEAM_ROBOTS:                  # before allocating the sheet
+                raise ScenarioError("team.regular.n", f"a planning team has at most "
+                                    f"{MAX_TEAM_ROBOTS} robots, got {reg.n}")
             sheet = Sheet.regular(reg.n, reg.circumradius, phase=reg.phase)
     except TautError as exc:
         raise ScenarioError("team.sheet", exc.problem) from None
+    if sheet.n > MAX_TEAM_ROBOTS:
+        raise ScenarioError("team.sheet", f"a planning team has at most {MAX_TEAM_ROBOTS} "
+                            f"robots, got {sheet.n}")
     team = Team(sheet, t.hold_height, t.robot_radius, t.height_safety, t.lateral_safety,
                 t.speed, t.rotation_speed, t.mass)
     obstacles = []

@@ -190,7 +190,8 @@ class PoseChecker:
         r = self.robots(states)
         K, N = r.shape[:2]
         self.checks += K
-        ok = shapely.covers(self.robot_region, shapely.points(r.reshape(-1, 2)))
+        p = r.reshape(-1, 2)                     # point-in-region without point objects
+        ok = shapely.intersects_xy(self.robot_region, p[:, 0], p[:, 1])
         ok = ok.reshape(K, N).all(axis=1)
         if not ok.any():
             return ok

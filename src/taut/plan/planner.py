@@ -204,8 +204,9 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
     if results and not found.timed_out and len(results) == len(found.notes):
         return failure(scenario, f"every candidate failed verification: {tried}", planner,
                        "unverified")
-    cap = ("the time budget" if found.timed_out
-           else f"{budget.iterations} samples per search")
+    cap = (f"the time cap of {budget.time_budget:g} s" if found.timed_out
+           else f"{budget.iterations} samples per run, {found.iterations} of "
+                f"{budget.total_samples} in all")
     if not tried:
         tried = "searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
                                         for f in forms)
@@ -215,7 +216,7 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
 
 def plan(scenario: Scenario, *, method: Method = "se2",
          baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
-         sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float = 10.0,
+         sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float | None = None,
          iterations: int = 3000, seed: int = 0) -> PlanResult:
     """Plan the transport of the object from ``scenario.start`` to ``scenario.goal``.
 
@@ -231,15 +232,16 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     sheet_margin : float
         Every robot pair stays this far inside its sheet distance, m (default 0.01 m:
         robots off by at most 5 mm each never tear the sheet).
-    time_budget : float
-        Wall-clock cap of the SE(2) search, s (the crossing search gets 70 % of it; when it
-        fails, the disc roadmap and then the SE(2) bypass search with the full budget, as
-        the baseline runs it, are tried, so a failure can take about 1.7 times this).
+    time_budget : float or None
+        Optional wall-clock safety cap of each SE(2) search, s (default None: no cap).
+        The budget that decides success is ``iterations``, so the answer does not depend
+        on the machine's load; a cap that stops a search is reported in the message, and
+        then the answer may depend on the load.
     iterations : int
-        Samples per RRT-Connect run of the SE(2) search.
+        Samples per RRT-Connect run of the SE(2) search (the deterministic budget).
     seed : int
-        Seed of the SE(2) search (plans are reproducible for a given seed and budget, as
-        long as the time cap is not what stops the search).
+        Seed of the SE(2) search: plans are reproducible for a given seed and
+        ``iterations`` (unless the optional time cap stops a search).
 
     Returns
     -------
@@ -267,11 +269,13 @@ def plan(scenario: Scenario, *, method: Method = "se2",
         raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
     if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
         raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
-    if not (time_budget > 0) or int(iterations) < 1:
-        raise InvalidInputError("time_budget", "time_budget and iterations must be positive")
+    if time_budget is not None and not (time_budget > 0):
+        raise InvalidInputError("time_budget", "must be a positive time in s, or None")
+    if int(iterations) < 1:
+        raise InvalidInputError("iterations", "must be a positive count")
     margin = float(sheet_margin)
-    budget = SearchBudget(iterations=int(iterations), time_budget=float(time_budget),
-                          seed=int(seed))
+    budget = SearchBudget(iterations=int(iterations), seed=int(seed),
+                          time_budget=None if time_budget is None else float(time_budget))
     cached = _library(scenario, margin)
     lib: Library = (cached[0], list(cached[1]), list(cached[2]))
     if baseline == "disc":
@@ -284,7 +288,8 @@ def plan(scenario: Scenario, *, method: Method = "se2",
         return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
                         lib)
     full = budget                 # the SE(2) bypass fallback runs exactly as the baseline
-    first = replace(budget, time_budget=0.7 * budget.time_budget)
+    first = budget if budget.time_budget is None else replace(
+        budget, time_budget=0.7 * budget.time_budget)
     best = _se2(scenario, allow_crossing=True, sheet_margin=margin, budget=first,
                 planner="crossing", library=lib)
     if best.success or best.status == "refuted":
