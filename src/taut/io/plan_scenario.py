@@ -106,15 +106,15 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
     """
     raw = validate_mapping(_PlanFile, data)
     t = raw.team
+    if t.regular is not None and t.regular.n > MAX_TEAM_ROBOTS:   # before allocating it
+        raise ScenarioError("team.regular.n", f"a planning team has at most "
+                            f"{MAX_TEAM_ROBOTS} robots, got {t.regular.n}")
     try:
         if t.sheet is not None:
             sheet = Sheet(np.array(t.sheet, dtype=float))
         else:
             reg = t.regular
             assert reg is not None                       # checked by _Team._one_sheet
-            if reg.n > MAX_TEAM_ROBOTS:                  # before allocating the sheet
-                raise ScenarioError("team.regular.n", f"a planning team has at most "
-                                    f"{MAX_TEAM_ROBOTS} robots, got {reg.n}")
             sheet = Sheet.regular(reg.n, reg.circumradius, phase=reg.phase)
     except TautError as exc:
         raise ScenarioError("team.sheet", exc.problem) from None

@@ -282,8 +282,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
         return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
                        sheet_margin=margin)
     if baseline:
-        return _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=budget,
-                    planner="se2-bypass", library=lib)
+        return _bypass(scenario, margin, budget)
     if method != "se2":
         return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
                         lib)
@@ -299,8 +298,18 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     alt = _roadmap(scenario, True, margin, "crossing", lib)
     if alt.success:
         return alt
-    alt = _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=full,
-               planner="crossing", library=lib)
+    alt = _bypass(scenario, margin, full)
     if alt.success:
-        return alt
+        return relabel(alt, "crossing")
     return best
+
+
+@functools.lru_cache(maxsize=32)
+def _bypass(scenario: Scenario, sheet_margin: float, budget: SearchBudget) -> PlanResult:
+    """The SE(2) bypass search (the baseline, and the crossing planner's last fallback),
+    memoised: it is deterministic for a given scenario, margin and sample budget, so the
+    fallback and the baseline are one search, run once."""
+    cached = _library(scenario, sheet_margin)
+    lib: Library = (cached[0], list(cached[1]), list(cached[2]))
+    return _se2(scenario, allow_crossing=False, sheet_margin=sheet_margin, budget=budget,
+                planner="se2-bypass", library=lib)
