@@ -29,6 +29,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._validate import as_count
 from ..errors import InvalidInputError
 from . import _tol
 from ._se2 import SearchBudget, search_se2
@@ -214,6 +215,25 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
                    f"{tried}", planner, "budget_exhausted")
 
 
+def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
+                     time_budget: float | None, iterations: int, seed: int) -> SearchBudget:
+    """Validate :func:`plan`'s options (typed errors naming the field); the budget."""
+    if not isinstance(scenario, Scenario):
+        raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
+    if method not in ("se2", "roadmap", "algorithm2"):
+        raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
+                                          f"{method!r}")
+    if baseline not in (False, True, "se2", "disc"):
+        raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
+    if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
+        raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
+    if time_budget is not None and not (time_budget > 0):
+        raise InvalidInputError("time_budget", "must be a positive time in s, or None")
+    return SearchBudget(iterations=as_count(iterations, "iterations", minimum=1),
+                        seed=as_count(seed, "seed", minimum=0),
+                        time_budget=None if time_budget is None else float(time_budget))
+
+
 def plan(scenario: Scenario, *, method: Method = "se2",
          baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
          sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float | None = None,
@@ -260,22 +280,9 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     >>> r.success, r.status, r.crossed                             # doctest: +SKIP
     (True, 'ok', ('1', '2'))
     """
-    if not isinstance(scenario, Scenario):
-        raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
-    if method not in ("se2", "roadmap", "algorithm2"):
-        raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
-                                          f"{method!r}")
-    if baseline not in (False, True, "se2", "disc"):
-        raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
-    if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
-        raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
-    if time_budget is not None and not (time_budget > 0):
-        raise InvalidInputError("time_budget", "must be a positive time in s, or None")
-    if int(iterations) < 1:
-        raise InvalidInputError("iterations", "must be a positive count")
+    budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
+                              iterations, seed)
     margin = float(sheet_margin)
-    budget = SearchBudget(iterations=int(iterations), seed=int(seed),
-                          time_budget=None if time_budget is None else float(time_budget))
     cached = _library(scenario, margin)
     lib: Library = (cached[0], list(cached[1]), list(cached[2]))
     if baseline == "disc":
