@@ -85,6 +85,7 @@ class SE2Search:
     timed_out: bool = False
     iterations: int = 0
     spent: bool = False           # the total sample budget ran out
+    pairs: int = 0                # formation pairs (one change) in the search
 
 
 def _bounds(scenario: Scenario) -> np.ndarray:
@@ -237,6 +238,7 @@ def search_se2(scenario: Scenario, formations: list[Formation], *, allow_crossin
         # at most MAX_PAIRS of them.
         pairs.sort(key=lambda p: (ends[id(p[0])][1], ends[id(p[1])][0]))
         pairs = pairs[:MAX_PAIRS]
+    run.out.pairs = len(pairs)
     # Rounds: quick singles, quick pairs, full singles, full pairs; stop at the first
     # round that finds a verified plan.
     retry = [f for f in formations if run.left() > 0 and run.single(f, quick)]

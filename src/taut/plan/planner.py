@@ -208,11 +208,13 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
     cap = (f"the time cap of {budget.time_budget:g} s" if found.timed_out
            else f"{budget.iterations} samples per run, {found.iterations} of "
                 f"{budget.total_samples} in all")
-    if not tried:
-        tried = "searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
+    searched = ("searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
                                         for f in forms)
+                + f" alone and {found.pairs} formation pair(s) with one change, "
+                + ("crossing low obstacles" if allow_crossing else "bypassing only"))
     return failure(scenario, f"not found within the budget ({cap}; seed {budget.seed}): "
-                   f"{tried}", planner, "budget_exhausted")
+                   + "; ".join(x for x in (searched, tried) if x), planner,
+                   "budget_exhausted")
 
 
 def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
