@@ -119,7 +119,11 @@ class Formation:
         h = np.asarray(heading, dtype=float)
         c, s = np.cos(h)[..., None], np.sin(h)[..., None]
         x, y = self.robots[:, 0], self.robots[:, 1]
-        return np.stack([c * x - s * y, s * x + c * y], axis=-1) + np.asarray(centre)[..., None, :]
+        p = np.asarray(centre, dtype=float)[..., None, :]
+        out = np.empty(np.broadcast_shapes(c.shape[:-1] + x.shape, p.shape[:-1]) + (2,))
+        out[..., 0] = c * x - s * y + p[..., 0]     # the hot path of the SE(2) search:
+        out[..., 1] = s * x + c * y + p[..., 1]     # no stacking, no temporary (.., N, 2)
+        return out
 
 
 def _hull_order(p: np.ndarray) -> np.ndarray:
