@@ -108,3 +108,24 @@ def test_iterations_must_be_positive():
     with pytest.raises(InvalidInputError) as e:
         plan(sc, time_budget=-1.0)
     assert e.value.field == "time_budget"
+
+
+def test_budget_exhaustion_diagnoses_a_passage_too_narrow():
+    # Gaps of 0.85 m beside a tall cylinder in a 2 m corridor (perpendicular line: (2 -
+    # 0.3) / 2); the triangle team's narrowest formation is wider than that plus the
+    # clearance, so the message says so, without claiming impossibility.
+    import re
+    from taut.plan import Obstacle
+    from taut.plan.planner import _library, _min_width
+    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.15)])
+    r = plan(sc, iterations=40)
+    assert r.status == "budget_exhausted" and r.certificate is None
+    m = re.search(r"obstacle 'wall-ish' .*? the widest passage is ([0-9.]+) m, less than "
+                  r"the ([0-9.]+) m", r.message)
+    assert m, r.message
+    passage, need = float(m.group(1)), float(m.group(2))
+    assert passage <= 0.85 + 1e-3 and passage > 0.5     # the perpendicular line is a bound
+    compact, others, _ = _library(sc, r.sheet_margin)
+    narrowest = min(_min_width(f) for f in (compact, *others))
+    assert need == pytest.approx(narrowest + 2 * sc.team.clearance, abs=1e-3)
+    assert "not ruled out" in r.message

@@ -34,7 +34,7 @@ from ..errors import InvalidInputError
 from . import _tol
 from ._se2 import SearchBudget, search_se2
 from ._se2_motion import Piece, sample_pieces
-from .certificate import find_certificate
+from .certificate import find_certificate, narrowest_cut
 from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
 from .result import PlanResult, _summary, attempt, compact_formation, failure, relabel
 from .route import crossable
@@ -213,8 +213,28 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
                 + f" alone and {found.pairs} formation pair(s) with one change, "
                 + ("crossing low obstacles" if allow_crossing else "bypassing only"))
     return failure(scenario, f"not found within the budget ({cap}; seed {budget.seed}): "
-                   + "; ".join(x for x in (searched, tried) if x), planner,
-                   "budget_exhausted")
+                   + "; ".join(x for x in (searched, tried, _diagnosis(scenario, forms,
+                                                                       allow_crossing)) if x),
+                   planner, "budget_exhausted")
+
+
+def _diagnosis(scenario: Scenario, forms: list[Formation], allow_crossing: bool) -> str:
+    """Why the search likely failed (not a proof): the narrowest passage beside obstacles
+    no formation of the library can cross, against what the narrowest formation needs."""
+    top = max(f.max_height for f in forms) if allow_crossing else -np.inf
+    blockers = [o for o in scenario.world.obstacles if o.height > top + _tol.GEOMETRY_TOL]
+    cut = narrowest_cut(scenario, blockers)
+    if cut is None:
+        return ""
+    narrowest = min(forms, key=_min_width)
+    need = _min_width(narrowest) + 2 * scenario.team.clearance
+    if cut[0] >= need:
+        return ""
+    return (f"diagnosis: on the narrowest line through obstacle {cut[1]!r} (which no "
+            f"formation of the library can cross) the widest passage is {cut[0]:.3g} m, "
+            f"less than the {need:.3g} m the narrowest formation found needs (its width "
+            f"{_min_width(narrowest):.3g} m plus twice the clearance); a narrower formation "
+            "outside the library is not ruled out")
 
 
 def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
