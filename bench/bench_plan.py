@@ -2,10 +2,14 @@
 
 Usage::
 
-    python bench/bench_plan.py [--count 50] [--seed 2024] [--budget 10] [--margin-study]
-                               [--robustness 5e-3] [--trials 50] [--json OUT]
+    python bench/bench_plan.py [--count 50] [--seed 2024] [--iterations 3000]
+                               [--time-cap S] [--margin-study] [--robustness 5e-3]
+                               [--trials 20] [--json OUT]
 
-Measures, on this machine (report the load: the numbers are wall-clock times):
+Every plan of the suites uses the deterministic budget (``iterations`` samples per
+RRT-Connect run, seed 0), so which plans are found does not depend on the machine's load;
+``--time-cap`` adds the optional wall-clock safety cap (off by default). Measures, on this
+machine (report the load: the times are wall-clock):
 
 * plan time of the planning paper's corridor (``examples/plan/paper_corridor.yaml``;
   goal < 2 s), median and spread of 5 runs, interleaved with the two baselines;
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import sys
 import time
@@ -44,14 +49,14 @@ def timed(fn, *args, **kw):
     return out, time.perf_counter() - t
 
 
-def paper(budget: float) -> None:
+def paper(budget: dict) -> None:
     sc = load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml")
     t = {"crossing": [], "se2-bypass": [], "disc": []}
     res = {}
     for _ in range(5):                                   # interleaved
         for name, kw in (("crossing", {}), ("se2-bypass", {"baseline": "se2"}),
                          ("disc", {"baseline": "disc"})):
-            r, dt = timed(plan, sc, time_budget=budget, **kw)
+            r, dt = timed(plan, sc, **budget, **kw)
             t[name].append(dt)
             res[name] = r
     for name, ts in t.items():
@@ -60,9 +65,9 @@ def paper(budget: float) -> None:
               f"(min {min(ts):.2f}, max {max(ts):.2f}); {r.status}: {r.message[:90]}")
 
 
-def row(sc, budget: float, margin_study: bool, sigma: float | None, trials: int) -> dict:
-    r, t_r = timed(plan, sc, time_budget=budget)
-    b, t_b = timed(plan, sc, baseline="se2", time_budget=budget)
+def row(sc, budget: dict, margin_study: bool, sigma: float | None, trials: int) -> dict:
+    r, t_r = timed(plan, sc, **budget)
+    b, t_b = timed(plan, sc, baseline="se2", **budget)
     d, t_d = timed(plan, sc, baseline="disc")
     out = dict(name=sc.name, n=sc.team.n, obstacles=len(sc.world.obstacles),
                ok=r.success, status=r.status, message=r.message, ok_se2=b.success,
@@ -70,7 +75,8 @@ def row(sc, budget: float, margin_study: bool, sigma: float | None, trials: int)
                length_se2=b.path_length, duration_se2=b.duration,
                length_disc=d.path_length, duration_disc=d.duration, crossed=len(r.crossed),
                reforms=len(r.formations) - 1 if r.success else 0,
-               plan_time=t_r, plan_time_se2=t_b, plan_time_disc=t_d, recheck=None)
+               plan_time=t_r, plan_time_se2=t_b, plan_time_disc=t_d, recheck=None,
+               superset=bool(r.success or not (b.success or d.success)))
     if r.success:
         rr, ro = resample_motion(r.robots, r.object, 10)
         chk = verify_motion(sc, rr, ro, sheet_margin=r.sheet_margin)
@@ -82,8 +88,10 @@ def row(sc, budget: float, margin_study: bool, sigma: float | None, trials: int)
         if sigma is not None:
             rob = r.robustness(sigma, trials, seed=1)
             out["tear"], out["drop"] = rob.tear_probability, rob.drop_probability
+            out["worst_extension"] = rob.worst_extension
+            out["trials"] = trials
     if margin_study:
-        z, t_z = timed(plan, sc, time_budget=budget, sheet_margin=0.0)
+        z, t_z = timed(plan, sc, sheet_margin=0.0, **budget)
         out.update(ok_m0=z.success, length_m0=z.path_length, duration_m0=z.duration,
                    plan_time_m0=t_z)
     return out
@@ -133,32 +141,57 @@ def report(rows: list[dict], margin_study: bool) -> bool:
     return sup_se2 and sup_disc and recheck
 
 
+def _dump(args, rows: list[dict], meta: dict, done: bool) -> None:
+    n = len(rows)
+    summary = {"scenarios": n, "finished": done,
+               "crossing": sum(x["ok"] for x in rows),
+               "se2_bypass": sum(x["ok_se2"] for x in rows),
+               "disc": sum(x["ok_disc"] for x in rows),
+               "superset_everywhere": all(x["superset"] for x in rows),
+               "recheck_10x_all_pass": all(x["recheck"] for x in rows if x["ok"]),
+               "statuses": {k: sum(x["status"] == k for x in rows)
+                            for k in sorted({x["status"] for x in rows})},
+               "load_now": os.getloadavg()}
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps({"meta": meta, "summary": summary, "rows": rows},
+                                    indent=1, default=float))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--count", type=int, default=50)
     ap.add_argument("--seed", type=int, default=2024)
-    ap.add_argument("--budget", type=float, default=10.0, help="time budget per plan, s")
+    ap.add_argument("--iterations", type=int, default=3000,
+                    help="deterministic search budget: samples per RRT-Connect run")
+    ap.add_argument("--time-cap", type=float, default=None,
+                    help="optional wall-clock safety cap per search, s (default none)")
     ap.add_argument("--margin-study", action="store_true")
     ap.add_argument("--robustness", type=float, default=None, metavar="SIGMA")
-    ap.add_argument("--trials", type=int, default=50)
+    ap.add_argument("--trials", type=int, default=20)
     ap.add_argument("--no-paper", action="store_true")
     ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args(argv)
+    budget = {"iterations": args.iterations, "time_budget": args.time_cap}
     if not args.no_paper:
-        paper(args.budget)
+        paper(budget)
+    meta = {"count": args.count, "seed": args.seed, "iterations": args.iterations,
+            "time_cap": args.time_cap, "robustness_sigma": args.robustness,
+            "trials": args.trials, "margin_study": args.margin_study,
+            "load_at_start": os.getloadavg(), "cpus": os.cpu_count(),
+            "started": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}
     suite, gen_time = timed(generate_suite, args.count, args.seed)
     print(f"\nsuite: {args.count} scenarios (seed {args.seed}, generated in {gen_time:.1f} s)")
     rows = []
     for sc in suite:
-        rows.append(row(sc, args.budget, args.margin_study, args.robustness, args.trials))
+        rows.append(row(sc, budget, args.margin_study, args.robustness, args.trials))
         x = rows[-1]
         print(f"{x['name']:<18} {x['status']:<17} se2 {x['ok_se2']!s:<5} disc "
               f"{x['ok_disc']!s:<5} {x['plan_time']:.1f} s", flush=True)
         if args.json is not None:                    # partial results survive a stop
-            args.json.write_text(json.dumps(rows, indent=1, default=float))
+            _dump(args, rows, meta, done=False)
     good = report(rows, args.margin_study)
     if args.json is not None:
-        args.json.write_text(json.dumps(rows, indent=1, default=float))
+        _dump(args, rows, meta, done=True)
     return 0 if good else 1
 
 

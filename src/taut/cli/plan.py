@@ -17,6 +17,8 @@ __all__ = ["register", "plan_to_dict", "plan_command"]
 
 #: Largest search budget the command accepts, s (one hour).
 MAX_BUDGET_S = 3600.0
+#: Largest iteration budget the command accepts (a few minutes of search per run).
+MAX_ITERATIONS = 200_000
 
 
 def plan_command(
@@ -36,7 +38,12 @@ def plan_command(
     algorithm2: bool = typer.Option(False, "--algorithm2",
                                     help="Cross only as the paper's Algorithm 2 does (the "
                                          "obstacle passes under the object)."),
-    budget: float = typer.Option(10.0, "--budget", help="Time budget of the search, s."),
+    budget: Optional[float] = typer.Option(None, "--budget", help="Optional wall-clock "
+                                           "safety cap of each search, s (default: none; "
+                                           "then the answer does not depend on the "
+                                           "machine's load)."),
+    iterations: int = typer.Option(3000, "--iterations", help="Search budget: samples per "
+                                   "RRT-Connect run (deterministic for a seed)."),
     sheet_margin: float = typer.Option(0.01, "--sheet-margin",
                                        help="Robot pairs stay this far inside their sheet "
                                             "distance, m."),
@@ -51,11 +58,12 @@ def plan_command(
     out = output_path(out, "--out", JSON_SUFFIXES)
     plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
-    if not 0 < budget <= MAX_BUDGET_S:
+    if budget is not None and not 0 < budget <= MAX_BUDGET_S:
         raise InvalidInputError("--budget", f"must be in (0, {MAX_BUDGET_S:g}] s, got {budget:g}")
     if not 0 <= sheet_margin <= 1.0:
         raise InvalidInputError("--sheet-margin", f"must be in [0, 1] m, got {sheet_margin:g}")
     as_count(seed, "--seed", minimum=0)
+    as_count(iterations, "--iterations", minimum=1, maximum=MAX_ITERATIONS)
     if baseline and disc_baseline:
         raise InvalidInputError("--baseline", "give at most one of --baseline and "
                                 "--disc-baseline")
@@ -63,7 +71,7 @@ def plan_command(
     with working("plan"):
         result = plan(sc, baseline="disc" if disc_baseline else baseline,
                       method="algorithm2" if algorithm2 else "se2", time_budget=budget,
-                      sheet_margin=sheet_margin, seed=seed)
+                      iterations=iterations, sheet_margin=sheet_margin, seed=seed)
     doc = plan_to_dict(result)
     if out is not None:
         out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")

@@ -29,7 +29,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..errors import ScenarioError, TautError
-from ..plan.world import Obstacle, Scenario, Team, World
+from ..plan.world import MAX_TEAM_ROBOTS, Obstacle, Scenario, Team, World
 from ..sheet import Sheet
 from .files import read_mapping, validate_mapping
 
@@ -106,6 +106,9 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
     """
     raw = validate_mapping(_PlanFile, data)
     t = raw.team
+    if t.regular is not None and t.regular.n > MAX_TEAM_ROBOTS:   # before allocating it
+        raise ScenarioError("team.regular.n", f"a planning team has at most "
+                            f"{MAX_TEAM_ROBOTS} robots, got {t.regular.n}")
     try:
         if t.sheet is not None:
             sheet = Sheet(np.array(t.sheet, dtype=float))
@@ -115,6 +118,9 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
             sheet = Sheet.regular(reg.n, reg.circumradius, phase=reg.phase)
     except TautError as exc:
         raise ScenarioError("team.sheet", exc.problem) from None
+    if sheet.n > MAX_TEAM_ROBOTS:
+        raise ScenarioError("team.sheet", f"a planning team has at most {MAX_TEAM_ROBOTS} "
+                            f"robots, got {sheet.n}")
     team = Team(sheet, t.hold_height, t.robot_radius, t.height_safety, t.lateral_safety,
                 t.speed, t.rotation_speed, t.mass)
     obstacles = []

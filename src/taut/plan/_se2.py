@@ -13,8 +13,10 @@ obstacles low enough for both formations); the search runs from the start to any
 in ``A`` and on from the one reached to the goal in ``B``. The quasi-static simulation
 then checks each change (:mod:`taut.plan._se2_motion`).
 
-All candidates are deterministic for a given ``seed``; the budget is an iteration count
-per search and a wall-clock cap for the whole search (reported when it stops the search).
+All candidates are deterministic for a given ``seed``: the budget that decides success is
+an iteration count per search (samples drawn), independent of the machine's load; an
+optional wall-clock cap for the whole search is only a safety stop (reported when it
+stops the search, and then the answer may depend on the load).
 """
 
 from __future__ import annotations
@@ -36,6 +38,10 @@ __all__ = ["SearchBudget", "SE2Search", "search_se2", "MAX_PAIRS"]
 
 #: Most formation pairs (one formation change) searched.
 MAX_PAIRS = 6
+#: Default total samples of one search, in units of ``SearchBudget.iterations``: room for
+#: the quick rounds (a fifth of a run per formation and pair) and a few full runs, while
+#: bounding the work of a failing search.
+TOTAL_RUNS = 4
 
 
 @dataclass(frozen=True)
@@ -46,18 +52,28 @@ class SearchBudget:
     ----------
     iterations : int
         Samples per RRT-Connect run.
-    time_budget : float
-        Wall-clock cap of the whole search, s.
+    time_budget : float or None
+        Optional wall-clock safety cap of the whole search, s (None: no cap, the search
+        is deterministic for ``seed``).
     seed : int
         Seed of every random choice.
     reform_samples : int
         Formation-change states sampled per formation pair.
+    total : int or None
+        Samples of the whole search (every run together; default ``TOTAL_RUNS`` times
+        ``iterations``): bounds the work deterministically.
     """
 
     iterations: int = 3000
-    time_budget: float = 10.0
+    time_budget: float | None = None
     seed: int = 0
     reform_samples: int = 24
+    total: int | None = None
+
+    @property
+    def total_samples(self) -> int:
+        """Samples the whole search may draw."""
+        return self.total if self.total is not None else TOTAL_RUNS * self.iterations
 
 
 @dataclass
@@ -68,6 +84,8 @@ class SE2Search:
     notes: list[str] = field(default_factory=list)
     timed_out: bool = False
     iterations: int = 0
+    spent: bool = False           # the total sample budget ran out
+    pairs: int = 0                # formation pairs (one change) in the search
 
 
 def _bounds(scenario: Scenario) -> np.ndarray:
@@ -83,7 +101,8 @@ def _transition_ok(scenario: Scenario, ca: PoseChecker, cb: PoseChecker,
     k = max(1, int(np.ceil(move / ca.resolution)))
     s = np.arange(0, k + 1) / k
     r = a[None] + s[:, None, None] * (b - a)[None]
-    if not shapely.covers(ca.robot_region, shapely.points(r.reshape(-1, 2))).all():
+    p = r.reshape(-1, 2)
+    if not shapely.intersects_xy(ca.robot_region, p[:, 0], p[:, 1]).all():
         return False
     hulls = shapely.convex_hull(shapely.multipoints(r))
     if not shapely.covers(ca.hull_region, hulls).all():
@@ -119,6 +138,13 @@ class _Runner:
         self._ends: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def left(self) -> float:
+        """Wall-clock time left under the optional cap, s (inf without one); 0 once the
+        total sample budget is spent."""
+        if self.out.iterations >= self.budget.total_samples:
+            self.out.spent = True
+            return 0.0
+        if self.budget.time_budget is None:
+            return np.inf
         return self.budget.time_budget - (time.perf_counter() - self.t0)
 
     def checker(self, f: Formation) -> PoseChecker:
@@ -128,8 +154,9 @@ class _Runner:
 
     def search(self, c: PoseChecker, starts: np.ndarray, goals: np.ndarray,
                iterations: int | None = None):
+        room = self.budget.total_samples - self.out.iterations
         res = rrt_connect(c, starts, goals, bounds=_bounds(self.sc), rng=self.rng,
-                          iterations=iterations or self.budget.iterations,
+                          iterations=max(1, min(iterations or self.budget.iterations, room)),
                           time_limit=max(self.left(), 0))
         self.out.iterations += res.iterations
         self.out.timed_out |= res.timed_out
@@ -211,6 +238,7 @@ def search_se2(scenario: Scenario, formations: list[Formation], *, allow_crossin
         # at most MAX_PAIRS of them.
         pairs.sort(key=lambda p: (ends[id(p[0])][1], ends[id(p[1])][0]))
         pairs = pairs[:MAX_PAIRS]
+    run.out.pairs = len(pairs)
     # Rounds: quick singles, quick pairs, full singles, full pairs; stop at the first
     # round that finds a verified plan.
     retry = [f for f in formations if run.left() > 0 and run.single(f, quick)]
@@ -225,6 +253,6 @@ def search_se2(scenario: Scenario, formations: list[Formation], *, allow_crossin
         for a, b in pairs:
             if run.left() > 0:
                 run.pair(a, b, quick if stage == "quick pairs" else None)
-    if run.left() <= 0:
+    if run.left() <= 0 and not run.out.spent:
         run.out.timed_out = True
     return run.out

@@ -176,6 +176,7 @@ class PoseChecker:
                                       reflex])
         self.near_r = np.concatenate([[o.mec_radius for o in blocked], np.zeros(len(reflex))])
         self.near_r = self.near_r + self.radius + 2 * self.resolution
+        self._near_r2 = self.near_r ** 2
         self._n_reflex = len(reflex)
 
     def robots(self, states: np.ndarray) -> np.ndarray:
@@ -190,15 +191,16 @@ class PoseChecker:
         r = self.robots(states)
         K, N = r.shape[:2]
         self.checks += K
-        ok = shapely.covers(self.robot_region, shapely.points(r.reshape(-1, 2)))
+        p = r.reshape(-1, 2)                     # point-in-region without point objects
+        ok = shapely.intersects_xy(self.robot_region, p[:, 0], p[:, 1])
         ok = ok.reshape(K, N).all(axis=1)
         if not ok.any():
             return ok
         idx = np.flatnonzero(ok)
         if len(self.near_r):
             s = np.asarray(states, dtype=float).reshape(-1, 3)[idx, :2]
-            d = np.linalg.norm(s[:, None] - self.near_c[None], axis=-1)
-            idx = idx[(d <= self.near_r[None]).any(axis=1)]
+            d2 = ((s[:, None] - self.near_c[None]) ** 2).sum(axis=-1)
+            idx = idx[(d2 <= self._near_r2[None]).any(axis=1)]
         else:
             idx = idx[:0]
         if not len(idx):

@@ -110,3 +110,33 @@ def find_certificate(scenario: Scenario, directions: int = 72) -> Certificate | 
             if cert is not None:
                 return cert
     return None
+
+
+def narrowest_cut(scenario: Scenario, blockers: list, directions: int = 72
+                  ) -> tuple[float, str] | None:
+    """Diagnosis for a failed search (not a proof): over lines through each obstacle of
+    ``blockers`` (obstacles no formation of the library can cross) that separate start and
+    goal, the least widest free gap along the line, m, treating ``blockers`` as walls, and
+    the obstacle it passes through; None when no such line separates start and goal.
+
+    A team whose narrowest formation needs more than this passage cannot get past with the
+    library's formations; a narrower formation outside the library is not ruled out.
+    """
+    world = scenario.world
+    span = 4 * float(np.ptp(world.free_space, axis=0).max()) + 1.0
+    walls = unary_union([o.geometry for o in blockers]) if blockers else None
+    a = np.pi * np.arange(directions) / directions
+    best: tuple[float, str] | None = None
+    for o in blockers:
+        p = np.asarray(o.mec_center, float)
+        for u in np.column_stack([np.cos(a), np.sin(a)]):
+            n = np.array([-u[1], u[0]])
+            if np.dot(scenario.start - p, n) * np.dot(scenario.goal - p, n) >= 0:
+                continue
+            line = LineString([p - span * u, p + span * u]).intersection(world.geometry)
+            free = line.difference(walls) if walls is not None else line
+            widest = max((g.length for g in getattr(free, "geoms", [free]) if not g.is_empty),
+                         default=0.0)
+            if best is None or widest < best[0]:
+                best = (float(widest), str(o.id))
+    return best

@@ -29,11 +29,12 @@ from typing import Literal
 
 import numpy as np
 
+from .._validate import as_count
 from ..errors import InvalidInputError
 from . import _tol
 from ._se2 import SearchBudget, search_se2
 from ._se2_motion import Piece, sample_pieces
-from .certificate import find_certificate
+from .certificate import find_certificate, narrowest_cut
 from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
 from .result import PlanResult, _summary, attempt, compact_formation, failure, relabel
 from .route import crossable
@@ -204,18 +205,60 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
     if results and not found.timed_out and len(results) == len(found.notes):
         return failure(scenario, f"every candidate failed verification: {tried}", planner,
                        "unverified")
-    cap = ("the time budget" if found.timed_out
-           else f"{budget.iterations} samples per search")
-    if not tried:
-        tried = "searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
+    cap = (f"the time cap of {budget.time_budget:g} s" if found.timed_out
+           else f"{budget.iterations} samples per run, {found.iterations} of "
+                f"{budget.total_samples} in all")
+    searched = ("searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
                                         for f in forms)
+                + f" alone and {found.pairs} formation pair(s) with one change, "
+                + ("crossing low obstacles" if allow_crossing else "bypassing only"))
     return failure(scenario, f"not found within the budget ({cap}; seed {budget.seed}): "
-                   f"{tried}", planner, "budget_exhausted")
+                   + "; ".join(x for x in (searched, tried, _diagnosis(scenario, forms,
+                                                                       allow_crossing)) if x),
+                   planner, "budget_exhausted")
+
+
+def _diagnosis(scenario: Scenario, forms: list[Formation], allow_crossing: bool) -> str:
+    """Why the search likely failed (not a proof): the narrowest passage beside obstacles
+    no formation of the library can cross, against what the narrowest formation needs."""
+    top = max(f.max_height for f in forms) if allow_crossing else -np.inf
+    blockers = [o for o in scenario.world.obstacles if o.height > top + _tol.GEOMETRY_TOL]
+    cut = narrowest_cut(scenario, blockers)
+    if cut is None:
+        return ""
+    narrowest = min(forms, key=_min_width)
+    need = _min_width(narrowest) + 2 * scenario.team.clearance
+    if cut[0] >= need:
+        return ""
+    return (f"diagnosis: on the narrowest line through obstacle {cut[1]!r} (which no "
+            f"formation of the library can cross) the widest passage is {cut[0]:.3g} m, "
+            f"less than the {need:.3g} m the narrowest formation found needs (its width "
+            f"{_min_width(narrowest):.3g} m plus twice the clearance); a narrower formation "
+            "outside the library is not ruled out")
+
+
+def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
+                     time_budget: float | None, iterations: int, seed: int) -> SearchBudget:
+    """Validate :func:`plan`'s options (typed errors naming the field); the budget."""
+    if not isinstance(scenario, Scenario):
+        raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
+    if method not in ("se2", "roadmap", "algorithm2"):
+        raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
+                                          f"{method!r}")
+    if baseline not in (False, True, "se2", "disc"):
+        raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
+    if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
+        raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
+    if time_budget is not None and not (time_budget > 0):
+        raise InvalidInputError("time_budget", "must be a positive time in s, or None")
+    return SearchBudget(iterations=as_count(iterations, "iterations", minimum=1),
+                        seed=as_count(seed, "seed", minimum=0),
+                        time_budget=None if time_budget is None else float(time_budget))
 
 
 def plan(scenario: Scenario, *, method: Method = "se2",
          baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
-         sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float = 10.0,
+         sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float | None = None,
          iterations: int = 3000, seed: int = 0) -> PlanResult:
     """Plan the transport of the object from ``scenario.start`` to ``scenario.goal``.
 
@@ -231,15 +274,16 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     sheet_margin : float
         Every robot pair stays this far inside its sheet distance, m (default 0.01 m:
         robots off by at most 5 mm each never tear the sheet).
-    time_budget : float
-        Wall-clock cap of the SE(2) search, s (the crossing search gets 70 % of it; when it
-        fails, the disc roadmap and then the SE(2) bypass search with the full budget, as
-        the baseline runs it, are tried, so a failure can take about 1.7 times this).
+    time_budget : float or None
+        Optional wall-clock safety cap of each SE(2) search, s (default None: no cap).
+        The budget that decides success is ``iterations``, so the answer does not depend
+        on the machine's load; a cap that stops a search is reported in the message, and
+        then the answer may depend on the load.
     iterations : int
-        Samples per RRT-Connect run of the SE(2) search.
+        Samples per RRT-Connect run of the SE(2) search (the deterministic budget).
     seed : int
-        Seed of the SE(2) search (plans are reproducible for a given seed and budget, as
-        long as the time cap is not what stops the search).
+        Seed of the SE(2) search: plans are reproducible for a given seed and
+        ``iterations`` (unless the optional time cap stops a search).
 
     Returns
     -------
@@ -258,33 +302,22 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     >>> r.success, r.status, r.crossed                             # doctest: +SKIP
     (True, 'ok', ('1', '2'))
     """
-    if not isinstance(scenario, Scenario):
-        raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
-    if method not in ("se2", "roadmap", "algorithm2"):
-        raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
-                                          f"{method!r}")
-    if baseline not in (False, True, "se2", "disc"):
-        raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
-    if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
-        raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
-    if not (time_budget > 0) or int(iterations) < 1:
-        raise InvalidInputError("time_budget", "time_budget and iterations must be positive")
+    budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
+                              iterations, seed)
     margin = float(sheet_margin)
-    budget = SearchBudget(iterations=int(iterations), time_budget=float(time_budget),
-                          seed=int(seed))
     cached = _library(scenario, margin)
     lib: Library = (cached[0], list(cached[1]), list(cached[2]))
     if baseline == "disc":
         return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
                        sheet_margin=margin)
     if baseline:
-        return _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=budget,
-                    planner="se2-bypass", library=lib)
+        return _bypass(scenario, margin, budget)
     if method != "se2":
         return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
                         lib)
     full = budget                 # the SE(2) bypass fallback runs exactly as the baseline
-    first = replace(budget, time_budget=0.7 * budget.time_budget)
+    first = budget if budget.time_budget is None else replace(
+        budget, time_budget=0.7 * budget.time_budget)
     best = _se2(scenario, allow_crossing=True, sheet_margin=margin, budget=first,
                 planner="crossing", library=lib)
     if best.success or best.status == "refuted":
@@ -294,8 +327,18 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     alt = _roadmap(scenario, True, margin, "crossing", lib)
     if alt.success:
         return alt
-    alt = _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=full,
-               planner="crossing", library=lib)
+    alt = _bypass(scenario, margin, full)
     if alt.success:
-        return alt
+        return relabel(alt, "crossing")
     return best
+
+
+@functools.lru_cache(maxsize=32)
+def _bypass(scenario: Scenario, sheet_margin: float, budget: SearchBudget) -> PlanResult:
+    """The SE(2) bypass search (the baseline, and the crossing planner's last fallback),
+    memoised: it is deterministic for a given scenario, margin and sample budget, so the
+    fallback and the baseline are one search, run once."""
+    cached = _library(scenario, sheet_margin)
+    lib: Library = (cached[0], list(cached[1]), list(cached[2]))
+    return _se2(scenario, allow_crossing=False, sheet_margin=sheet_margin, budget=budget,
+                planner="se2-bypass", library=lib)

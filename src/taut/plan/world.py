@@ -188,6 +188,13 @@ class World:
         return self._width
 
 
+#: Most robots of a planning team. The formation optimisation (eq. 15: SLSQP over 2N + 4
+#: variables with N(N-1)/2 pair constraints, then forward kinematics over the taut sets)
+#: grows steeply with N: about 1 s at 12 robots and a minute at 16 on a loaded 2-core
+#: machine, and 148 s at 40 before answering. Larger teams are refused at once.
+MAX_TEAM_ROBOTS = 12
+
+
 @dataclass(frozen=True, eq=False)
 class Team:
     """A sheet-carrying robot team (planning paper Sec. II-A and V-A).
@@ -227,6 +234,9 @@ class Team:
     def __post_init__(self) -> None:
         if not isinstance(self.sheet, Sheet):
             raise InvalidInputError("sheet", "must be a taut.sheet.Sheet")
+        if self.sheet.n > MAX_TEAM_ROBOTS:
+            raise InvalidInputError("sheet", f"a planning team has at most {MAX_TEAM_ROBOTS} "
+                                             f"robots, got {self.sheet.n}")
         object.__setattr__(self, "hold_height", check_hold_height(self.hold_height))
         for name in ("robot_radius", "speed", "rotation_speed"):
             object.__setattr__(self, name, as_positive(getattr(self, name), name))
