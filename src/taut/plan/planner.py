@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from . import _tol
+from ._ompl import Search, engine
 from ._se2 import SearchBudget, search_se2
 from ._se2_motion import Piece, sample_pieces
 from .certificate import find_certificate
@@ -181,7 +182,8 @@ def _finish_se2(scenario: Scenario, pieces: list[Piece], planner: str, sheet_mar
 
 
 def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
-         budget: SearchBudget, planner: str, library: Library) -> PlanResult:
+         budget: SearchBudget, planner: str, library: Library,
+         search: Search = "rrtconnect") -> PlanResult:
     """One SE(2) search (crossing planner or its bypass baseline) and its best plan."""
     compact, others, notes = library
     forms = [compact, *others]
@@ -192,10 +194,10 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
         return results[-1].success
 
     found = search_se2(scenario, forms, allow_crossing=allow_crossing, budget=budget,
-                       accept=accept)
+                       accept=accept, engine=engine(search))
     good = [r for r in results if r.success]
     if good:
-        return min(good, key=lambda r: r.duration)
+        return replace(min(good, key=lambda r: r.duration), search=search)
     cert = find_certificate(scenario)
     if cert is not None:
         return failure(scenario, cert.message, planner, "refuted", cert)
@@ -216,7 +218,7 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
 def plan(scenario: Scenario, *, method: Method = "se2",
          baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
          sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float = 10.0,
-         iterations: int = 3000, seed: int = 0) -> PlanResult:
+         iterations: int = 3000, seed: int = 0, search: Search = "rrtconnect") -> PlanResult:
     """Plan the transport of the object from ``scenario.start`` to ``scenario.goal``.
 
     Parameters
@@ -240,6 +242,11 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     seed : int
         Seed of the SE(2) search (plans are reproducible for a given seed and budget, as
         long as the time cap is not what stops the search).
+    search : {"rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"}
+        Who searches SE(2) (``method="se2"`` and ``baseline="se2"``): taut's own seeded
+        RRT-Connect (default), or OMPL's RRT-Connect / RRT* / PRM on the same validity
+        checker, formations, bounds and verification (optional extra ``plan-ompl``;
+        seeding in :mod:`taut.plan._ompl`).
 
     Returns
     -------
@@ -265,6 +272,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
                                           f"{method!r}")
     if baseline not in (False, True, "se2", "disc"):
         raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
+    engine(search)                      # validates the name and that OMPL is installed
     if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
         raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
     if not (time_budget > 0) or int(iterations) < 1:
@@ -279,14 +287,14 @@ def plan(scenario: Scenario, *, method: Method = "se2",
                        sheet_margin=margin)
     if baseline:
         return _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=budget,
-                    planner="se2-bypass", library=lib)
+                    planner="se2-bypass", library=lib, search=search)
     if method != "se2":
         return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
                         lib)
     full = budget                 # the SE(2) bypass fallback runs exactly as the baseline
     first = replace(budget, time_budget=0.7 * budget.time_budget)
     best = _se2(scenario, allow_crossing=True, sheet_margin=margin, budget=first,
-                planner="crossing", library=lib)
+                planner="crossing", library=lib, search=search)
     if best.success or best.status == "refuted":
         return best
     # Fallbacks that make the planner succeed wherever a baseline does: the disc roadmap,
@@ -295,7 +303,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     if alt.success:
         return alt
     alt = _se2(scenario, allow_crossing=False, sheet_margin=margin, budget=full,
-               planner="crossing", library=lib)
+               planner="crossing", library=lib, search=search)
     if alt.success:
         return alt
     return best
