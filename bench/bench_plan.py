@@ -4,7 +4,7 @@ Usage::
 
     python bench/bench_plan.py [--count 50] [--seed 2024] [--iterations 3000]
                                [--time-cap S] [--margin-study] [--robustness 5e-3]
-                               [--trials 20] [--json OUT]
+                               [--trials 20] [--json OUT] [--library ompl-rrtconnect]
 
 Every plan of the suites uses the deterministic budget (``iterations`` samples per
 RRT-Connect run, seed 0), so which plans are found does not depend on the machine's load;
@@ -23,6 +23,11 @@ machine (report the load: the times are wall-clock):
   time against the default margin where both succeed);
 * ``--robustness S``: per crossing plan, seeded Monte Carlo with every robot displaced up
   to ``S`` m (uniform in a disc) at every sample: tear and drop probabilities.
+* ``--library NAME``: instead, the crossing planner with taut's own RRT-Connect against
+  the same planner searching with ``plan(..., search=NAME)`` (an OMPL planner, extra
+  ``plan-ompl``), same validity checker, budget and seed, interleaved per scenario (the
+  order alternates): success counts, plan times, which plans the SE(2) search itself found
+  (not a fallback), and whether each succeeds on a superset of the other's scenarios.
 """
 
 from __future__ import annotations
@@ -157,6 +162,36 @@ def _dump(args, rows: list[dict], meta: dict, done: bool) -> None:
                                     indent=1, default=float))
 
 
+def compare_libraries(suite: list, library: str, budget: dict) -> bool:
+    """``--library``: own RRT-Connect vs ``library`` on every scenario (module docstring)."""
+    rows = []
+    for k, sc in enumerate(suite):
+        runs = {}
+        order = ("rrtconnect", library) if k % 2 == 0 else (library, "rrtconnect")
+        for name in order:
+            r, dt = timed(plan, sc, search=name, **budget)
+            runs[name] = (r.success, r.search is not None, dt, r.status)
+        rows.append(runs)
+        print(f"{sc.name:<18} " + "  ".join(
+            f"{n}: {runs[n][3]:<16} {'(search)' if runs[n][1] else '        '} "
+            f"{runs[n][2]:5.1f} s" for n in ("rrtconnect", library)), flush=True)
+    n = len(rows)
+    print(f"\n{'search':<16} {'success':>9} {'by SE(2) search':>16} {'median s':>9} "
+          f"{'min s':>6} {'max s':>6}")
+    for name in ("rrtconnect", library):
+        ts = [x[name][2] for x in rows]
+        print(f"{name:<16} {sum(x[name][0] for x in rows):>4}/{n:<4} "
+              f"{sum(x[name][1] for x in rows):>11}/{n:<4} {statistics.median(ts):>9.2f} "
+              f"{min(ts):>6.2f} {max(ts):>6.2f}")
+    own_sup = all(x["rrtconnect"][0] for x in rows if x[library][0])
+    lib_sup = all(x[library][0] for x in rows if x["rrtconnect"][0])
+    only_lib = sum(x[library][0] and not x["rrtconnect"][0] for x in rows)
+    only_own = sum(x["rrtconnect"][0] and not x[library][0] for x in rows)
+    print(f"own superset of {library}: {own_sup} ({only_lib} solved only by {library}); "
+          f"{library} superset of own: {lib_sup} ({only_own} solved only by own)")
+    return own_sup
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--count", type=int, default=50)
@@ -170,8 +205,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--trials", type=int, default=20)
     ap.add_argument("--no-paper", action="store_true")
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--library", default=None, metavar="SEARCH",
+                    help="compare the own RRT-Connect with plan(search=SEARCH), e.g. "
+                         "ompl-rrtconnect")
     args = ap.parse_args(argv)
     budget = {"iterations": args.iterations, "time_budget": args.time_cap}
+    if args.library is not None:
+        suite = generate_suite(args.count, args.seed)
+        print(f"suite: {args.count} scenarios (seed {args.seed}); {args.iterations} "
+              f"iterations, time cap {args.time_cap}; own RRT-Connect vs {args.library}")
+        return 0 if compare_libraries(suite, args.library, budget) else 1
     if not args.no_paper:
         paper(budget)
     meta = {"count": args.count, "seed": args.seed, "iterations": args.iterations,

@@ -163,6 +163,8 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("plan", ["plan", f]) for f in files + [str(p) for p in _plan_mutations(tmp)]]
     for opt in ("--plot", "--animate", "--out"):
         cases += [("plan", ["plan", str(PLAN), opt, o]) for o in outs]
+    cases += [("plan", ["plan", str(PLAN), "--search", v])
+              for v in ["", "ompl", "RRTConnect", "ompl-rrt", "prm", "1"]]
     # cdpr
     models = ["nosuch"] + files
     pose = ["--pose", "0", "0", "1"]

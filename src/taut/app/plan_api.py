@@ -31,6 +31,9 @@ __all__ = ["PlanAPI", "plan_series", "world_to_dict"]
 
 #: Finished jobs kept for the page to collect.
 _KEEP_JOBS = 16
+#: Wall-clock cap of one planning job, s: the app stays interactive (the planner's own
+#: budget is counted in samples; a failing plan could otherwise search for minutes).
+PLAN_TIME_CAP_S = 30.0
 
 
 def world_to_dict(sc: Scenario) -> dict[str, Any]:
@@ -158,7 +161,7 @@ class PlanAPI:
             job.stage, job.step = "bypass-only baseline", 1
             base = plan_baseline(sc)
             job.stage, job.step = "planner with obstacle crossing", 2
-            best = plan(sc)
+            best = plan(sc, time_budget=PLAN_TIME_CAP_S)
             job.result = {"plan": _summary(sc, best), "baseline": _summary(sc, base),
                           "world": world_to_dict(sc)}
         except TautError as exc:

@@ -48,6 +48,10 @@ def plan_command(
                                        help="Robot pairs stay this far inside their sheet "
                                             "distance, m."),
     seed: int = typer.Option(0, "--seed", help="Seed of the SE(2) search."),
+    search: str = typer.Option("rrtconnect", "--search",
+                               help="Who searches SE(2): rrtconnect (taut's own, "
+                                    "deterministic), ompl-rrtconnect, ompl-rrtstar or "
+                                    "ompl-prm (OMPL, extra plan-ompl)."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
@@ -64,6 +68,7 @@ def plan_command(
         raise InvalidInputError("--sheet-margin", f"must be in [0, 1] m, got {sheet_margin:g}")
     as_count(seed, "--seed", minimum=0)
     as_count(iterations, "--iterations", minimum=1, maximum=MAX_ITERATIONS)
+    _check_search(search)
     if baseline and disc_baseline:
         raise InvalidInputError("--baseline", "give at most one of --baseline and "
                                 "--disc-baseline")
@@ -71,7 +76,8 @@ def plan_command(
     with working("plan"):
         result = plan(sc, baseline="disc" if disc_baseline else baseline,
                       method="algorithm2" if algorithm2 else "se2", time_budget=budget,
-                      iterations=iterations, sheet_margin=sheet_margin, seed=seed)
+                      iterations=iterations, sheet_margin=sheet_margin, seed=seed,
+                      search=search)  # type: ignore[arg-type]  # checked above
     doc = plan_to_dict(result)
     if out is not None:
         out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")
@@ -95,6 +101,15 @@ def plan_command(
                 typer.echo(f"taut: {name}: {path} not written: there is no plan to draw",
                            err=True)
     return 0 if result.success else 1
+
+
+def _check_search(search: str) -> None:
+    """``--search`` names a known search whose library is installed."""
+    from ..plan._ompl import engine
+    try:
+        engine(search)
+    except InvalidInputError as exc:
+        raise InvalidInputError("--search", exc.problem) from None
 
 
 def register(app: typer.Typer) -> None:

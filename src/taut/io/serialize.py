@@ -159,7 +159,8 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
     """JSON form of a plan: ``success``, ``status``, ``message``, ``reason`` (deprecated:
     ``message`` on failure, null on success), ``planner``, ``times`` [T], ``robots``
     [T][N][2], ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``, ``bypassed``,
-    plus ``path_length`` (m) and ``duration`` (s) (null on failure)."""
+    plus ``path_length`` (m) and ``duration`` (s) (null on failure) and ``search`` (who
+    found an SE(2) plan, null otherwise)."""
     message = _attr(r, "message", "reason")
     return {
         "success": bool(r.success),
@@ -175,6 +176,7 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
         "bypassed": list(r.bypassed),
         "path_length": finite_or_none(r.path_length),
         "duration": finite_or_none(r.duration),
+        "search": getattr(r, "search", None),
     }
 
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import shapely
 
-from ._rrt import rrt_connect, shortcut, valid_headings
+from ._rrt import SearchOutcome, rrt_connect, shortcut, valid_headings
 from ._se2_motion import Piece
 from ._se2_space import PoseChecker
 from .formation import Formation
@@ -42,6 +42,9 @@ MAX_PAIRS = 6
 #: the quick rounds (a fifth of a run per formation and pair) and a few full runs, while
 #: bounding the work of a failing search.
 TOTAL_RUNS = 4
+
+#: A search from starts to goals with :func:`~taut.plan._rrt.rrt_connect`'s signature.
+Engine = Callable[..., SearchOutcome]
 
 
 @dataclass(frozen=True)
@@ -128,9 +131,10 @@ def _reform_states(scenario: Scenario, ca: PoseChecker, cb: PoseChecker,
 
 class _Runner:
     def __init__(self, scenario: Scenario, budget: SearchBudget, allow_crossing: bool,
-                 accept: Callable[[list[Piece]], bool]):
+                 accept: Callable[[list[Piece]], bool], engine: Engine | None = None):
         self.sc, self.budget, self.allow = scenario, budget, allow_crossing
         self.accept = accept
+        self.engine = engine
         self.rng = np.random.default_rng(budget.seed)
         self.t0 = time.perf_counter()
         self.out = SE2Search()
@@ -155,13 +159,16 @@ class _Runner:
     def search(self, c: PoseChecker, starts: np.ndarray, goals: np.ndarray,
                iterations: int | None = None):
         room = self.budget.total_samples - self.out.iterations
-        res = rrt_connect(c, starts, goals, bounds=_bounds(self.sc), rng=self.rng,
-                          iterations=max(1, min(iterations or self.budget.iterations, room)),
-                          time_limit=max(self.left(), 0))
+        res = (self.engine or rrt_connect)(
+            c, starts, goals, bounds=_bounds(self.sc), rng=self.rng,
+            iterations=max(1, min(iterations or self.budget.iterations, room)),
+            time_limit=max(self.left(), 0))
         self.out.iterations += res.iterations
         self.out.timed_out |= res.timed_out
         if res.path is None:
             return None, -1
+        if self.engine is not None:             # an engine returns its simplified path
+            return res.path, res.goal_index
         return shortcut(c, res.path, self.rng), res.goal_index
 
     def single(self, f: Formation, iterations: int | None = None) -> bool:
@@ -223,11 +230,13 @@ class _Runner:
 
 def search_se2(scenario: Scenario, formations: list[Formation], *, allow_crossing: bool,
                budget: SearchBudget, accept: Callable[[list[Piece]], bool],
-               reform: bool = True) -> SE2Search:
+               reform: bool = True, engine: Engine | None = None) -> SE2Search:
     """Search every formation alone, then (``reform`` and none alone succeeded) every
     ordered pair with one formation change; returns every candidate found that
-    ``accept`` (the verification) accepts."""
-    run = _Runner(scenario, budget, allow_crossing, accept)
+    ``accept`` (the verification) accepts. ``engine`` replaces the seeded RRT-Connect and
+    its shortcutting (same arguments and outcome as :func:`~taut.plan._rrt.rrt_connect`,
+    path already simplified; e.g. an OMPL planner, :mod:`taut.plan._ompl`)."""
+    run = _Runner(scenario, budget, allow_crossing, accept, engine)
     quick = max(1, budget.iterations // 5)
     pairs = []
     if reform:

@@ -32,6 +32,7 @@ import numpy as np
 from .._validate import as_count
 from ..errors import InvalidInputError
 from . import _tol
+from ._ompl import Search, engine
 from ._se2 import SearchBudget, search_se2
 from ._se2_motion import Piece, sample_pieces
 from .certificate import find_certificate, narrowest_cut
@@ -182,7 +183,8 @@ def _finish_se2(scenario: Scenario, pieces: list[Piece], planner: str, sheet_mar
 
 
 def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
-         budget: SearchBudget, planner: str, library: Library) -> PlanResult:
+         budget: SearchBudget, planner: str, library: Library,
+         search: Search = "rrtconnect") -> PlanResult:
     """One SE(2) search (crossing planner or its bypass baseline) and its best plan."""
     compact, others, notes = library
     forms = [compact, *others]
@@ -193,10 +195,10 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
         return results[-1].success
 
     found = search_se2(scenario, forms, allow_crossing=allow_crossing, budget=budget,
-                       accept=accept)
+                       accept=accept, engine=engine(search))
     good = [r for r in results if r.success]
     if good:
-        return min(good, key=lambda r: r.duration)
+        return replace(min(good, key=lambda r: r.duration), search=search)
     cert = find_certificate(scenario)
     if cert is not None:
         return failure(scenario, cert.message, planner, "refuted", cert)
@@ -259,7 +261,7 @@ def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_ma
 def plan(scenario: Scenario, *, method: Method = "se2",
          baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
          sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float | None = None,
-         iterations: int = 3000, seed: int = 0) -> PlanResult:
+         iterations: int = 3000, seed: int = 0, search: Search = "rrtconnect") -> PlanResult:
     """Plan the transport of the object from ``scenario.start`` to ``scenario.goal``.
 
     Parameters
@@ -284,6 +286,11 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     seed : int
         Seed of the SE(2) search: plans are reproducible for a given seed and
         ``iterations`` (unless the optional time cap stops a search).
+    search : {"rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"}
+        Who searches SE(2) (``method="se2"`` and ``baseline="se2"``): taut's own seeded
+        RRT-Connect (default), or OMPL's RRT-Connect / RRT* / PRM on the same validity
+        checker, formations, bounds and verification (optional extra ``plan-ompl``;
+        seeding in :mod:`taut.plan._ompl`).
 
     Returns
     -------
@@ -304,6 +311,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     """
     budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
                               iterations, seed)
+    engine(search)                      # validates the name and that OMPL is installed
     margin = float(sheet_margin)
     cached = _library(scenario, margin)
     lib: Library = (cached[0], list(cached[1]), list(cached[2]))
@@ -311,7 +319,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
         return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
                        sheet_margin=margin)
     if baseline:
-        return _bypass(scenario, margin, budget)
+        return _bypass(scenario, margin, budget, search)
     if method != "se2":
         return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
                         lib)
@@ -319,7 +327,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     first = budget if budget.time_budget is None else replace(
         budget, time_budget=0.7 * budget.time_budget)
     best = _se2(scenario, allow_crossing=True, sheet_margin=margin, budget=first,
-                planner="crossing", library=lib)
+                planner="crossing", library=lib, search=search)
     if best.success or best.status == "refuted":
         return best
     # Fallbacks that make the planner succeed wherever a baseline does: the disc roadmap,
@@ -327,18 +335,19 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     alt = _roadmap(scenario, True, margin, "crossing", lib)
     if alt.success:
         return alt
-    alt = _bypass(scenario, margin, full)
+    alt = _bypass(scenario, margin, full, search)
     if alt.success:
         return relabel(alt, "crossing")
     return best
 
 
 @functools.lru_cache(maxsize=32)
-def _bypass(scenario: Scenario, sheet_margin: float, budget: SearchBudget) -> PlanResult:
+def _bypass(scenario: Scenario, sheet_margin: float, budget: SearchBudget,
+            search: Search = "rrtconnect") -> PlanResult:
     """The SE(2) bypass search (the baseline, and the crossing planner's last fallback),
     memoised: it is deterministic for a given scenario, margin and sample budget, so the
     fallback and the baseline are one search, run once."""
     cached = _library(scenario, sheet_margin)
     lib: Library = (cached[0], list(cached[1]), list(cached[2]))
     return _se2(scenario, allow_crossing=False, sheet_margin=sheet_margin, budget=budget,
-                planner="se2-bypass", library=lib)
+                planner="se2-bypass", library=lib, search=search)

@@ -96,6 +96,9 @@ class PlanResult:
         Why no plan exists, when that is proved.
     sheet_margin : float
         The margin every robot pair keeps inside its sheet distance, m.
+    search : str or None
+        Who found an SE(2) plan (``plan(..., search=...)``: ``"rrtconnect"`` or an OMPL
+        planner); None for the roadmap planners and failures.
     """
 
     success: bool
@@ -118,6 +121,7 @@ class PlanResult:
     certificate: Certificate | None = None
     sheet_margin: float = 0.0
     scenario: Scenario | None = None
+    search: str | None = None
 
     def __post_init__(self) -> None:
         check_status(self.status)
