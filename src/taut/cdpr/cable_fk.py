@@ -25,6 +25,7 @@ from .._validate import as_array
 from ..errors import InvalidInputError
 from ._bases import as_base_poses, moved_exits
 from ._tol import FK_MAX_ITER, FK_POLISH_TOL, FK_RESIDUAL_TOL, FK_SAME_SOLUTION
+from ._batching import unbatch
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
 
@@ -65,7 +66,8 @@ def rpy_from_matrices(R: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CableFKResult:
-    """Poses for a batch of cable-length vectors.
+    """Poses for a batch of cable-length vectors (one vector (m,): the leading B axis of
+    every array dropped, ``success`` a bool, ``status`` a str).
 
     Attributes
     ----------
@@ -170,6 +172,7 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     Returns
     -------
     CableFKResult
+        Arrays with a leading axis of B for lengths (B, m); without it for lengths (m,).
 
     Examples
     --------
@@ -178,11 +181,12 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     >>> robot = load_cdpr_model("fastkit")
     >>> pose = [0.4, 0.05, 1.1, 0.02, -0.03, 0.1]
     >>> fk = cable_forward_kinematics(robot, cable_state(robot, pose).lengths)
-    >>> bool(fk.success[0]), bool(np.allclose(fk.poses[0], pose, atol=1e-9))
+    >>> fk.success, bool(np.allclose(fk.poses, pose, atol=1e-9))
     (True, True)
     """
     lengths_arr = as_array(lengths, "lengths")
-    if lengths_arr.ndim == 1:
+    single = lengths_arr.ndim == 1
+    if single:
         lengths_arr = lengths_arr[None]
     if lengths_arr.ndim != 2 or lengths_arr.shape[1] != robot.m:
         raise InvalidInputError("lengths", f"must have shape ({robot.m},) or (B, {robot.m})")
@@ -232,7 +236,9 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
            + ("" if ok.all() else f"; worst residual {float(res.max()):.3g} m "
               "(lengths no pose can have, or no start in the basin)"))
     poses = np.column_stack([p, rpy_from_matrices(R)])
-    return CableFKResult(poses, res, it, n_sol, ok, status, msg)
+    return unbatch(CableFKResult(poses, res, it, n_sol, ok, status, msg),
+                   ("poses", "residual", "iterations", "n_solutions", "success", "status"),
+                   single)
 
 
 def _count_distinct(sols: list[tuple[np.ndarray, np.ndarray, np.ndarray]], B: int

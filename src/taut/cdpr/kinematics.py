@@ -2,7 +2,8 @@
 
 A pose is ``(x, y, z, roll, pitch, yaw)`` (m, rad); the platform rotation is
 ``R = Rz(yaw) Ry(pitch) Rx(roll)``. A 3-vector ``(x, y, z)`` means zero orientation.
-Batched inputs carry a leading axis of B poses. Cable ``i`` pulls the platform along
+Batched inputs carry a leading axis of B poses; one pose ``(6,)`` or ``(3,)`` gives
+unbatched results (the rule of :mod:`taut.cdpr._batching`). Cable ``i`` pulls the platform along
 ``u_i``, the unit vector from its attachment point to its exit point.
 """
 
@@ -15,6 +16,7 @@ import numpy as np
 
 from .._validate import as_array, require_instance
 from ..errors import InfeasiblePoseError, InvalidInputError
+from ._batching import is_single, unbatch
 from ._tol import BOX_REL, ZERO_LENGTH_REL
 from .model import CableRobot
 
@@ -74,7 +76,7 @@ def rotation_matrices(rpy: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CableState:
-    """Inverse kinematics of a batch of poses.
+    """Inverse kinematics of a batch of poses (one pose: every leading B axis dropped).
 
     Attributes
     ----------
@@ -113,12 +115,28 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
     validated : bool
         Skip validation when ``poses`` is already a checked ``(B, 6)`` array.
 
+    Returns
+    -------
+    CableState
+        Arrays with a leading axis of B poses for a batch; without it for one pose
+        (``lengths`` (m,), ``W`` (n, m), ...).
+
     Raises
     ------
     InfeasiblePoseError
         A position outside the frame box, or an attachment point on its exit point
         (zero cable length, direction undefined).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> cable_state(robot, [0, 0, 1.0]).W.shape           # one pose: (n, m)
+    (6, 8)
+    >>> cable_state(robot, [[0, 0, 1.0], [0.5, 0, 1.2]]).lengths.shape   # a batch
+    (2, 8)
     """
+    single = not validated and is_single(poses)
     P = poses if validated else as_poses(robot, poses)
     R = rotation_matrices(P[:, 3:])
     r = np.einsum("bij,mj->bmi", R, robot.attach_local)
@@ -136,11 +154,13 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
         W = np.swapaxes(u, 1, 2).copy()
     else:
         W = np.concatenate([np.swapaxes(u, 1, 2), np.swapaxes(np.cross(r, u), 1, 2)], axis=1)
-    return CableState(P, L, u, r, W, R)
+    return unbatch(CableState(P, L, u, r, W, R), ("poses", "lengths", "unit", "r", "W", "R"),
+                   single)
 
 
 def wrench_matrix(robot: CableRobot, poses: Any) -> np.ndarray:
-    """The wrench matrix W, shape (B, n, m) (FASTKIT eq. 18); see :func:`cable_state`."""
+    """The wrench matrix W, shape (B, n, m), or (n, m) for one pose (FASTKIT eq. 18); see
+    :func:`cable_state`."""
     return cable_state(robot, poses).W
 
 
@@ -148,8 +168,12 @@ def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
     """External wrench ``w_e`` (FASTKIT eq. 19) of platform and payload weight, (B, n).
 
     ``w_e = [f_e; m_e]`` with ``f_e = (m_p + m_l) g`` (N) and ``m_e`` the moment of both
-    weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3).
+    weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3);
+    one rotation (3, 3) gives one wrench (n,).
     """
+    R = np.asarray(R, dtype=float)
+    if R.ndim == 2:
+        return gravity_wrench(robot, R[None])[0]
     g = robot.gravity
     f = np.broadcast_to(robot.total_mass * g, (R.shape[0], 3))
     if robot.dof == 3:
@@ -164,6 +188,10 @@ def tipping_matrix(robot: CableRobot, unit: np.ndarray) -> np.ndarray:
     are ``m_C = T t + robot.edge_weight_moment`` (N m) for tensions ``t`` (N).
 
     ``T[j, i] = u_Cj . ((c_j - b_i) x u_i)`` for a cable ``i`` leaving the base of edge
-    ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``.
+    ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``. One pose's
+    unit vectors (m, 3) give (E, m).
     """
+    unit = np.asarray(unit, dtype=float)
+    if unit.ndim == 2:
+        return tipping_matrix(robot, unit[None])[0]
     return np.einsum("jik,bik->bji", robot._tip_V, unit)

@@ -137,7 +137,7 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     P = as_array(pose, "pose")
     if P.ndim != 1:
         raise InvalidInputError("pose", "must be a single pose (x, y, z[, roll, pitch, yaw])")
-    fom = first_order_model(robot, P, mode, moving)
+    fom = first_order_model(robot, P[None], mode, moving)       # a batch of one pose
     n = fom.A.shape[2]
     t = as_array(twist, "twist")
     if t.shape != (n,):

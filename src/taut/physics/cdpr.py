@@ -216,7 +216,7 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
     >>> from taut.cdpr import distribute_tensions
     >>> robot = load_cdpr_model("fastkit")
     >>> pose = [-2.0, 0.0, 0.2, 0.0, 0.0, 0.0]
-    >>> t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions[0]
+    >>> t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions
     >>> r = check_tipping(robot, pose, t)
     >>> r.verdicts, r.taut_stays, bool(r.success)
     (('stays', 'stays'), True, True)
