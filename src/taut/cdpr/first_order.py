@@ -147,6 +147,13 @@ def first_order_model(robot: CableRobot, poses: ArrayLike, mode: ModeName = "tas
     -------
     FirstOrderModel
         Leading axis of B poses for a batch; none for one pose (``A`` (m, n), ...).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> fom = first_order_model(load_cdpr_model("fastkit"), [0, 0, 1.0])
+    >>> fom.A.shape, fom.B.shape, fom.joint_names[:2]     # active base moving, 8 cables
+    ((8, 6), (8, 11), ('active.theta', 'active.rho1'))
     """
     single = is_single(poses)
     md = resolve_mode(robot, mode, moving)

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._batching import is_single, unbatch
-from ._tol import BOX_REL
+from ._tol import BOX_REL, SEGMENT_PARALLEL, TINY
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
 
@@ -39,9 +39,9 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
     c = np.einsum("...i,...i", d1, r)
     b = np.einsum("...i,...i", d1, d2)
     den = a * e - b * b
-    tiny = 1e-300
+    tiny = TINY
     with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(den > 1e-14 * a * e, np.clip((b * f - c * e) / np.maximum(den, tiny),
+        s = np.where(den > SEGMENT_PARALLEL * a * e, np.clip((b * f - c * e) / np.maximum(den, tiny),
                                                   0.0, 1.0), 0.0)
         t = np.where(e > tiny, (b * s + f) / np.maximum(e, tiny), 0.0)
         s = np.where(t < 0, np.clip(-c / np.maximum(a, tiny), 0.0, 1.0),

@@ -10,9 +10,9 @@ unbatched results (the rule of :mod:`taut.cdpr._batching`). Cable ``i`` pulls th
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array, require_instance
 from ..errors import InfeasiblePoseError, InvalidInputError
@@ -24,7 +24,7 @@ __all__ = ["as_poses", "rotation_matrices", "CableState", "cable_state", "wrench
            "gravity_wrench", "tipping_matrix"]
 
 
-def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
+def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose",
              check_bounds: bool = True) -> np.ndarray:
     """Validate platform poses and return them as a float64 ``(B, 6)`` array.
 
@@ -57,8 +57,9 @@ def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
     return arr
 
 
-def rotation_matrices(rpy: np.ndarray) -> np.ndarray:
+def rotation_matrices(rpy: ArrayLike) -> np.ndarray:
     """``Rz(yaw) Ry(pitch) Rx(roll)`` for ``rpy`` of shape (B, 3) (rad) -> (B, 3, 3)."""
+    rpy = np.asarray(rpy, dtype=float)
     cr, cp, cy = np.cos(rpy.T)
     sr, sp, sy = np.sin(rpy.T)
     R = np.empty((rpy.shape[0], 3, 3))
@@ -104,7 +105,8 @@ class CableState:
     R: np.ndarray
 
 
-def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> CableState:
+def cable_state(robot: CableRobot, poses: ArrayLike, *, validated: bool = False
+                ) -> CableState:
     """Cable lengths, unit vectors and the wrench matrix W (FASTKIT eq. 18) at poses.
 
     Parameters
@@ -137,7 +139,7 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
     (2, 8)
     """
     single = not validated and is_single(poses)
-    P = poses if validated else as_poses(robot, poses)
+    P = np.asarray(poses) if validated else as_poses(robot, poses)
     R = rotation_matrices(P[:, 3:])
     r = np.einsum("bij,mj->bmi", R, robot.attach_local)
     vec = robot.exits_world[None, :, :] - (P[:, None, :3] + r)
@@ -158,13 +160,13 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
                    single)
 
 
-def wrench_matrix(robot: CableRobot, poses: Any) -> np.ndarray:
+def wrench_matrix(robot: CableRobot, poses: ArrayLike) -> np.ndarray:
     """The wrench matrix W, shape (B, n, m), or (n, m) for one pose (FASTKIT eq. 18); see
     :func:`cable_state`."""
     return cable_state(robot, poses).W
 
 
-def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
+def gravity_wrench(robot: CableRobot, R: ArrayLike) -> np.ndarray:
     """External wrench ``w_e`` (FASTKIT eq. 19) of platform and payload weight, (B, n).
 
     ``w_e = [f_e; m_e]`` with ``f_e = (m_p + m_l) g`` (N) and ``m_e`` the moment of both
@@ -183,7 +185,7 @@ def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
     return np.concatenate([f, m], axis=1)
 
 
-def tipping_matrix(robot: CableRobot, unit: np.ndarray) -> np.ndarray:
+def tipping_matrix(robot: CableRobot, unit: ArrayLike) -> np.ndarray:
     """Tipping coefficients ``T`` (B, E, m) so that the edge moments of FASTKIT eqs. 21-23
     are ``m_C = T t + robot.edge_weight_moment`` (N m) for tensions ``t`` (N).
 

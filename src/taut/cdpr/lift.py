@@ -16,7 +16,7 @@ from scipy.optimize import minimize
 from .._validate import as_array
 from ..errors import InvalidInputError
 from ._common import renamed_keyword, wrench_vertices
-from ._tol import LIFT_RTOL, REFUTE_REL
+from ._tol import LIFT_FTOL, LIFT_GTOL, LIFT_RTOL, REFUTE_REL
 from .model import CableRobot
 from .placement import workspace_box
 from .workspace import grid_points
@@ -127,7 +127,7 @@ def _max_mean_lift(q: np.ndarray, t: float, c: float, rtol: float = LIFT_RTOL,
         return float(t * c * inv.mean()), -(t * c) * (inv ** 3) @ diff / len(q)
 
     pol = minimize(neg, arg, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)),
-                   options={"ftol": 1e-15, "gtol": 1e-12})
+                   options={"ftol": LIFT_FTOL, "gtol": LIFT_GTOL})
     if -pol.fun > best:
         best, arg = float(-pol.fun), np.clip(pol.x, lo, hi)
     atol = rtol * t
@@ -258,6 +258,13 @@ def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
     Returns
     -------
     LiftBound
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> lb = lift_bound(load_cdpr_model("fastkit"), [[-2.5, -0.05, 0.2], [2.5, 0.05, 2.2]])
+    >>> lb.refutes, lb.status, round(lb.bound, 1), round(lb.required, 1)   # N
+    (True, 'refuted', 64.2, 117.7)
 
     Notes
     -----

@@ -149,10 +149,19 @@ class HPolytopeBatch:
         slack = h if origin is None else h - np.einsum("bsn,bn->bs", H, origin)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = slack / c
+            loose = (slack + tol) / c            # every row relaxed by tol, as in contains
         hi = np.min(np.where(c > zero, ratio, np.inf), axis=1)
         lo = np.max(np.where(c < -zero, ratio, -np.inf), axis=1)
         zero_ok = np.all((np.abs(c) > zero) | (slack >= -tol), axis=1)
-        reach = zero_ok & (hi >= np.maximum(lo, 0.0) - tol)
+        # Whether some s >= 0 satisfies every row to within tol. The slack tol of a row is
+        # tol / |c| along the ray (|c| <= 1 for unit rows and a unit direction), so the
+        # interval test is made on the relaxed rows, not on s with the row tolerance (that
+        # missed a point-like interval, lo - hi ~ 3e-8 N with tol 1.5e-8 N, that the LP
+        # finds: tests/cdpr/test_wrench_set.py::test_random_point_mass_robots).
+        hi_loose = np.min(np.where(c > zero, loose, np.inf), axis=1)
+        lo_loose = np.max(np.where(c < -zero, loose, -np.inf), axis=1)
+        reach = zero_ok & ((hi >= np.maximum(lo, 0.0) - tol)
+                           | (hi_loose >= np.maximum(lo_loose, 0.0)))
         if E.shape[1]:
             along = np.abs(np.einsum("bkn,n->bk", E, direction)).max(axis=1) <= SPAN_TOL
             hi = np.where(along, hi, 0.0)

@@ -13,6 +13,7 @@ import numpy as np
 from .._validate import as_array, as_positive
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ._bases import as_base_poses, moved_exits
+from ._tol import INTERP_TENSION_TOL
 from .controllers import ControlContext
 from .dynamics_model import DynamicsModel
 from .kinematics import gravity_wrench, rotation_matrices
@@ -157,7 +158,7 @@ def _exact_where_needed(robot: CableRobot, geo: RefGeometry, P: np.ndarray,
                         ) -> tuple[np.ndarray, np.ndarray]:
     """Recompute exactly (fixed bases) the steps whose interpolated, polished tensions are
     outside the limits."""
-    bad = np.any((t < robot.t_min - 1e-6) | (t > robot.t_max + 1e-6), axis=1) & ok
+    bad = np.any((t < robot.t_min - INTERP_TENSION_TOL) | (t > robot.t_max + INTERP_TENSION_TOL), axis=1) & ok
     if geo.moving or not bad.any():
         return t, ok & ~bad if geo.moving else ok
     res = distribute_tensions(robot, P[bad], "closed_form", external_wrench=w_ext[bad],

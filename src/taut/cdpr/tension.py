@@ -39,7 +39,7 @@ from .._outcome import deprecated_alias
 from ..errors import InvalidInputError
 from ._batching import is_single, unbatch
 from ._common import batch_outcome, constraints, feas_tol, required_wrench, svd_split
-from ._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_REL
+from ._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_FTOL, SLSQP_REL
 from .kinematics import as_poses, cable_state, tipping_matrix
 from .model import CableRobot
 
@@ -331,7 +331,7 @@ def _qp_scipy(W: np.ndarray, w: np.ndarray, A: np.ndarray, b: np.ndarray,
                 {"type": "ineq", "fun": lambda t, k=k: b[k] - A[k] @ t,
                  "jac": lambda t, k=k: -A[k]}]
         sol = minimize(lambda t: 0.5 * t @ t, tm, jac=lambda t: t, constraints=cons,
-                       method="SLSQP", options={"ftol": 1e-12, "maxiter": 200})
+                       method="SLSQP", options={"ftol": SLSQP_FTOL, "maxiter": 200})
         if sol.success and np.all(A[k] @ sol.x <= b[k] + SLSQP_REL * float(np.max(robot.t_max))):
             out[k] = sol.x
     return out

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import product
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -273,7 +273,8 @@ class AxisCapacities:
 
 
 def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
-                    method: str = "hrep", *, sliding: bool = True) -> AxisCapacities:
+                    method: Literal["hrep", "lp"] = "hrep", *, sliding: bool = True
+                    ) -> AxisCapacities:
     """Axis capacities ``max s >= 0`` with ``W t + w_e + s e = 0`` (eq. 17) inside the tension
     limits (eq. 20) and, if ``tipping``, the tipping limits (eqs. 21-23), for ``e`` each of
     ``+-x, +-y, +-z`` forces and (6-DoF) moments about P.
@@ -345,6 +346,15 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     positive; negative when some required wrench is not available. ``-inf`` at singular
     poses or when the AWS is empty. ``disturbance`` is the deprecated name of
     ``external_wrench``.
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> bool(capacity_margin(robot, [0, 0, 0.6]) > 0)           # one pose: a float
+    True
+    >>> (capacity_margin(robot, [[0, 0, 0.6], [2, 0, 1.8]]) > 0).tolist()
+    [True, False]
     """
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
