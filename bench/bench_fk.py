@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from taut.sheet import FKSolver, Sheet, forward_kinematics
-from taut.sheet.random import random_scattered_team, random_team
+from taut.sheet import random_scattered_team, random_team
 
 try:
     import vvcm_rs

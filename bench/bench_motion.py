@@ -26,7 +26,7 @@ from taut.io.trajectory import load_trajectory
 from taut.sheet import Sheet, forward_kinematics
 from taut.sheet import inverse_kinematics
 from taut.sheet._ik_certificate import verify_certificate
-from taut.sheet.random import random_team
+from taut.sheet import random_team
 from taut.sheet import simulate
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -33,7 +33,7 @@ from taut.physics import check_equilibria
 from taut.physics._mesh import sheet_mesh
 from taut.physics._sheet_model import build_sheet_sim
 from taut.sheet import forward_kinematics
-from taut.sheet.random import random_team
+from taut.sheet import random_team
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = {"Example 1": ROOT / "examples/sheet/example1.yaml",

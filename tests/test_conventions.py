@@ -57,3 +57,20 @@ def test_required_outcomes_are_public():
 def test_outcome_has_success_status_message(modname, name, cls):
     missing = {"success", "status", "message"} - _members(cls)
     assert not missing, f"{modname}.{name} lacks {sorted(missing)}"
+
+
+@pytest.mark.parametrize("pkg", ["taut.sheet", "taut.plan", "taut.cdpr"])
+def test_one_public_import_path(pkg):
+    """Every name a public submodule's ``__all__`` lists is the package's own name (issue
+    10: one public import path per name); private modules start with an underscore."""
+    import importlib
+    import pkgutil
+
+    package = importlib.import_module(pkg)
+    for mod in pkgutil.iter_modules(package.__path__):
+        if mod.name.startswith("_"):
+            continue
+        m = importlib.import_module(f"{pkg}.{mod.name}")
+        for name in getattr(m, "__all__", ()):
+            assert name in package.__all__ and getattr(package, name) is getattr(m, name), \
+                f"{pkg}.{mod.name}.{name} is not re-exported by {pkg}"

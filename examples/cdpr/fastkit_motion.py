@@ -94,14 +94,14 @@ def main() -> None:
     mv = twist_capacities(robot, POSE, lim, "task")          # active base moving
     fx = twist_capacities(robot, POSE, lim, "task", ())      # all bases fixed
     nav = twist_capacities(robot, POSE, lim, "navigation")
-    plot_capacity_bars({"active base moving": mv.positive[0], "bases fixed": fx.positive[0]},
+    plot_capacity_bars({"active base moving": mv.positive, "bases fixed": fx.positive},
                        mv.labels, ["m/s"] * 3 + ["rad/s"] * 3,
                        "FASTKIT twist capacity at (1, 0, 0.8) m (cf. Fig. 13)",
                        HERE / "fastkit_twist_capacities.png")
     wt = axis_capacities(robot, POSE, tipping=True)
     wf = axis_capacities(robot, POSE, tipping=False)
-    plot_capacity_bars({"bases moving (tipping)": wt.positive[0],
-                        "bases fixed (no tipping)": wf.positive[0]},
+    plot_capacity_bars({"bases moving (tipping)": wt.positive,
+                        "bases fixed (no tipping)": wf.positive},
                        wt.labels, ["N"] * 3 + ["N m"] * 3,
                        "FASTKIT wrench capacity at (1, 0, 0.8) m (cf. Fig. 14)",
                        HERE / "fastkit_wrench_capacities.png")

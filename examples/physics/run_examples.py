@@ -52,7 +52,7 @@ def tipping_table() -> None:
     print("|---|---|---|---|---|---|")
     for x, z in ((-2.0, 0.2), (2.0, 0.2), (1.5, 1.0), (-1.0, 1.4), (0.0, 1.4)):
         pose = [x, 0.0, z, 0.0, 0.0, 0.0]
-        t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions[0]
+        t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions
         c = check_tipping(robot, pose, t)
         print(f"| {x:+.1f}, {z:.1f} | {c.margin:+.1f} | "
               f"{'stays' if c.taut_stays else 'tips'} | {', '.join(c.verdicts)} | "

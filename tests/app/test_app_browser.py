@@ -191,13 +191,13 @@ def test_cable_robot_out_of_the_workspace_is_flagged(page):
     wait_for(d, "CdprView.st && CdprView.ws && !CdprView.inflight")
     robot = load_cdpr_model("fastkit")
     pose = d.execute_script("return CdprView.st.pose")
-    assert distribute_tensions(robot, pose, "qp_min_norm", tipping=True).feasible[0]
+    assert distribute_tensions(robot, pose, "qp_min_norm", tipping=True).success
     assert by_id(d, "cdpr-flag").get_attribute("data-feasible") == "1"
     drag(d, "#cdpr-side .platform", [(0, -8)] * 14)                  # lift it high
     wait_for(d, "!CdprView.inflight && !CdprView.pending")
     pose = d.execute_script("return CdprView.st.pose")
     assert pose[2] > 1.9
-    assert not distribute_tensions(robot, pose, "qp_min_norm", tipping=True).feasible[0]
+    assert not distribute_tensions(robot, pose, "qp_min_norm", tipping=True).success
     flag = by_id(d, "cdpr-flag")
     assert flag.get_attribute("data-feasible") == "0"
     assert flag.text.startswith("NOT wrench-feasible")
@@ -268,5 +268,5 @@ def test_cable_robot_link_reproduces_the_pose(page):
     np.testing.assert_allclose(d.execute_script("return CdprView.st.pose"), pose, atol=1e-12)
     assert by_id(d, "cdpr-flag").text == flag
     robot = load_cdpr_model("ipanema")
-    ok = distribute_tensions(robot, pose, "qp_min_norm", tipping=True).feasible[0]
+    ok = distribute_tensions(robot, pose, "qp_min_norm", tipping=True).success
     assert flag.startswith("wrench-feasible" if ok else "NOT wrench-feasible")

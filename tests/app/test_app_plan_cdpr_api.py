@@ -81,9 +81,9 @@ def test_feasible_pose_tensions_and_margins_are_the_library_s(cdpr):
     pose = [0.3, 0.0, 0.8, 0.0, 0.0, 0.0]
     got = api.state({"model": model, "pose": pose})
     want = distribute_tensions(robot, pose, "qp_min_norm", tipping=True)
-    assert got["feasible"] is bool(want.feasible[0]) is True
-    np.testing.assert_allclose(got["tensions"], want.tensions[0], rtol=1e-12)
-    moments = tipping_moments(robot, pose, want.tensions[0]).moments[0]
+    assert got["feasible"] is bool(want.success) is True
+    np.testing.assert_allclose(got["tensions"], want.tensions, rtol=1e-12)
+    moments = tipping_moments(robot, pose, want.tensions).moments
     for k, m in enumerate(got["margins"]):
         assert m["margin"] == pytest.approx(-moments[robot.edge_base == k].max(), abs=1e-9)
 
@@ -93,7 +93,7 @@ def test_pose_out_of_the_workspace_is_flagged(cdpr):
     robot = load_cdpr_model("fastkit")
     high = [0.0, 0.0, 2.3, 0.0, 0.0, 0.0]          # cables nearly horizontal
     got = api.state({"model": model, "pose": high})
-    assert not distribute_tensions(robot, high, "qp_min_norm", tipping=False).feasible[0]
+    assert not distribute_tensions(robot, high, "qp_min_norm", tipping=False).success
     assert got["feasible"] is False and got["feasible_limits"] is False
     assert got["message"].startswith("NOT wrench-feasible")
     assert got["tensions"] is not None              # the closed form's attempt is shown

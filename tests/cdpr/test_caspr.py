@@ -42,7 +42,7 @@ def test_structure_matrix_equals_hand_built(name):
         pose = np.r_[g.uniform(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo)),
                      g.uniform(-0.2, 0.2, 3)]
         W, lims = _by_hand(name, pose)
-        np.testing.assert_allclose(cable_state(robot, pose).W[0], W, atol=1e-12)
+        np.testing.assert_allclose(cable_state(robot, pose).W, W, atol=1e-12)
     np.testing.assert_array_equal(robot.t_min, lims[:, 0])
     np.testing.assert_array_equal(robot.t_max, lims[:, 1])
     body = ET.parse(DIR / f"{name}_bodies.xml").getroot().find("./links/link_rigid/physical")

@@ -89,18 +89,6 @@ def test_external_wrench_name_and_deprecated_disturbance(fastkit):
     assert cdpr.disturbance_box is external_wrench_box
 
 
-def test_every_submodule_export_is_public_in_taut_cdpr():
-    import importlib
-    import pkgutil
-    for mod in pkgutil.iter_modules(cdpr.__path__):
-        if mod.name.startswith("_"):
-            continue
-        m = importlib.import_module(f"taut.cdpr.{mod.name}")
-        for name in getattr(m, "__all__", ()):
-            assert name in cdpr.__all__ and getattr(cdpr, name) is getattr(m, name), \
-                f"taut.cdpr.{mod.name}.{name}"
-
-
 def test_cable_state_reports_the_offending_pose(point_mass):
     """Regression: the zero-length check and the reported index used different
     tolerances, so a length between them (here 2e-12 m, below 1e-12 * (1 + 3 m)) was

@@ -52,22 +52,22 @@ def test_fk_with_a_moved_mobile_base(fastkit):
 def test_fk_round_trip_property(ipanema, x, y, z, a, b, c):
     pose = np.array([x, y, z, a, b, c])
     fk = cable_forward_kinematics(ipanema, cable_state(ipanema, pose).lengths)
-    assert fk.success[0]
-    assert np.abs(fk.poses[0] - pose).max() < 1e-9
+    assert fk.success
+    assert np.abs(fk.poses - pose).max() < 1e-9
 
 
 def test_inconsistent_lengths_are_reported_not_converged(ipanema):
     L = cable_state(ipanema, [0.0, 0.0, 1.5]).lengths.copy()
-    L[0, 0] *= 0.2                                  # no pose has these lengths
+    L[0] *= 0.2                                  # no pose has these lengths
     fk = cable_forward_kinematics(ipanema, L, restarts=2)
-    assert not fk.success[0] and fk.status[0] == "not_converged"
-    assert fk.residual[0] > 1e-3 and "residual" in fk.message
+    assert not fk.success and fk.status == "not_converged"
+    assert fk.residual > 1e-3 and "residual" in fk.message
 
 
 def test_all_solutions_counts_one_for_a_generic_fully_constrained_pose(ipanema):
     L = cable_state(ipanema, [0.2, -0.1, 1.4, 0.05, 0.0, 0.1]).lengths
     fk = cable_forward_kinematics(ipanema, L, all_solutions=True, restarts=4)
-    assert fk.success[0] and fk.n_solutions[0] >= 1
+    assert fk.success and fk.n_solutions >= 1
 
 
 @pytest.mark.parametrize("bad", [[1.0] * 7, [1.0] * 7 + [-1.0], [np.nan] * 8])

@@ -34,10 +34,10 @@ def test_rest_holds_pose_and_tensions_match_the_distribution(fk_stab, controller
     run = simulate(fk_stab, _hold(fk_stab, HOLD), controller, engine="numpy")
     assert run.success, run.message
     assert np.abs(run.poses - HOLD).max() < 1e-6
-    ref = distribute_tensions(fk_stab, HOLD, "closed_form", tipping=False).tensions[0]
+    ref = distribute_tensions(fk_stab, HOLD, "closed_form", tipping=False).tensions
     assert np.abs(run.tensions - ref).max() < 1e-4          # N, of ~30 N
     # Tipping margins from the simulation = -tipping_moments at the same static state.
-    tm = tipping_moments(fk_stab, run.poses[-1], run.tensions[-1]).moments[0]
+    tm = tipping_moments(fk_stab, run.poses[-1], run.tensions[-1]).moments
     assert np.allclose(run.tipping_margin[-1], -tm, atol=1e-9, rtol=1e-12)
 
 
@@ -45,7 +45,7 @@ def test_tipping_monitor_with_errors_matches_tipping_moments_at_rest(fk_stab):
     run = simulate(fk_stab, _hold(fk_stab, HOLD, 0.3), TorqueController(), engine="numpy",
                    model_errors=ModelErrors(exit_offset=0.0, mass_scale=1.1))
     k = len(run.times) - 1
-    tm = tipping_moments(fk_stab, run.poses[k], run.tensions[k]).moments[0]
+    tm = tipping_moments(fk_stab, run.poses[k], run.tensions[k]).moments
     assert np.allclose(run.tipping_margin[k], -tm, atol=1e-6)
 
 
@@ -67,8 +67,8 @@ def _energy_run(robot, dyn, seconds, h):
     from taut.cdpr import cable_state
     pl = Plant(robot, dyn, stack_perturbations(robot, None))
     ex = robot.exits_world.T.copy()
-    t = distribute_tensions(robot, HOLD, "closed_form", tipping=False).tensions[0]
-    L = cable_state(robot, HOLD).lengths[0]
+    t = distribute_tensions(robot, HOLD, "closed_form", tipping=False).tensions
+    L = cable_state(robot, HOLD).lengths
     L0 = dyn.cable_stiffness * L / (dyn.cable_stiffness + t)
     s = initial_state(pl, ex, L0[None], HOLD)
     s.vc += [0.04, 0.03, -0.05]

@@ -15,7 +15,7 @@ HI = -LO
 def _check(fastkit, res, t, scale=1.0):
     fom = first_order_model(fastkit, POSE)
     assert np.all(res.q_dot >= LO - 1e-8) and np.all(res.q_dot <= HI + 1e-8)
-    np.testing.assert_allclose(fom.A[0] @ (scale * t), fom.B[0] @ res.q_dot, atol=1e-8)
+    np.testing.assert_allclose(fom.A @ (scale * t), fom.B @ res.q_dot, atol=1e-8)
     assert res.residual < 1e-8
 
 
@@ -41,8 +41,8 @@ def test_least_base_keeps_bases_still_when_cables_suffice(fastkit):
 
 def test_twist_needing_the_base(fastkit):
     """Between the fixed-base and moving-base capacity along x the base must move."""
-    mv = twist_capacities(fastkit, POSE).positive[0, 0]
-    fx = twist_capacities(fastkit, POSE, moving=()).positive[0, 0]
+    mv = twist_capacities(fastkit, POSE).positive[0]
+    fx = twist_capacities(fastkit, POSE, moving=()).positive[0]
     assert mv > fx
     t = np.array([0.5 * (mv + fx), 0, 0, 0, 0, 0])
     res = resolve_redundancy(fastkit, POSE, t, objective="least_base")
@@ -54,7 +54,7 @@ def test_twist_needing_the_base(fastkit):
 
 
 def test_infeasible_twist_reports_largest_fraction(fastkit):
-    cap = twist_capacities(fastkit, POSE).positive[0, 2]
+    cap = twist_capacities(fastkit, POSE).positive[2]
     t = np.array([0, 0, 1.25 * cap, 0, 0, 0])
     res = resolve_redundancy(fastkit, POSE, t)
     assert not res.success

@@ -120,14 +120,14 @@ def test_point_mass_equal_tensions(point_mass, z0, method):
     dh = H - z0
     L = np.sqrt(2 * A * A + dh * dh)
     r = distribute_tensions(point_mass, [0.0, 0.0, z0], method)
-    assert r.success[0]
-    np.testing.assert_allclose(r.tensions[0], MASS * G * L / (4 * dh), rtol=1e-12)
+    assert r.success
+    np.testing.assert_allclose(r.tensions, MASS * G * L / (4 * dh), rtol=1e-12)
 
 
 def test_point_mass_infeasible_when_limits_too_low():
     robot = point_mass_robot(t_min=1.0, t_max=5.0)      # 4 x 5 N < 39 N weight
     for m in ("closed_form", "lp_min_sum", "qp_min_norm"):
-        assert not distribute_tensions(robot, [0, 0, 1.0], m).success[0]
+        assert not distribute_tensions(robot, [0, 0, 1.0], m).success
 
 
 def test_bad_method(point_mass):
@@ -164,11 +164,11 @@ def test_tipping_moment_about_front_edge_by_hand():
     # moment about the front edge = -M g 0.5 + t h; about the back edge the arm is the same
     # height (the pull is horizontal), so -M g 0.5 - t h; side edges: no moment.
     front = np.argmax(robot.edge_points[:, 0] + np.roll(robot.edge_points[:, 0], -1))
-    assert res.moments.shape == (1, 4)
-    np.testing.assert_allclose(res.moments[0, front], -M * G * 0.5 + 100.0 * h, atol=1e-9)
-    np.testing.assert_allclose(np.sort(res.moments[0]),
+    assert res.moments.shape == (4,)                   # one pose: (E,)
+    np.testing.assert_allclose(res.moments[front], -M * G * 0.5 + 100.0 * h, atol=1e-9)
+    np.testing.assert_allclose(np.sort(res.moments),
                                np.sort([-M * G * 0.5 + 100 * h, -M * G * 0.5 - 100 * h,
                                         -M * G * 0.5, -M * G * 0.5]), atol=1e-9)
-    assert res.stable[0]
+    assert res.stable
     tip = tipping_moments(robot, [2.0, 0.0, h], [M * G * 0.5 / h + 1.0, 0, 0, 0])
-    assert not tip.stable[0] and tip.worst_edge[0] == front
+    assert not tip.stable and tip.worst_edge == front

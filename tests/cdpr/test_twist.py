@@ -58,11 +58,11 @@ def test_parallel_jacobian_matches_finite_differences(fastkit):
     g = np.random.default_rng(3)
     h = 1e-6
     for pose in POSES:
-        A = parallel_jacobian(fastkit, pose)[0]
+        A = parallel_jacobian(fastkit, pose)       # one pose: (m, n)
         for _ in range(3):
             t = g.normal(size=6)
-            fd = (cable_state(fastkit, _moved(pose, t, h)).lengths[0]
-                  - cable_state(fastkit, _moved(pose, t, -h)).lengths[0]) / (2 * h)
+            fd = (cable_state(fastkit, _moved(pose, t, h)).lengths
+                  - cable_state(fastkit, _moved(pose, t, -h)).lengths) / (2 * h)
             np.testing.assert_allclose(A @ t, fd, atol=1e-7)
 
 
@@ -75,13 +75,13 @@ def test_base_jacobian_matches_finite_differences(robot_name, fastkit):
     h = 1e-6
     for pose in poses:
         fom = first_order_model(robot, pose, "task", names)
-        assert fom.B.shape == (1, robot.m, 3 * len(names) + robot.m)
+        assert fom.B.shape == (robot.m, 3 * len(names) + robot.m)   # one pose
         for k in range(len(names)):
             dq = g.normal(size=3)
-            fd = (cable_state(_move_base(robot, k, dq, h), pose).lengths[0]
-                  - cable_state(_move_base(robot, k, dq, -h), pose).lengths[0]) / (2 * h)
+            fd = (cable_state(_move_base(robot, k, dq, h), pose).lengths
+                  - cable_state(_move_base(robot, k, dq, -h), pose).lengths) / (2 * h)
             # platform still (t = 0): 0 = B_b q_b + l_dot  =>  l_dot = -B_b q_b  (eq. 8)
-            np.testing.assert_allclose(-fom.B_b[0][:, 3 * k:3 * k + 3] @ dq, fd, atol=1e-7)
+            np.testing.assert_allclose(-fom.B_b[:, 3 * k:3 * k + 3] @ dq, fd, atol=1e-7)
             # only that base's cables change length
             assert np.allclose(fd[robot.cable_base != k], 0.0, atol=1e-7)
 
@@ -95,11 +95,11 @@ def test_full_model_combined_motion(fastkit):
 
     def lengths(s):
         r = _move_base(_move_base(fastkit, 0, qa, s), 1, qp, s)
-        return cable_state(r, _moved(pose, t, s)).lengths[0]
+        return cable_state(r, _moved(pose, t, s)).lengths
 
     ldot = (lengths(h) - lengths(-h)) / (2 * h)
     q = np.concatenate([qa, qp, ldot])
-    np.testing.assert_allclose(fom.A[0] @ t, fom.B[0] @ q, atol=1e-7)
+    np.testing.assert_allclose(fom.A @ t, fom.B @ q, atol=1e-7)
 
 
 def test_zonotope_hrep_is_exact():
@@ -139,7 +139,7 @@ def test_support_function_two_formulations(fastkit):
     lim = fastkit_motion_limits()
     for pose in POSES[:2]:
         ats = available_twist_set(fastkit, pose, lim)
-        A, B = ats.model.A[0], ats.model.B[0]
+        A, B = ats.model.A, ats.model.B
         lo = np.r_[lim.base_min, np.full(8, -2.0)]
         hi = np.r_[lim.base_max, np.full(8, 2.0)]
         for _ in range(4):
@@ -150,8 +150,8 @@ def test_support_function_two_formulations(fastkit):
             assert support(ats, d) == pytest.approx(-sol.fun, rel=1e-7)
             # the optimal twist is in the set; pushed 1 % further it is not
             t = sol.x[:6]
-            assert ats.contains(t, tol=1e-7)[0]
-            assert not ats.contains(1.01 * t)[0]
+            assert ats.contains(t, tol=1e-7)
+            assert not ats.contains(1.01 * t)
 
 
 def test_moving_bases_capacities_at_least_fixed(fastkit):
@@ -171,21 +171,21 @@ def test_membership_from_joint_rates(fastkit):
     pose = POSES[1]
     mv = available_twist_set(fastkit, pose)
     fx = available_twist_set(fastkit, pose, moving=())
-    A = mv.model.A[0]
-    Bb = mv.model.B[0][:, :3]
+    A = mv.model.A
+    Bb = mv.model.B[:, :3]
     inside = 0
     for _ in range(200):
         t = g.normal(size=6) * [1, 1, 1, 3, 3, 3]
         qb = g.uniform(-0.2, 0.2, 3)
         ldot = A @ t - Bb @ qb
         ok = np.all(np.abs(ldot) <= 2.0)
-        assert mv.contains(t, tol=1e-9)[0] or not ok
+        assert mv.contains(t, tol=1e-9) or not ok
         if ok:
             inside += 1
-        if fx.contains(t)[0]:
-            assert mv.contains(t)[0]
+        if fx.contains(t):
+            assert mv.contains(t)
         # with bases fixed, membership is exactly |A t| <= 2
-        assert fx.contains(t, tol=1e-9)[0] == bool(np.all(np.abs(A @ t) <= 2.0 + 1e-9))
+        assert fx.contains(t, tol=1e-9) == bool(np.all(np.abs(A @ t) <= 2.0 + 1e-9))
     assert inside > 20
 
 
@@ -196,20 +196,20 @@ def test_navigation_mode(fastkit):
     np.testing.assert_allclose(cap.positive, lp.positive, atol=1e-9)
     # active base at x = -3: pure vx / vy limited by the base speed; pure wz about P needs
     # the base origin to move at |r| wz, |r| = 3.3 m
-    assert cap.positive[0, 0] == pytest.approx(0.2)
-    assert cap.positive[0, 1] == pytest.approx(0.2)
-    assert cap.positive[0, 5] == pytest.approx(0.2 / 3.3)
-    assert np.allclose(cap.positive[0, 2:5], 0.0)
+    assert cap.positive[0] == pytest.approx(0.2)
+    assert cap.positive[1] == pytest.approx(0.2)
+    assert cap.positive[5] == pytest.approx(0.2 / 3.3)
+    assert np.allclose(cap.positive[2:5], 0.0)
     ats = available_twist_set(fastkit, pose, mode="navigation")
-    assert ats.contains([0.1, 0.1, 0, 0, 0, 0])[0]
-    assert not ats.contains([0.1, 0.0, 0.05, 0, 0, 0])[0]      # cannot lift in navigation
+    assert ats.contains([0.1, 0.1, 0, 0, 0, 0])
+    assert not ats.contains([0.1, 0.0, 0.05, 0, 0, 0])      # cannot lift in navigation
 
 
 def test_point_mass_three_dof():
     robot = three_base_robot()
     cap = twist_capacities(robot, [0.0, 0.0, 1.0], moving=("b0", "b1"))
     fix = twist_capacities(robot, [0.0, 0.0, 1.0], moving=())
-    assert cap.positive.shape == (1, 3)
+    assert cap.positive.shape == (3,)
     np.testing.assert_allclose(cap.positive, twist_capacities(
         robot, [0.0, 0.0, 1.0], moving=("b0", "b1"), method="lp").positive, rtol=1e-7)
     assert np.all(cap.positive >= fix.positive - 1e-9)
@@ -220,7 +220,7 @@ def test_point_mass_three_dof():
                               method="lp")
     np.testing.assert_allclose(nav.positive, nav_lp.positive, atol=1e-9)
     np.testing.assert_allclose(nav.negative, nav_lp.negative, atol=1e-9)
-    assert nav.positive[0, 2] == 0.0 and nav.positive[0, 0] > 0.2 - 1e-9
+    assert nav.positive[2] == 0.0 and nav.positive[0] > 0.2 - 1e-9
 
 
 def test_limits_defaults_and_validation():

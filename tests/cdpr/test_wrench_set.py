@@ -17,7 +17,7 @@ G = 9.81
 
 def lp_available(robot, pose, w, tipping):
     """Reference: is cable wrench w = W t reachable (LP feasibility)?"""
-    st_ = cable_state(robot, pose)
+    st_ = cable_state(robot, np.atleast_2d(pose))       # the batched form constraints takes
     Amat, b = constraints(robot, st_, tipping)
     m = robot.m
     extra = Amat[0, 2 * m:]
@@ -38,22 +38,22 @@ def test_hrep_is_exact_on_random_wrenches(request, name, tipping):
     agree, total, inside = 0, 0, 0
     for pose in poses:
         aws = available_wrench_set(robot, pose, tipping)
-        if not aws.nonempty[0]:
+        if not aws.nonempty:
             continue
         # Points near the boundary: Chebyshev-free scan along random rays from W t_mid.
-        W = cable_state(robot, pose).W[0]
+        W = cable_state(robot, pose).W
         c = W @ (0.5 * (robot.t_min + robot.t_max))
         for d in g.normal(size=(40, robot.dof)):
             d /= np.linalg.norm(d)
             # exact support along d from the H-rep (ray exit), then test just in/out
-            Hd = aws.H[0] @ d
-            slack = aws.h[0] - aws.H[0] @ c
+            Hd = aws.H @ d                    # one pose: H (S, n)
+            slack = aws.h - aws.H @ c
             s = np.min(np.where(Hd > 1e-12, slack / np.where(Hd > 1e-12, Hd, 1), np.inf))
             if not np.isfinite(s) or s <= 0:
                 continue
             for f in (0.98, 1.02):
                 w = c + f * s * d
-                a = bool(aws.contains(w, tol=1e-7)[0])
+                a = bool(aws.contains(w, tol=1e-7))
                 b = lp_available(robot, pose, w, tipping)
                 agree += a == b
                 inside += a
@@ -74,11 +74,11 @@ def test_tipping_aws_inside_plain_aws(fastkit):
     for pose in poses[:5]:
         a_t = available_wrench_set(fastkit, pose, True)
         a_f = available_wrench_set(fastkit, pose, False)
-        W = cable_state(fastkit, pose).W[0]
+        W = cable_state(fastkit, pose).W
         T = g.uniform(fastkit.t_min, fastkit.t_max, (500, fastkit.m))
         w = T @ W.T
-        in_t = np.array([a_t.contains(x)[0] for x in w])
-        in_f = np.array([a_f.contains(x)[0] for x in w])
+        in_t = np.array([a_t.contains(x) for x in w])
+        in_f = np.array([a_f.contains(x) for x in w])
         assert np.all(in_f)                      # every W t with t in the box
         assert not np.any(in_t & ~in_f)
     cap_t = axis_capacities(fastkit, poses[:50], tipping=True)
@@ -109,14 +109,14 @@ def test_point_mass_capacities_analytic(point_mass, z0):
     cap = axis_capacities(point_mass, [0, 0, z0], tipping=False)
     assert cap.labels == ("fx", "fy", "fz")
     # +z: cables at t_min carry what is left of the weight; -z: all at t_max.
-    np.testing.assert_allclose(cap.positive[0, 2], MASS * G - 4 * tmin * dh / L, rtol=1e-10)
-    np.testing.assert_allclose(cap.negative[0, 2], 4 * tmax * dh / L - MASS * G, rtol=1e-10)
+    np.testing.assert_allclose(cap.positive[2], MASS * G - 4 * tmin * dh / L, rtol=1e-10)
+    np.testing.assert_allclose(cap.negative[2], 4 * tmax * dh / L - MASS * G, rtol=1e-10)
     # +x: the two -x cables at b, the two +x cables at a, a + b = S fixed by the weight.
     S = MASS * G * L / (2 * dh)
     b = min(tmax, S - tmin)
     fx = 2 * (b - (S - b)) * A / L
-    np.testing.assert_allclose(cap.positive[0, 0], fx, rtol=1e-10)
-    np.testing.assert_allclose(cap.negative[0, 1], fx, rtol=1e-10)
+    np.testing.assert_allclose(cap.positive[0], fx, rtol=1e-10)
+    np.testing.assert_allclose(cap.negative[1], fx, rtol=1e-10)
     lp = axis_capacities(point_mass, [0, 0, z0], tipping=False, method="lp")
     np.testing.assert_allclose(lp.positive, cap.positive, rtol=1e-8)
 
@@ -162,9 +162,9 @@ def test_gravity_in_aws_iff_tensions_exist(fastkit, x, z, yaw, tip):
     from taut.cdpr import distribute_tensions
     pose = [x, 0.0, z, 0.0, 0.0, yaw]
     aws = available_wrench_set(fastkit, pose, tip)
-    lp = distribute_tensions(fastkit, pose, "lp_min_sum", tipping=tip).success[0]
-    assert bool(aws.contains(-aws.gravity_wrench, tol=1e-7)[0]) == lp
-    assert bool(wrench_feasible(fastkit, pose, tipping=tip)[0]) == lp
+    lp = distribute_tensions(fastkit, pose, "lp_min_sum", tipping=tip).success
+    assert bool(aws.contains(-aws.gravity_wrench, tol=1e-7)) == lp
+    assert bool(wrench_feasible(fastkit, pose, tipping=tip)) == lp
 
 
 @settings(max_examples=15, deadline=None)
@@ -185,10 +185,10 @@ def test_random_point_mass_robots(half, height, z, x, tmin, span, seed):
                              for i in range(5)))
     lo, hi = robot.bounds
     pose = [lo[0] + 0.5 * (x + 1) * (hi[0] - lo[0]), 0.5 * (lo[1] + hi[1]), z * hi[2]]
-    lp = distribute_tensions(robot, pose, "lp_min_sum").success[0]
-    assert bool(wrench_feasible(robot, pose, tipping=False)[0]) == lp
-    assert distribute_tensions(robot, pose, "qp_min_norm").success[0] == lp
-    if distribute_tensions(robot, pose, "closed_form").success[0]:
+    lp = distribute_tensions(robot, pose, "lp_min_sum").success
+    assert bool(wrench_feasible(robot, pose, tipping=False)) == lp
+    assert distribute_tensions(robot, pose, "qp_min_norm").success == lp
+    if distribute_tensions(robot, pose, "closed_form").success:
         assert lp
     a = axis_capacities(robot, pose, tipping=False)
     b = axis_capacities(robot, pose, tipping=False, method="lp")

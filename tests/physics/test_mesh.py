@@ -5,7 +5,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 from taut.physics._mesh import sheet_mesh
-from taut.sheet.random import random_convex_polygon
+from taut.sheet import random_convex_polygon
 
 
 @settings(max_examples=25, deadline=None)

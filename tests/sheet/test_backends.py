@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from taut.sheet import FKSolver, Sheet
-from taut.sheet.random import random_convex_polygon, random_scattered_team, random_team
+from taut.sheet import random_convex_polygon, random_scattered_team, random_team
 from taut.sheet._tol import BACKEND_RTOL, BACKEND_WEIGHT_TOL
 
 pytest.importorskip("numba")

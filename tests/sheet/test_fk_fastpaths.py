@@ -9,8 +9,8 @@ from taut.errors import InfeasibleFormationError
 from taut.sheet import Sheet, _kernel, fk, forward_kinematics, forward_kinematics_batch
 from taut.sheet._candidates import hull_candidates, padded_small_subsets
 from taut.sheet._kernel import Frame, reduced_hessian_min_eig, solve_candidates, solve_table
-from taut.sheet.model import check_formation
-from taut.sheet.random import random_scattered_team, random_team
+from taut.sheet import check_formation
+from taut.sheet import random_scattered_team, random_team
 
 SETTINGS = settings(max_examples=30, deadline=None)
 

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from taut.sheet import Sheet, forward_kinematics, forward_kinematics_batch
-from taut.sheet.random import random_scattered_team, random_team
+from taut.sheet import random_scattered_team, random_team
 from taut.sheet._tol import SNAP_TOL
 
 SETTINGS = settings(max_examples=40, deadline=None)

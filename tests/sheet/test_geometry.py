@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from taut.errors import InvalidInputError
-from taut.sheet.geometry import (formation_metrics, formation_size, max_obstacle_diameter,
+from taut.sheet import (formation_metrics, formation_size, max_obstacle_diameter,
                                  max_obstacle_height, min_robot_distance,
                                  minimum_enclosing_circle)
 

@@ -11,9 +11,9 @@ from taut.errors import InvalidInputError
 from taut.sheet import (IKCertificate, Sheet, contact_weights, forward_kinematics,
                         formation_from_angles, ik_constraints, inverse_kinematics)
 from taut.sheet._ik_certificate import verify_certificate
-from taut.sheet.model import check_formation
-from taut.sheet.random import random_team
-from taut.sheet.results import GRAVITY
+from taut.sheet import check_formation
+from taut.sheet import random_team
+from taut.sheet import GRAVITY
 
 
 def all_taut_stable_at(sheet, formation, z, target, contact=None, tol=1e-6, mass=None):

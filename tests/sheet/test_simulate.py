@@ -12,9 +12,9 @@ from hypothesis import strategies as st
 from taut.errors import InfeasibleFormationError, InvalidInputError, InvalidTrajectoryError
 from taut.io.trajectory import load_trajectory
 from taut.sheet import Sheet, forward_kinematics, forward_kinematics_batch
-from taut.sheet.ik import inverse_kinematics
-from taut.sheet.random import random_team
-from taut.sheet.simulate import simulate
+from taut.sheet import inverse_kinematics
+from taut.sheet import random_team
+from taut.sheet import simulate
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "sheet" / "trajectories"
 SQUARE = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])

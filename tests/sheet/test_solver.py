@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from taut.errors import InfeasibleFormationError, InvalidInputError
 from taut.sheet import FKSolver, Sheet, forward_kinematics, forward_kinematics_batch, solver
-from taut.sheet.random import random_team
+from taut.sheet import random_team
 
 
 def two_stable_team():

@@ -121,22 +121,22 @@ class CdprAPI:
             return dict(out, in_frame=False, feasible=False, feasible_limits=False,
                         message=str(exc), tensions=None, shown="none", margins=[])
         limits = distribute_tensions(robot, pose, method, tipping=False)
-        ok_tip, ok_lim = bool(succeeded(with_tip)[0]), bool(succeeded(limits)[0])
+        ok_tip, ok_lim = bool(succeeded(with_tip)), bool(succeeded(limits))
         shown, label = (with_tip, "with tipping") if ok_tip else (limits, "limits only")
-        if not ok_lim and not np.all(np.isfinite(limits.tensions[0])):
+        if not ok_lim and not np.all(np.isfinite(limits.tensions)):
             # No solution at all: show the closed form's best attempt and its violations.
             shown = distribute_tensions(robot, pose, "closed_form", tipping=False)
             label = "closed-form attempt (violates the limits)"
-        t = shown.tensions[0]
+        t = shown.tensions
         margins = []
         if robot.has_tipping and (ok_tip or ok_lim):   # margins of a valid distribution
             tm = tipping_moments(robot, pose, t)
             for k, b in enumerate(robot.bases):
                 sel = tm.edge_base == k
                 if np.any(sel):
-                    worst = float(tm.moments[0, sel].max())
+                    worst = float(tm.moments[sel].max())
                     margins.append({"base": b.name, "margin": -worst,
-                                    "stable": worst <= 0.0 or bool(tm.stable[0])})
+                                    "stable": worst <= 0.0 or bool(tm.stable)})
         if ok_tip:
             msg = "wrench-feasible: tensions within limits and no base tips"
         elif ok_lim:

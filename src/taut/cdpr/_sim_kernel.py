@@ -16,7 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._tol import EVENT_TENSION_TOL
+from ._tol import EVENT_TENSION_TOL, SO3_TAYLOR_SQ
 
 _jit = numba.njit(cache=True)
 
@@ -250,7 +250,7 @@ def _plant_step(b: int, mode: int, cmd: np.ndarray, tau: np.ndarray, T: np.ndarr
 def _rotate(R: np.ndarray, b: int, p0: float, p1: float, p2: float) -> None:
     """``R[b] <- R[b] exp([phi]x)`` (Rodrigues; Taylor series for small angles)."""
     th2 = p0 * p0 + p1 * p1 + p2 * p2
-    if th2 < 1e-6:
+    if th2 < SO3_TAYLOR_SQ:
         a = 1.0 - th2 / 6.0 * (1.0 - th2 / 20.0)
         c2 = 0.5 - th2 / 24.0 * (1.0 - th2 / 30.0)
     else:

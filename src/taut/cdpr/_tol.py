@@ -166,3 +166,81 @@ EVENT_TENSION_TOL = 1e-6
 #: Velocity a reference CSV may imply at most, m/s and rad/s: beyond it the file is
 #: almost certainly in mm or degrees.
 MAX_REFERENCE_SPEED = 20.0
+
+# --- formerly inline thresholds (issue 10: one home per core) ---------------------------
+#: Relative threshold (times |d1|^2 |d2|^2) on the determinant of the closest-point system
+#: of two segments below which they count as parallel (interference). Dimensionless;
+#: 1e-14 is ~100 ulp of the product, so only numerically parallel pairs take the fallback.
+SEGMENT_PARALLEL = 1e-14
+
+#: Slack (control steps) subtracted from ``duration * rate`` before rounding up, so that a
+#: duration that is a whole number of steps up to round-off does not get one step more.
+STEP_COUNT_SLACK = 1e-9
+
+#: Forward-difference step of the rest-state Newton solve of the plant (m for the CoM,
+#: rad for the rotation): ~sqrt(float64 eps) times the ~1 m / 1 rad scales, the usual
+#: balance of truncation and round-off error.
+EQUILIBRIUM_FD_STEP = 1e-7
+
+#: ``ftol`` of SciPy's SLSQP in the tension QP and the redundancy resolution (relative
+#: change of the objective, dimensionless): tight enough that the polish step, not the
+#: optimiser, sets the final accuracy.
+SLSQP_FTOL = 1e-12
+
+#: A torque counts as saturated at ``|tau| >= limit * (1 - SATURATION_REL)``
+#: (dimensionless): the controller clips at the limit exactly, this absorbs round-off.
+SATURATION_REL = 1e-12
+
+#: Rotation angle (rad) below which the SO(3) exponential uses its Taylor series (the
+#: closed form divides by the angle); at 1e-8 rad the series' first neglected term is
+#: ~1e-33. The compiled kernel tests the squared angle against SO3_TAYLOR_SQ (rad^2):
+#: below it the 4-term series has error < th^6 / 5040 < 1e-22.
+SO3_SMALL_ANGLE = 1e-8
+SO3_TAYLOR_SQ = 1e-6
+
+#: Levenberg-Marquardt damping of the cable forward kinematics (dimensionless, relative
+#: to the Gauss-Newton matrix scale of cable lengths in m): start, floor and ceiling. The
+#: start is near Gauss-Newton (good starts converge quadratically); the bounds keep the
+#: damping from under- or overflowing over the iterations (/10 on success, x10 on failure).
+FK_DAMPING_START = 1e-6
+FK_DAMPING_MIN = 1e-12
+FK_DAMPING_MAX = 1e8
+
+#: Default slack of :func:`taut.cdpr.resolve_redundancy` on joint limits and the twist
+#: residual (m/s, rad/s): ~1e-9 of the FASTKIT rates, far above LP round-off.
+REDUNDANCY_TOL = 1e-9
+
+#: Weight of the cable rates relative to the base rates in the ``least_base`` objective of
+#: :func:`taut.cdpr.resolve_redundancy` (dimensionless; its square, 1e-6, multiplies the
+#: cables' squared normalised rates): small, so bases move only when the cables alone
+#: cannot produce the twist, yet large enough to make the minimiser unique.
+LEAST_BASE_CABLE_WEIGHT = 1e-3
+
+#: Two consecutive waypoints closer than this (m) repeat each other (a zero-length segment
+#: has no direction): far below any positioning accuracy of a cable robot.
+WAYPOINT_SAME = 1e-9
+
+#: L-BFGS-B tolerances of the lift certificate's inner maximisation (relative objective
+#: change, projected gradient in N): tight, because the certificate compares the maximum
+#: with the weight to REFUTE_REL.
+LIFT_FTOL = 1e-15
+LIFT_GTOL = 1e-12
+
+#: Width (m or rad) given to a search coordinate whose half-range is zero (differential
+#: evolution needs lower < upper): the coordinate is effectively fixed.
+FIXED_COORD_WIDTH = 1e-12
+
+#: Deployment search tolerances: differential evolution's relative population ``tol``, and
+#: Nelder-Mead's ``xatol`` (m and rad: 0.1 mm is below any base positioning accuracy) and
+#: ``fatol`` (the capacity margin's mixed N / N m units).
+DEPLOY_DE_TOL = 1e-6
+DEPLOY_NM_XATOL = 1e-4
+DEPLOY_NM_FATOL = 1e-6
+
+#: Tension slack (N) before interpolated reference tensions count as outside the limits
+#: and are recomputed exactly (simulation setup): the same size as EVENT_TENSION_TOL.
+INTERP_TENSION_TOL = 1e-6
+
+#: Default ``certificate_tol`` of :func:`taut.cdpr.tallest_workspace` (m): the height
+#: resolution of the certified upper limit.
+TALLEST_CERTIFICATE_TOL = 1e-3

@@ -17,14 +17,16 @@ With ``all_solutions=True`` every start is run and distinct zero-residual poses 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array
 from ..errors import InvalidInputError
 from ._bases import as_base_poses, moved_exits
-from ._tol import FK_MAX_ITER, FK_POLISH_TOL, FK_RESIDUAL_TOL, FK_SAME_SOLUTION
+from ._tol import (FK_DAMPING_MAX, FK_DAMPING_MIN, FK_DAMPING_START, FK_MAX_ITER, FK_POLISH_TOL,
+                   FK_RESIDUAL_TOL, FK_SAME_SOLUTION, SO3_SMALL_ANGLE, SO3_TAYLOR_SQ)
+from ._batching import unbatch
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
 
@@ -42,12 +44,12 @@ def so3_exp(phi: np.ndarray) -> np.ndarray:
     """Rotation matrices ``exp([phi]x)`` (B, 3, 3) of rotation vectors ``phi`` (B, 3), rad
     (Rodrigues' formula, series near zero)."""
     th2 = (phi * phi).sum(axis=1)
-    if th2.max() < 1e-6:                  # Taylor series, error < th^6 / 5040 < 1e-22
+    if th2.max() < SO3_TAYLOR_SQ:         # Taylor series, error < th^6 / 5040 < 1e-22
         a = 1.0 - th2 / 6.0 * (1.0 - th2 / 20.0)
         b = 0.5 - th2 / 24.0 * (1.0 - th2 / 30.0)
     else:
         th = np.sqrt(th2)
-        small = th < 1e-8
+        small = th < SO3_SMALL_ANGLE
         a = np.where(small, 1.0 - th2 / 6.0, np.sin(th) / np.where(small, 1.0, th))
         b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(th)) / np.where(small, 1.0, th2))
     K = (phi @ _SKEW_GEN).reshape(-1, 3, 3)
@@ -65,7 +67,8 @@ def rpy_from_matrices(R: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CableFKResult:
-    """Poses for a batch of cable-length vectors.
+    """Poses for a batch of cable-length vectors (one vector (m,): the leading B axis of
+    every array dropped, ``success`` a bool, ``status`` a str).
 
     Attributes
     ----------
@@ -98,7 +101,7 @@ def _solve(exits: np.ndarray, attach: np.ndarray, lengths: np.ndarray, p: np.nda
            R: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Batched LM from (p, R); returns p, R, residual (B,), iterations (B,)."""
     B = p.shape[0]
-    lam = np.full(B, 1e-6)
+    lam = np.full(B, FK_DAMPING_START)
     it = np.zeros(B, dtype=int)
 
     def resid(p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -134,7 +137,8 @@ def _solve(exits: np.ndarray, attach: np.ndarray, lengths: np.ndarray, p: np.nda
         u = np.where(good[:, None, None], u_new, u)
         r = np.where(good[:, None, None], r_new, r)
         cost = np.where(good, c_new, cost)
-        lam = np.where(good, np.maximum(lam / 10.0, 1e-12), np.minimum(lam * 10.0, 1e8))
+        lam = np.where(good, np.maximum(lam / 10.0, FK_DAMPING_MIN),
+                       np.minimum(lam * 10.0, FK_DAMPING_MAX))
         it += act
     return p, R, np.abs(e).max(axis=1), it
 
@@ -144,9 +148,10 @@ def _default_start(robot: CableRobot) -> np.ndarray:
     return np.r_[0.5 * (box[0] + box[1]), 0.0, 0.0, 0.0]
 
 
-def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any = None,
-                             initial_guess: Any = None, restarts: int = 8, seed: int = 0,
-                             all_solutions: bool = False) -> CableFKResult:
+def cable_forward_kinematics(robot: CableRobot, lengths: ArrayLike, *,
+                             base_poses: ArrayLike | None = None,
+                             initial_guess: ArrayLike | None = None, restarts: int = 8,
+                             seed: int = 0, all_solutions: bool = False) -> CableFKResult:
     """Platform poses that give the cable lengths (the inverse of
     :func:`taut.cdpr.cable_state`).
 
@@ -170,6 +175,7 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     Returns
     -------
     CableFKResult
+        Arrays with a leading axis of B for lengths (B, m); without it for lengths (m,).
 
     Examples
     --------
@@ -178,11 +184,12 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     >>> robot = load_cdpr_model("fastkit")
     >>> pose = [0.4, 0.05, 1.1, 0.02, -0.03, 0.1]
     >>> fk = cable_forward_kinematics(robot, cable_state(robot, pose).lengths)
-    >>> bool(fk.success[0]), bool(np.allclose(fk.poses[0], pose, atol=1e-9))
+    >>> fk.success, bool(np.allclose(fk.poses, pose, atol=1e-9))
     (True, True)
     """
     lengths_arr = as_array(lengths, "lengths")
-    if lengths_arr.ndim == 1:
+    single = lengths_arr.ndim == 1
+    if single:
         lengths_arr = lengths_arr[None]
     if lengths_arr.ndim != 2 or lengths_arr.shape[1] != robot.m:
         raise InvalidInputError("lengths", f"must have shape ({robot.m},) or (B, {robot.m})")
@@ -232,7 +239,9 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
            + ("" if ok.all() else f"; worst residual {float(res.max()):.3g} m "
               "(lengths no pose can have, or no start in the basin)"))
     poses = np.column_stack([p, rpy_from_matrices(R)])
-    return CableFKResult(poses, res, it, n_sol, ok, status, msg)
+    return unbatch(CableFKResult(poses, res, it, n_sol, ok, status, msg),
+                   ("poses", "residual", "iterations", "n_solutions", "success", "status"),
+                   single)
 
 
 def _count_distinct(sols: list[tuple[np.ndarray, np.ndarray, np.ndarray]], B: int

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 from scipy.optimize import linprog
 
 from ._common import svd_split
+from ._batching import first, is_single
 from ._tol import CLOSURE_TOL
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
@@ -24,7 +25,7 @@ __all__ = ["wrench_closure"]
 
 def wrench_closure(robot: CableRobot, poses: ArrayLike, *,
                    closure_tol: float = CLOSURE_TOL) -> np.ndarray:
-    """Whether each pose has wrench closure, (B,) bool.
+    """Whether each pose has wrench closure, (B,) bool (a bool for one pose).
 
     Parameters
     ----------
@@ -41,9 +42,10 @@ def wrench_closure(robot: CableRobot, poses: ArrayLike, *,
     >>> fc = load_cdpr_model("fastkit_fc")
     >>> wrench_closure(fc, [[0, 0, 1.2], [0, 0, 2.3]]).tolist()
     [True, False]
-    >>> wrench_closure(load_cdpr_model("fastkit"), [0, 0, 1.2]).tolist()   # suspended
-    [False]
+    >>> wrench_closure(load_cdpr_model("fastkit"), [0, 0, 1.2])   # suspended
+    False
     """
+    single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     _, _, full = svd_split(st.W)
@@ -57,4 +59,4 @@ def wrench_closure(robot: CableRobot, poses: ArrayLike, *,
         sol = linprog(c, A_ub=A_ub, b_ub=np.zeros(m), A_eq=A_eq, b_eq=np.zeros(A_eq.shape[0]),
                       bounds=[(0.0, 1.0)] * m + [(None, None)], method="highs")
         out[k] = sol.status == 0 and -sol.fun > closure_tol
-    return out
+    return first(out) if single else out

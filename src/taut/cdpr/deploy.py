@@ -37,6 +37,7 @@ from .._outcome import check_status, deprecated_alias
 from .._validate import as_array
 from ..errors import InvalidInputError, TautError
 from ._common import renamed_keyword, wrench_vertices
+from ._tol import DEPLOY_DE_TOL, DEPLOY_NM_FATOL, DEPLOY_NM_XATOL, FIXED_COORD_WIDTH
 from .lift import LiftBound, lift_bound, upward_force_bound
 from .model import CableRobot
 from .motion_modes import MotionLimits, fastkit_motion_limits
@@ -227,12 +228,13 @@ class _PlacementScore:
 def _search(objective: _PlacementScore, x0: np.ndarray, half: np.ndarray,
             opts: DeploymentOptions) -> np.ndarray:
     """Seeded differential evolution from the model's placement, then Nelder-Mead."""
-    bounds = [(a - h, a + h) if h > 0 else (a, a + 1e-12) for a, h in zip(x0, half)]
+    bounds = [(a - h, a + h) if h > 0 else (a, a + FIXED_COORD_WIDTH) for a, h in zip(x0, half)]
     de = differential_evolution(objective, bounds, x0=x0, seed=opts.seed,
                                 maxiter=opts.maxiter, popsize=opts.popsize, polish=False,
-                                tol=1e-6, init="sobol")
+                                tol=DEPLOY_DE_TOL, init="sobol")
     loc = minimize(objective, de.x, method="Nelder-Mead",
-                   options={"maxfev": 60 * len(x0), "xatol": 1e-4, "fatol": 1e-6})
+                   options={"maxfev": 60 * len(x0), "xatol": DEPLOY_NM_XATOL,
+                            "fatol": DEPLOY_NM_FATOL})
     best = loc.x if loc.fun <= de.fun else de.x
     return np.clip(best, [b[0] for b in bounds], [b[1] for b in bounds])
 

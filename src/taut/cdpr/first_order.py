@@ -37,6 +37,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._batching import is_single, unbatch
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
 from .motion_modes import BASE_JOINTS, Mode, ModeName, resolve_mode
@@ -83,8 +84,9 @@ def base_jacobians(robot: CableRobot, positions: np.ndarray) -> np.ndarray:
 
 def parallel_jacobian(robot: CableRobot, poses: ArrayLike) -> np.ndarray:
     """Parallel Jacobian ``A`` (B, m, n) with ``l_dot = A t`` for fixed bases (eqs. 1-3);
-    n = 6 (``t = [v; w]``, m/s and rad/s) or 3 for a point-mass platform."""
-    return -np.swapaxes(cable_state(robot, poses).W, 1, 2)
+    n = 6 (``t = [v; w]``, m/s and rad/s) or 3 for a point-mass platform. One pose gives
+    (m, n)."""
+    return np.swapaxes(-cable_state(robot, poses).W, -1, -2)
 
 
 @dataclass(frozen=True)
@@ -125,6 +127,10 @@ class FirstOrderModel:
         return 3 * len(self.mode.moving)
 
 
+#: The per-pose fields of :class:`FirstOrderModel` (dropped to one pose by the batching rule).
+FOM_PER_POSE = ("poses", "A", "B_b", "base_twists", "B", "lengths")
+
+
 def first_order_model(robot: CableRobot, poses: ArrayLike, mode: ModeName = "task",
                       moving: Sequence[str] | None = None) -> FirstOrderModel:
     """First-order kinematic model of a mobile CDPR at poses (FASTKIT eqs. 1-9).
@@ -140,7 +146,16 @@ def first_order_model(robot: CableRobot, poses: ArrayLike, mode: ModeName = "tas
     Returns
     -------
     FirstOrderModel
+        Leading axis of B poses for a batch; none for one pose (``A`` (m, n), ...).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> fom = first_order_model(load_cdpr_model("fastkit"), [0, 0, 1.0])
+    >>> fom.A.shape, fom.B.shape, fom.joint_names[:2]     # active base moving, 8 cables
+    ((8, 6), (8, 11), ('active.theta', 'active.rho1'))
     """
+    single = is_single(poses)
     md = resolve_mode(robot, mode, moving)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
@@ -161,5 +176,6 @@ def first_order_model(robot: CableRobot, poses: ArrayLike, mode: ModeName = "tas
         jn = jn + tuple(c.name for c in robot.cables)
     else:
         Bsel = Bb[:, :, cols]
-    return FirstOrderModel(P, A6[:, :, :n].copy(), Bb, T[:, :, :n].copy(), md, Bsel, jn,
-                           st.lengths)
+    fom = FirstOrderModel(P, A6[:, :, :n].copy(), Bb, T[:, :, :n].copy(), md, Bsel, jn,
+                          st.lengths)
+    return unbatch(fom, FOM_PER_POSE, single)

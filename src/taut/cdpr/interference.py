@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._tol import BOX_REL
+from ._batching import is_single, unbatch
+from ._tol import BOX_REL, SEGMENT_PARALLEL, TINY
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
 
@@ -38,9 +39,9 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
     c = np.einsum("...i,...i", d1, r)
     b = np.einsum("...i,...i", d1, d2)
     den = a * e - b * b
-    tiny = 1e-300
+    tiny = TINY
     with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(den > 1e-14 * a * e, np.clip((b * f - c * e) / np.maximum(den, tiny),
+        s = np.where(den > SEGMENT_PARALLEL * a * e, np.clip((b * f - c * e) / np.maximum(den, tiny),
                                                   0.0, 1.0), 0.0)
         t = np.where(e > tiny, (b * s + f) / np.maximum(e, tiny), 0.0)
         s = np.where(t < 0, np.clip(-c / np.maximum(a, tiny), 0.0, 1.0),
@@ -58,7 +59,7 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
 
 @dataclass(frozen=True)
 class Interference:
-    """Interference of the cables at B poses.
+    """Interference of the cables at B poses (one pose: the leading B axis dropped).
 
     Attributes
     ----------
@@ -119,6 +120,7 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     >>> res.cable_cable.tolist(), res.free.tolist()    # level: crossing pairs meet
     ([True, False], [False, True])
     """
+    single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     att = P[:, None, :3] + st.r                                  # (B, m, 3)
@@ -138,4 +140,5 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     through = _through_box(a_loc, e_loc, lo + shrink, hi - shrink)
     if not np.all(hi - lo > 2 * shrink):          # flat or point platform: no volume
         through = np.zeros_like(through)
-    return Interference(D, close, through, ~close & ~through.any(axis=1), float(min_distance))
+    res = Interference(D, close, through, ~close & ~through.any(axis=1), float(min_distance))
+    return unbatch(res, ("distance", "cable_cable", "cable_platform", "free"), single)

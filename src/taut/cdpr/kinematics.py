@@ -2,19 +2,21 @@
 
 A pose is ``(x, y, z, roll, pitch, yaw)`` (m, rad); the platform rotation is
 ``R = Rz(yaw) Ry(pitch) Rx(roll)``. A 3-vector ``(x, y, z)`` means zero orientation.
-Batched inputs carry a leading axis of B poses. Cable ``i`` pulls the platform along
+Batched inputs carry a leading axis of B poses; one pose ``(6,)`` or ``(3,)`` gives
+unbatched results (the rule of :mod:`taut.cdpr._batching`). Cable ``i`` pulls the platform along
 ``u_i``, the unit vector from its attachment point to its exit point.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array, require_instance
 from ..errors import InfeasiblePoseError, InvalidInputError
+from ._batching import is_single, unbatch
 from ._tol import BOX_REL, ZERO_LENGTH_REL
 from .model import CableRobot
 
@@ -22,7 +24,7 @@ __all__ = ["as_poses", "rotation_matrices", "CableState", "cable_state", "wrench
            "gravity_wrench", "tipping_matrix"]
 
 
-def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
+def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose",
              check_bounds: bool = True) -> np.ndarray:
     """Validate platform poses and return them as a float64 ``(B, 6)`` array.
 
@@ -55,8 +57,9 @@ def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
     return arr
 
 
-def rotation_matrices(rpy: np.ndarray) -> np.ndarray:
+def rotation_matrices(rpy: ArrayLike) -> np.ndarray:
     """``Rz(yaw) Ry(pitch) Rx(roll)`` for ``rpy`` of shape (B, 3) (rad) -> (B, 3, 3)."""
+    rpy = np.asarray(rpy, dtype=float)
     cr, cp, cy = np.cos(rpy.T)
     sr, sp, sy = np.sin(rpy.T)
     R = np.empty((rpy.shape[0], 3, 3))
@@ -74,7 +77,7 @@ def rotation_matrices(rpy: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CableState:
-    """Inverse kinematics of a batch of poses.
+    """Inverse kinematics of a batch of poses (one pose: every leading B axis dropped).
 
     Attributes
     ----------
@@ -102,7 +105,8 @@ class CableState:
     R: np.ndarray
 
 
-def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> CableState:
+def cable_state(robot: CableRobot, poses: ArrayLike, *, validated: bool = False
+                ) -> CableState:
     """Cable lengths, unit vectors and the wrench matrix W (FASTKIT eq. 18) at poses.
 
     Parameters
@@ -113,13 +117,29 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
     validated : bool
         Skip validation when ``poses`` is already a checked ``(B, 6)`` array.
 
+    Returns
+    -------
+    CableState
+        Arrays with a leading axis of B poses for a batch; without it for one pose
+        (``lengths`` (m,), ``W`` (n, m), ...).
+
     Raises
     ------
     InfeasiblePoseError
         A position outside the frame box, or an attachment point on its exit point
         (zero cable length, direction undefined).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> cable_state(robot, [0, 0, 1.0]).W.shape           # one pose: (n, m)
+    (6, 8)
+    >>> cable_state(robot, [[0, 0, 1.0], [0.5, 0, 1.2]]).lengths.shape   # a batch
+    (2, 8)
     """
-    P = poses if validated else as_poses(robot, poses)
+    single = not validated and is_single(poses)
+    P = np.asarray(poses) if validated else as_poses(robot, poses)
     R = rotation_matrices(P[:, 3:])
     r = np.einsum("bij,mj->bmi", R, robot.attach_local)
     vec = robot.exits_world[None, :, :] - (P[:, None, :3] + r)
@@ -136,20 +156,26 @@ def cable_state(robot: CableRobot, poses: Any, *, validated: bool = False) -> Ca
         W = np.swapaxes(u, 1, 2).copy()
     else:
         W = np.concatenate([np.swapaxes(u, 1, 2), np.swapaxes(np.cross(r, u), 1, 2)], axis=1)
-    return CableState(P, L, u, r, W, R)
+    return unbatch(CableState(P, L, u, r, W, R), ("poses", "lengths", "unit", "r", "W", "R"),
+                   single)
 
 
-def wrench_matrix(robot: CableRobot, poses: Any) -> np.ndarray:
-    """The wrench matrix W, shape (B, n, m) (FASTKIT eq. 18); see :func:`cable_state`."""
+def wrench_matrix(robot: CableRobot, poses: ArrayLike) -> np.ndarray:
+    """The wrench matrix W, shape (B, n, m), or (n, m) for one pose (FASTKIT eq. 18); see
+    :func:`cable_state`."""
     return cable_state(robot, poses).W
 
 
-def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
+def gravity_wrench(robot: CableRobot, R: ArrayLike) -> np.ndarray:
     """External wrench ``w_e`` (FASTKIT eq. 19) of platform and payload weight, (B, n).
 
     ``w_e = [f_e; m_e]`` with ``f_e = (m_p + m_l) g`` (N) and ``m_e`` the moment of both
-    weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3).
+    weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3);
+    one rotation (3, 3) gives one wrench (n,).
     """
+    R = np.asarray(R, dtype=float)
+    if R.ndim == 2:
+        return gravity_wrench(robot, R[None])[0]
     g = robot.gravity
     f = np.broadcast_to(robot.total_mass * g, (R.shape[0], 3))
     if robot.dof == 3:
@@ -159,11 +185,15 @@ def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
     return np.concatenate([f, m], axis=1)
 
 
-def tipping_matrix(robot: CableRobot, unit: np.ndarray) -> np.ndarray:
+def tipping_matrix(robot: CableRobot, unit: ArrayLike) -> np.ndarray:
     """Tipping coefficients ``T`` (B, E, m) so that the edge moments of FASTKIT eqs. 21-23
     are ``m_C = T t + robot.edge_weight_moment`` (N m) for tensions ``t`` (N).
 
     ``T[j, i] = u_Cj . ((c_j - b_i) x u_i)`` for a cable ``i`` leaving the base of edge
-    ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``.
+    ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``. One pose's
+    unit vectors (m, 3) give (E, m).
     """
+    unit = np.asarray(unit, dtype=float)
+    if unit.ndim == 2:
+        return tipping_matrix(robot, unit[None])[0]
     return np.einsum("jik,bik->bji", robot._tip_V, unit)

@@ -16,7 +16,7 @@ from scipy.optimize import minimize
 from .._validate import as_array
 from ..errors import InvalidInputError
 from ._common import renamed_keyword, wrench_vertices
-from ._tol import LIFT_RTOL, REFUTE_REL
+from ._tol import LIFT_FTOL, LIFT_GTOL, LIFT_RTOL, REFUTE_REL
 from .model import CableRobot
 from .placement import workspace_box
 from .workspace import grid_points
@@ -35,7 +35,7 @@ def _lift_terms(t_max: np.ndarray, c: np.ndarray, d: np.ndarray) -> np.ndarray:
 
 def upward_force_bound(robot: CableRobot, points: ArrayLike) -> np.ndarray:
     """Upper bound ``sum_i f_i(d_i)`` on the upward cable force at level platform positions,
-    for the robot as placed, (B,) N.
+    for the robot as placed, (B,) N (a float for one point).
 
     ``f_i(d) = t_max,i max(h_i - z_ai, 0) / sqrt(d^2 + (h_i - z_ai)^2)`` with ``h_i`` the
     exit height, ``z_ai`` the attachment height and ``d_i`` their horizontal distance:
@@ -49,13 +49,15 @@ def upward_force_bound(robot: CableRobot, points: ArrayLike) -> np.ndarray:
         Platform positions (orientation zero), m. Not checked against the frame box.
     """
     P = as_array(points, "points")
-    P = P[None, :] if P.ndim == 1 else P
+    single = P.ndim == 1
+    P = P[None, :] if single else P
     if P.ndim != 2 or P.shape[1] != 3:
         raise InvalidInputError("points", "must be (x, y, z) or a (B, 3) array")
     att = P[:, None, :] + robot.attach_local[None, :, :]           # level platform
     vec = robot.exits_world[None, :, :] - att                        # (B, m, 3)
     d = np.hypot(vec[..., 0], vec[..., 1])
-    return _lift_terms(robot.t_max, vec[..., 2], d).sum(axis=1)
+    out = _lift_terms(robot.t_max, vec[..., 2], d).sum(axis=1)
+    return out[0] if single else out
 
 
 def _mean_lift(e: np.ndarray, q: np.ndarray, t: float, c: float, radius: float = 0.0,
@@ -125,7 +127,7 @@ def _max_mean_lift(q: np.ndarray, t: float, c: float, rtol: float = LIFT_RTOL,
         return float(t * c * inv.mean()), -(t * c) * (inv ** 3) @ diff / len(q)
 
     pol = minimize(neg, arg, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)),
-                   options={"ftol": 1e-15, "gtol": 1e-12})
+                   options={"ftol": LIFT_FTOL, "gtol": LIFT_GTOL})
     if -pol.fun > best:
         best, arg = float(-pol.fun), np.clip(pol.x, lo, hi)
     atol = rtol * t
@@ -256,6 +258,13 @@ def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
     Returns
     -------
     LiftBound
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> lb = lift_bound(load_cdpr_model("fastkit"), [[-2.5, -0.05, 0.2], [2.5, 0.05, 2.2]])
+    >>> lb.refutes, lb.status, round(lb.bound, 1), round(lb.required, 1)   # N
+    (True, 'refuted', 64.2, 117.7)
 
     Notes
     -----

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ._tol import EQUILIBRIUM_FORCE_TOL
+from ._tol import EQUILIBRIUM_FD_STEP, EQUILIBRIUM_FORCE_TOL
 from .cable_fk import so3_exp
 from .dynamics_model import DynamicsModel
 from .kinematics import rotation_matrices
@@ -239,7 +239,7 @@ def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.nda
         M = np.cross(r, Tu, axis=1).sum(axis=2)
         return np.hstack([F, M])
 
-    eps = 1e-7
+    eps = EQUILIBRIUM_FD_STEP
     for _ in range(50):
         res = residual(s)
         if np.abs(res).max() < EQUILIBRIUM_FORCE_TOL:

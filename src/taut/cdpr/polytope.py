@@ -27,7 +27,11 @@ __all__ = ["HPolytopeBatch", "lp_max_step"]
 
 @dataclass(frozen=True)
 class HPolytopeBatch:
-    """B polyhedra ``{x : H x <= h, E x = 0}`` in R^n.
+    """B polyhedra ``{x : H x <= h, E x = 0}`` in R^n, or one polyhedron.
+
+    One polyhedron (the set at one pose) has no leading axis (``H`` (S, n), ``h`` (S,),
+    ``E`` (k, n)) and its methods return scalars (``contains`` a bool) instead of (B,)
+    arrays: the batching rule of :mod:`taut.cdpr._batching`.
 
     Attributes
     ----------
@@ -45,6 +49,9 @@ class HPolytopeBatch:
     ...                      np.array([[1.0, 1, 2, 2]]), np.zeros((1, 0, 2)))
     >>> box.contains([0.5, -1.5]).tolist(), box.margin([0.5, -1.5]).tolist()
     ([True], [0.5])
+    >>> one = HPolytopeBatch(box.H[0], box.h[0], box.E[0])     # one polyhedron
+    >>> one.contains([0.5, -1.5]), float(one.margin([0.5, -1.5]))
+    (True, 0.5)
     """
 
     H: np.ndarray
@@ -52,14 +59,32 @@ class HPolytopeBatch:
     E: np.ndarray
 
     @property
+    def single(self) -> bool:
+        """Whether this is one polyhedron (no leading batch axis)."""
+        return bool(self.H.ndim == 2)
+
+    @property
     def batch(self) -> int:
-        """Number of polyhedra B."""
-        return int(self.H.shape[0])
+        """Number of polyhedra B (1 for a single polyhedron)."""
+        return 1 if self.single else int(self.H.shape[0])
 
     @property
     def dim(self) -> int:
         """Ambient dimension n."""
-        return int(self.H.shape[2])
+        return int(self.H.shape[-1])
+
+    def _rows(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(H, h, E)`` with a leading batch axis (added for a single polyhedron)."""
+        if self.single:
+            return self.H[None], self.h[None], self.E[None]
+        return self.H, self.h, self.E
+
+    def _out(self, value: np.ndarray) -> Any:
+        """Per-polyhedron results (B, ...) -> without the batch axis for one polyhedron."""
+        if not self.single:
+            return value
+        v = value[0]
+        return bool(v) if isinstance(v, np.bool_) else v
 
     def _points(self, x: Any, field: str) -> np.ndarray:
         """Validate one point (n,) or one per polyhedron (B, n) -> (B, n)."""
@@ -70,23 +95,29 @@ class HPolytopeBatch:
                                            "pose")
         return np.broadcast_to(p, (B, n))
 
-    def contains(self, x: ArrayLike, tol: float = CONTAINS_TOL) -> np.ndarray:
-        """Whether points ``(n,)`` or ``(B, n)`` lie in the polyhedra -> (B,) bool; ``tol``
-        is an absolute slack in the set's units."""
+    def contains(self, x: ArrayLike, tol: float = CONTAINS_TOL) -> Any:
+        """Whether points ``(n,)`` or ``(B, n)`` lie in the polyhedra -> (B,) bool (a bool
+        for one polyhedron); ``tol`` is an absolute slack in the set's units."""
+        return self._out(self._contains(x, tol))
+
+    def _contains(self, x: ArrayLike, tol: float) -> np.ndarray:
+        H, h, E = self._rows()
         p = self._points(x, "point")
-        ok = np.all(np.einsum("bsn,bn->bs", self.H, p) <= self.h + tol, axis=1)
-        if self.E.shape[1]:
-            ok &= np.all(np.abs(np.einsum("bkn,bn->bk", self.E, p)) <= tol, axis=1)
+        ok = np.all(np.einsum("bsn,bn->bs", H, p) <= h + tol, axis=1)
+        if E.shape[1]:
+            ok &= np.all(np.abs(np.einsum("bkn,bn->bk", E, p)) <= tol, axis=1)
         return ok
 
-    def margin(self, x: ArrayLike) -> np.ndarray:
-        """``min_s (h_s - H_s x)`` (B,): distance of ``x`` to the boundary along the unit
-        normals when inside, negative outside (equality violations count as ``-|E x|``)."""
+    def margin(self, x: ArrayLike) -> Any:
+        """``min_s (h_s - H_s x)`` (B,) (a float for one polyhedron): distance of ``x`` to
+        the boundary along the unit normals when inside, negative outside (equality
+        violations count as ``-|E x|``)."""
+        H, h, E = self._rows()
         p = self._points(x, "point")
-        m = np.min(self.h - np.einsum("bsn,bn->bs", self.H, p), axis=1)
-        if self.E.shape[1]:
-            m = np.minimum(m, -np.abs(np.einsum("bkn,bn->bk", self.E, p)).max(axis=1))
-        return m
+        m = np.min(h - np.einsum("bsn,bn->bs", H, p), axis=1)
+        if E.shape[1]:
+            m = np.minimum(m, -np.abs(np.einsum("bkn,bn->bk", E, p)).max(axis=1))
+        return self._out(m)
 
     def ray_lengths(self, origin: np.ndarray | None, direction: np.ndarray, *,
                     tol: float, zero: float = ZERO_ROW) -> tuple[np.ndarray, np.ndarray]:
@@ -108,19 +139,33 @@ class HPolytopeBatch:
             the direction leaves the span of ``E``'s complement).
         reach : (B,) bool
             Whether ``s = 0`` (or some ``s >= 0``) is in the set at all.
+
+        For one polyhedron ``origin`` is (n,) and both results are scalars.
         """
-        c = np.einsum("bsn,n->bs", self.H, direction)
-        slack = self.h if origin is None else self.h - np.einsum("bsn,bn->bs", self.H, origin)
+        H, h, E = self._rows()
+        if origin is not None and self.single:
+            origin = np.asarray(origin)[None]
+        c = np.einsum("bsn,n->bs", H, direction)
+        slack = h if origin is None else h - np.einsum("bsn,bn->bs", H, origin)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = slack / c
+            loose = (slack + tol) / c            # every row relaxed by tol, as in contains
         hi = np.min(np.where(c > zero, ratio, np.inf), axis=1)
         lo = np.max(np.where(c < -zero, ratio, -np.inf), axis=1)
         zero_ok = np.all((np.abs(c) > zero) | (slack >= -tol), axis=1)
-        reach = zero_ok & (hi >= np.maximum(lo, 0.0) - tol)
-        if self.E.shape[1]:
-            along = np.abs(np.einsum("bkn,n->bk", self.E, direction)).max(axis=1) <= SPAN_TOL
+        # Whether some s >= 0 satisfies every row to within tol. The slack tol of a row is
+        # tol / |c| along the ray (|c| <= 1 for unit rows and a unit direction), so the
+        # interval test is made on the relaxed rows, not on s with the row tolerance (that
+        # missed a point-like interval, lo - hi ~ 3e-8 N with tol 1.5e-8 N, that the LP
+        # finds: tests/cdpr/test_wrench_set.py::test_random_point_mass_robots).
+        hi_loose = np.min(np.where(c > zero, loose, np.inf), axis=1)
+        lo_loose = np.max(np.where(c < -zero, loose, -np.inf), axis=1)
+        reach = zero_ok & ((hi >= np.maximum(lo, 0.0) - tol)
+                           | (hi_loose >= np.maximum(lo_loose, 0.0)))
+        if E.shape[1]:
+            along = np.abs(np.einsum("bkn,n->bk", E, direction)).max(axis=1) <= SPAN_TOL
             hi = np.where(along, hi, 0.0)
-        return np.where(reach, np.maximum(hi, 0.0), 0.0), reach
+        return self._out(np.where(reach, np.maximum(hi, 0.0), 0.0)), self._out(reach)
 
     def axis_ray_lengths(self, origin: np.ndarray | None, *, tol: float, sign: float = 1.0,
                          zero: float = ZERO_ROW
@@ -128,9 +173,16 @@ class HPolytopeBatch:
         """:meth:`ray_lengths` along ``+sign e_k`` and ``-sign e_k`` for every axis k.
 
         Returns ``positive`` (B, n), ``negative`` (B, n) and ``reach`` (B, n, 2) (columns
-        ``+``, ``-``). ``sign = -1`` measures along ``-e_k`` for "positive" (used by the
-        wrench set, whose points are cable wrenches opposing the external wrench).
+        ``+``, ``-``; one polyhedron: (n,), (n,), (n, 2)). ``sign = -1`` measures along
+        ``-e_k`` for "positive" (used by the wrench set, whose points are cable wrenches
+        opposing the external wrench).
         """
+        if self.single:
+            H, h, E = self._rows()
+            o = None if origin is None else np.asarray(origin)[None]
+            pos, neg, reach = HPolytopeBatch(H, h, E).axis_ray_lengths(o, tol=tol, sign=sign,
+                                                                       zero=zero)
+            return pos[0], neg[0], reach[0]
         B, n = self.batch, self.dim
         pos, neg = np.zeros((B, n)), np.zeros((B, n))
         reach = np.zeros((B, n, 2), dtype=bool)
@@ -145,11 +197,12 @@ class HPolytopeBatch:
         """Support function ``max d . x`` over polyhedron ``k`` (LP over the H-rep, HiGHS);
         ``inf`` when unbounded, ``-inf`` when empty."""
         d = as_array(direction, "direction", shape=(self.dim,))
-        if np.any(self.h[k] == -np.inf):
+        Hs, hs, Es = self._rows()
+        if np.any(hs[k] == -np.inf):
             return -np.inf
-        keep = np.isfinite(self.h[k])
-        E = self.E[k]
-        sol = linprog(-d, A_ub=self.H[k][keep], b_ub=self.h[k][keep],
+        keep = np.isfinite(hs[k])
+        E = Es[k]
+        sol = linprog(-d, A_ub=Hs[k][keep], b_ub=hs[k][keep],
                       A_eq=E if E.shape[0] else None,
                       b_eq=np.zeros(E.shape[0]) if E.shape[0] else None,
                       bounds=[(None, None)] * d.size, method="highs")
@@ -161,8 +214,9 @@ class HPolytopeBatch:
 
     def facets(self, k: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Distinct rows ``(H, h)`` of polyhedron ``k`` (redundant rows may remain)."""
-        keep = np.isfinite(self.h[k])
-        Hk, hk = self.H[k][keep], self.h[k][keep]
+        Hs, hs, _ = self._rows()
+        keep = np.isfinite(hs[k])
+        Hk, hk = Hs[k][keep], hs[k][keep]
         _, first = np.unique(np.round(np.column_stack([Hk, hk]), 9), axis=0,
                              return_index=True)
         first.sort()

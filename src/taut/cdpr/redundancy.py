@@ -30,7 +30,7 @@ from scipy.optimize import linprog, minimize
 from .._outcome import deprecated_alias
 from .._validate import as_array
 from ..errors import InvalidInputError
-from ._tol import RATE_FLOOR, SCALE_ONE
+from ._tol import LEAST_BASE_CABLE_WEIGHT, RATE_FLOOR, REDUNDANCY_TOL, SCALE_ONE, SLSQP_FTOL
 from .first_order import FirstOrderModel, first_order_model
 from .model import CableRobot
 from .motion_modes import ModeName, MotionLimits, fastkit_motion_limits, joint_bounds
@@ -109,7 +109,7 @@ def _lp_scale(C: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray, nb: 
 def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
                        limits: MotionLimits | None = None, *, mode: ModeName = "task",
                        moving: Sequence[str] | None = None, objective: Objective = "min_norm",
-                       tol: float = 1e-9) -> RedundancyResult:
+                       tol: float = REDUNDANCY_TOL) -> RedundancyResult:
     """Joint rates producing a desired platform twist within joint limits.
 
     Parameters
@@ -130,6 +130,13 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     Returns
     -------
     RedundancyResult
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> res = resolve_redundancy(load_cdpr_model("fastkit"), [1, 0, 0.8], [0.5, 0, 0, 0, 0, 0])
+    >>> res.success, res.status, res.scale
+    (True, 'ok', 1.0)
     """
     if objective not in OBJECTIVES:
         raise InvalidInputError("objective", "must be one of " + ", ".join(OBJECTIVES))
@@ -137,7 +144,7 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     P = as_array(pose, "pose")
     if P.ndim != 1:
         raise InvalidInputError("pose", "must be a single pose (x, y, z[, roll, pitch, yaw])")
-    fom = first_order_model(robot, P, mode, moving)
+    fom = first_order_model(robot, P[None], mode, moving)       # a batch of one pose
     n = fom.A.shape[2]
     t = as_array(twist, "twist")
     if t.shape != (n,):
@@ -160,7 +167,7 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     dd = d * s_use
     w = 1.0 / np.maximum(np.maximum(np.abs(lo), np.abs(hi)), RATE_FLOOR)
     wb, wc = w[:nb], w[nb:]
-    cable_w = 1.0 if objective == "min_norm" else 1e-3
+    cable_w = 1.0 if objective == "min_norm" else LEAST_BASE_CABLE_WEIGHT
     x = x0
     if nb:
         def f(x):
@@ -176,7 +183,7 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
                 {"type": "ineq", "fun": lambda x: (dd - C @ x) - lo[nb:],
                  "jac": lambda x: -C}]
         res = minimize(f, x0, jac=g, bounds=list(zip(lo[:nb], hi[:nb])), constraints=cons,
-                       method="SLSQP", options={"ftol": 1e-12, "maxiter": 200})
+                       method="SLSQP", options={"ftol": SLSQP_FTOL, "maxiter": 200})
         xq = np.clip(res.x, lo[:nb], hi[:nb])
         lq = dd - C @ xq
         if np.all(lq <= hi[nb:] + tol) and np.all(lq >= lo[nb:] - tol) and f(xq) <= f(x0):

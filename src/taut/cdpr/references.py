@@ -9,14 +9,15 @@ accelerations ``[a; alpha]`` in the same order as the wrench ``[f; m]`` of FASTK
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import (MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded,
                          as_nonnegative, as_positive)
 from ..errors import InvalidInputError, InvalidTrajectoryError
-from ._tol import MAX_REFERENCE_SPEED
+from ._tol import MAX_REFERENCE_SPEED, WAYPOINT_SAME
 from .kinematics import as_poses
 from .model import CableRobot
 
@@ -98,7 +99,7 @@ def _profile(d: float, speed: float, acceleration: float, profile: str,
     return s, sd, sdd
 
 
-def pick_and_place(robot: CableRobot, waypoints: Any, speed: float = 1.0, *,
+def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, *,
                    profile: Profile = "quintic", acceleration: float = 3.0,
                    dwell: float = 0.3, rate: float = 1000.0) -> Reference:
     """Straight-line moves between waypoints, each at peak speed ``speed``, resting
@@ -157,7 +158,7 @@ def pick_and_place(robot: CableRobot, waypoints: Any, speed: float = 1.0, *,
     for k in range(len(wp) - 1):
         seg = wp[k + 1] - wp[k]
         d = float(np.linalg.norm(seg))
-        if d <= 1e-9:
+        if d <= WAYPOINT_SAME:
             raise InvalidInputError(f"waypoints[{k + 1}]", "repeats the previous waypoint")
         e = seg / d
         s, sd, sdd = _profile(d, speed, acceleration, profile, rate)
@@ -174,7 +175,8 @@ def pick_and_place(robot: CableRobot, waypoints: Any, speed: float = 1.0, *,
                      np.hstack([A, z]))
 
 
-def reference_from_samples(robot: CableRobot, times: Any, poses: Any) -> Reference:
+def reference_from_samples(robot: CableRobot, times: ArrayLike, poses: ArrayLike
+                           ) -> Reference:
     """A reference through sampled poses; velocities and accelerations by second-order
     finite differences (``numpy.gradient``), angular rates through the Euler-rate map.
 

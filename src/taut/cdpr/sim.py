@@ -10,14 +10,15 @@ with different seeded model errors, batched through one plant, summary numbers p
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Literal, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
                          as_nonnegative, as_positive)
 from ..errors import InvalidInputError
-from ._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H
+from ._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
 from .cable_fk import rpy_from_matrices
 from .controllers import (ControlContext, Controller, Measurement, TorqueController,
                           VelocityController)
@@ -30,6 +31,9 @@ from .sim_setup import BaseMotion, RefGeometry, build_context, reference_geometr
 from .sim_result import ControlResult, MonteCarloResult, assemble_result, summarise
 
 __all__ = ["simulate", "monte_carlo", "ControlResult", "MonteCarloResult", "BaseMotion"]
+
+#: The integrators of :func:`simulate`: compiled (numba), plain numpy, or numba when available.
+Engine = Literal["auto", "numba", "numpy"]
 
 _CHECK_EVERY = 50          # control steps between divergence checks
 _MC_RECORD_EVERY = 10      # Monte Carlo keeps every 10th state for the tipping monitor
@@ -76,7 +80,7 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
                                 f"control steps, more than {MAX_BATCH}")
     settle_s = as_nonnegative(settle, "settle")
     dt = 1.0 / rate
-    n = max(int(np.ceil(dur * rate - 1e-9)), 1)
+    n = max(int(np.ceil(dur * rate - STEP_COUNT_SLACK)), 1)
     k0 = int(round(settle_s * rate))
     times = (np.arange(n + 1 + k0) - k0) * dt
     geo = reference_geometry(robot, times, base_motion)
@@ -219,7 +223,8 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
              model_errors: ModelErrors | None = None, base_motion: BaseMotion | None = None,
              control_rate: float = 1000.0, duration: float | None = None,
              dynamics: DynamicsModel | None = None, substeps: int = 1,
-             external_wrench: Any = None, settle: float = 1.0, engine: str = "auto",
+             external_wrench: ArrayLike | None = None, settle: float = 1.0,
+             engine: Engine = "auto",
              progress: Callable[[int, int], None] | None = None) -> ControlResult:
     """Simulate a controller driving the cable robot along a reference.
 
@@ -308,7 +313,7 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
                 model_errors: Sequence[ModelErrors], *, base_motion: BaseMotion | None = None,
                 control_rate: float = 1000.0, duration: float | None = None,
                 dynamics: DynamicsModel | None = None, substeps: int = 1,
-                settle: float = 1.0, engine: str = "auto",
+                settle: float = 1.0, engine: Engine = "auto",
                 progress: Callable[[int, int], None] | None = None) -> MonteCarloResult:
     """Run one simulation per entry of ``model_errors``, batched through one plant (the
     per-step work is vectorised over runs), keeping summary numbers per run.

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from .._outcome import check_status
-from ._tol import EVENT_TENSION_TOL
+from ._tol import EVENT_TENSION_TOL, SATURATION_REL
 from .cable_fk import rpy_from_matrices
 from .controllers import Controller
 from .monitors import ControlEvent, episodes, tipping_margins
@@ -210,7 +210,7 @@ def _events(times: np.ndarray, T: np.ndarray, tau: np.ndarray, speed: np.ndarray
           + episodes(times, T, T > robot.t_max + tol, "over_tension", names, robot.t_max, "max")
           + episodes(times, -tips, tips < -tol, "tipping", list(enames),
                      np.zeros(len(enames)), "max")
-          + episodes(times, np.abs(tau), np.abs(tau) >= lim_t * (1 - 1e-12),
+          + episodes(times, np.abs(tau), np.abs(tau) >= lim_t * (1 - SATURATION_REL),
                      "torque_saturation", names, lim_t, "max")
           + episodes(times, np.abs(speed), np.abs(speed) > lim_w, "speed_saturation", names,
                      lim_w, "max"))

@@ -13,6 +13,7 @@ import numpy as np
 from .._validate import as_array, as_positive
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ._bases import as_base_poses, moved_exits
+from ._tol import INTERP_TENSION_TOL
 from .controllers import ControlContext
 from .dynamics_model import DynamicsModel
 from .kinematics import gravity_wrench, rotation_matrices
@@ -144,8 +145,8 @@ def _tensions(robot: CableRobot, geo: RefGeometry, P: np.ndarray, w_ext: np.ndar
         for i in idx:
             r1 = distribute_tensions(_robot_at(robot, geo.base_poses[i]), P[i], "closed_form",
                                      external_wrench=w_ext[i], tipping=False)
-            t_s.append(r1.tensions[0])
-            o_s.append(bool(r1.success[0]))
+            t_s.append(r1.tensions)                   # one pose: (m,)
+            o_s.append(r1.success)
         ts, ok_s = np.array(t_s), np.array(o_s)
     t = np.column_stack([np.interp(np.arange(T), idx, ts[:, j]) for j in range(robot.m)])
     ok = np.interp(np.arange(T), idx, ok_s.astype(float)) > 0.999
@@ -157,7 +158,7 @@ def _exact_where_needed(robot: CableRobot, geo: RefGeometry, P: np.ndarray,
                         ) -> tuple[np.ndarray, np.ndarray]:
     """Recompute exactly (fixed bases) the steps whose interpolated, polished tensions are
     outside the limits."""
-    bad = np.any((t < robot.t_min - 1e-6) | (t > robot.t_max + 1e-6), axis=1) & ok
+    bad = np.any((t < robot.t_min - INTERP_TENSION_TOL) | (t > robot.t_max + INTERP_TENSION_TOL), axis=1) & ok
     if geo.moving or not bad.any():
         return t, ok & ~bad if geo.moving else ok
     res = distribute_tensions(robot, P[bad], "closed_form", external_wrench=w_ext[bad],
@@ -184,12 +185,12 @@ def _check_feasible(robot: CableRobot, geo: RefGeometry, times: np.ndarray, P: n
         r = robot if not geo.moving else _robot_at(robot, geo.base_poses[i])
         res = distribute_tensions(r, P[i], "lp_min_max", external_wrench=w_ext[i],
                                   tipping=False)
-        if not res.success[0]:
+        if not res.success:
             raise InfeasiblePoseError(
                 "reference", f"leaves the wrench-feasible workspace at t = {times[i]:.3f} s, "
                 f"pose {np.round(P[i], 4).tolist()}: no tensions in [t_min, t_max] balance "
                 "gravity and the reference accelerations")
-        t[i] = res.tensions[0]
+        t[i] = res.tensions
     return t
 
 

@@ -50,12 +50,12 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
     Parameters
     ----------
     robot : CableRobot
-    unit : (B, m, 3)
+    unit : (B, m, 3) or (m, 3)
         Cable unit vectors ``u_i`` (attachment to exit), e.g. ``cable_state(...).unit``.
 
     Returns
     -------
-    S : (B, F, m)
+    S : (B, F, m), or (F, m) for one pose's unit vectors (m, 3)
         One row per pyramid face of every mobile base with a friction coefficient (N per N
         of tension; F = 0 when no base has one).
     s : (F,)
@@ -70,8 +70,12 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
     >>> robot = with_friction(load_cdpr_model("fastkit"), 0.5)
     >>> S, s, base = sliding_rows(robot, cable_state(robot, [0, 0, 1.0]).unit)
     >>> S.shape, base.tolist() == [0] * 8 + [1] * 8
-    ((1, 16, 8), True)
+    ((16, 8), True)
     """
+    unit = np.asarray(unit, dtype=float)
+    if unit.ndim == 2:
+        S1, s1, base1 = sliding_rows(robot, unit[None])
+        return S1[0], s1, base1
     B, m, _ = unit.shape
     rows, rhs, owner = [], [], []
     g_z = float(robot.gravity[2])

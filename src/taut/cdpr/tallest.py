@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
 from ._common import renamed_keyword, wrench_vertices
+from ._tol import TALLEST_CERTIFICATE_TOL
 from .deploy import DeploymentResult, plan_deployment
 from .lift import LiftBound, lift_bound
 from .model import CableRobot
@@ -78,7 +79,7 @@ class TallestWorkspace:
 
 def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
                       external_wrench: ArrayLike | None = None,
-                      tol: float = 0.05, certificate_tol: float = 1e-3,
+                      tol: float = 0.05, certificate_tol: float = TALLEST_CERTIFICATE_TOL,
                       samples: Sequence[int] = (41, 5), warm_start: bool = True,
                       disturbance: ArrayLike | None = None,
                       **plan_options: Any) -> TallestWorkspace:

@@ -37,8 +37,9 @@ from scipy.optimize import linprog, minimize
 
 from .._outcome import deprecated_alias
 from ..errors import InvalidInputError
+from ._batching import is_single, unbatch
 from ._common import batch_outcome, constraints, feas_tol, required_wrench, svd_split
-from ._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_REL
+from ._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_FTOL, SLSQP_REL
 from .kinematics import as_poses, cable_state, tipping_matrix
 from .model import CableRobot
 
@@ -51,7 +52,8 @@ QPSolver = Literal["auto", "enumeration", "scipy"]
 
 @dataclass(frozen=True)
 class TensionResult:
-    """Tensions for a batch of poses.
+    """Tensions for a batch of poses; for one pose every leading B axis is dropped
+    (``tensions`` (m,), ``success`` a bool, ``status`` a str, ``residual`` a float).
 
     Attributes
     ----------
@@ -122,6 +124,8 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     Returns
     -------
     TensionResult
+        Arrays with a leading axis of B poses for a batch (``success`` (B,) bool); for
+        one pose ``(6,)`` or ``(3,)`` without it (``success`` a bool, ``tensions`` (m,)).
 
     Examples
     --------
@@ -132,12 +136,16 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     ([True, False], ['ok', 'infeasible'])
     >>> bool((robot.t_min <= res.tensions[0]).all()), bool(res.residual[0] < 1e-9)
     (True, True)
+    >>> one = distribute_tensions(robot, [0, 0, 0.6], "qp_min_norm")    # one pose
+    >>> one.success, one.status, one.tensions.shape
+    (True, 'ok', (8,))
     """
     if method not in METHODS:
         raise InvalidInputError("method", f"unknown method {method!r}; choose one of "
                                           + ", ".join(METHODS))
     if qp_solver not in ("auto", "enumeration", "scipy"):
         raise InvalidInputError("qp_solver", "must be auto, enumeration or scipy")
+    single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     w = required_wrench(robot, st, external_wrench)
@@ -179,10 +187,12 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     what = " and ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
     status, message = batch_outcome(feas, "infeasible", f"poses balanced within the {what} "
                                     "limits")
-    return TensionResult(tensions=t_out, success=feas, status=status, message=message,
-                         residual=np.where(found, res, np.nan),
-                         tipping_moments=np.where(found[:, None], tip_m, np.nan),
-                         method=method, tipping=use_tip, sliding=use_slide)
+    out = TensionResult(tensions=t_out, success=feas, status=status, message=message,
+                        residual=np.where(found, res, np.nan),
+                        tipping_moments=np.where(found[:, None], tip_m, np.nan),
+                        method=method, tipping=use_tip, sliding=use_slide)
+    return unbatch(out, ("tensions", "success", "status", "residual", "tipping_moments"),
+                   single)
 
 
 def _chunks(n: int, size: int) -> list[slice]:
@@ -321,7 +331,7 @@ def _qp_scipy(W: np.ndarray, w: np.ndarray, A: np.ndarray, b: np.ndarray,
                 {"type": "ineq", "fun": lambda t, k=k: b[k] - A[k] @ t,
                  "jac": lambda t, k=k: -A[k]}]
         sol = minimize(lambda t: 0.5 * t @ t, tm, jac=lambda t: t, constraints=cons,
-                       method="SLSQP", options={"ftol": 1e-12, "maxiter": 200})
+                       method="SLSQP", options={"ftol": SLSQP_FTOL, "maxiter": 200})
         if sol.success and np.all(A[k] @ sol.x <= b[k] + SLSQP_REL * float(np.max(robot.t_max))):
             out[k] = sol.x
     return out

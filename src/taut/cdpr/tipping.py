@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 
 from .._validate import as_array
 from ..errors import InvalidInputError
+from ._batching import is_single, unbatch
 from ._common import feas_tol
 from .kinematics import as_poses, cable_state, tipping_matrix
 from .model import CableRobot
@@ -31,7 +32,7 @@ __all__ = ["TippingResult", "tipping_moments"]
 
 @dataclass(frozen=True)
 class TippingResult:
-    """Edge moments at a batch of poses.
+    """Edge moments at a batch of poses (one pose: the leading B axis dropped).
 
     Attributes
     ----------
@@ -53,7 +54,30 @@ class TippingResult:
 
 def tipping_moments(robot: CableRobot, poses: ArrayLike, tensions: ArrayLike) -> TippingResult:
     """Moments of base weight and cable forces about every support-polygon edge of every
-    mobile base (FASTKIT eqs. 21-23) for poses (B, 6) (m, rad) and tensions (B, m) (N)."""
+    mobile base (FASTKIT eqs. 21-23).
+
+    Parameters
+    ----------
+    robot : CableRobot
+    poses : array_like (6,), (3,), (B, 6) or (B, 3)
+        Platform poses, m and rad.
+    tensions : array_like (m,) or (B, m)
+        Cable tensions, N (one row is used for every pose).
+
+    Returns
+    -------
+    TippingResult
+        ``moments`` (B, E), ``stable`` (B,) for a batch; (E,) and a bool for one pose.
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> tip = tipping_moments(robot, [0, 0, 0.6], robot.t_min)
+    >>> tip.moments.shape == (robot.n_edges,), tip.stable
+    (True, True)
+    """
+    single = is_single(poses)
     P = as_poses(robot, poses)
     t = as_array(tensions, "tensions")
     t = np.broadcast_to(t, (P.shape[0], robot.m)) if t.ndim == 1 else t
@@ -63,4 +87,5 @@ def tipping_moments(robot: CableRobot, poses: ArrayLike, tensions: ArrayLike) ->
     M = np.einsum("bji,bi->bj", tipping_matrix(robot, st.unit), t) + robot.edge_weight_moment
     stable = np.all(M <= feas_tol(robot), axis=1)
     worst = np.argmax(M, axis=1) if M.shape[1] else np.full(P.shape[0], -1)
-    return TippingResult(M, stable, worst, robot.edge_base.copy())
+    return unbatch(TippingResult(M, stable, worst, robot.edge_base.copy()),
+                   ("moments", "stable", "worst_edge"), single)

@@ -15,15 +15,17 @@ Twists are ``t = [v; w]`` (m/s, rad/s, world frame, at P).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
+from ._batching import is_single, unbatch
 from ._tol import RANK_TOL, ZERO_ROW
-from .first_order import (FirstOrderModel, base_jacobians, first_order_model,
+from .kinematics import as_poses
+from .first_order import (FOM_PER_POSE, FirstOrderModel, base_jacobians, first_order_model,
                           parallel_jacobian)
 from .model import CableRobot
 from .motion_modes import (BASE_JOINTS, MODES, TWIST_LABELS, Mode, ModeName, MotionLimits,
@@ -140,7 +142,8 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     Returns
     -------
     AvailableTwistSet
-        Task mode: ``{t : A t = B q_dot, q_lo <= q_dot <= q_hi}`` as ``H = H_Z A``,
+        One set for one pose (``H`` (S, n), ``contains`` a bool), a batch of B sets for
+        a batch of poses. Task mode: ``{t : A t = B q_dot, q_lo <= q_dot <= q_hi}`` as ``H = H_Z A``,
         ``h = h_Z`` with ``(H_Z, h_Z)`` the facets of the joint-space zonotope ``B box``.
         Navigation mode: ``{Ad_P J_d q_dot_d : q_dot_d in box}``.
 
@@ -148,16 +151,21 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     --------
     >>> from taut.io.cdpr_model import load_cdpr_model
     >>> ats = available_twist_set(load_cdpr_model("fastkit"), [0.3, 0, 1.0])
-    >>> ats.contains([1.0, 0, 0, 0, 0, 0]).tolist()       # the paper's 1 m/s
-    [True]
+    >>> ats.contains([1.0, 0, 0, 0, 0, 0])                # the paper's 1 m/s
+    True
     """
+    single = is_single(poses)
     limits = fastkit_motion_limits() if limits is None else limits
-    fom = first_order_model(robot, poses, mode, moving)
+    fom = first_order_model(robot, as_poses(robot, poses), mode, moving)
     lo, hi = joint_bounds(robot, limits, fom.mode)
     build = _task_set if fom.mode.kind == "task" else _navigation_set
     H, h, E, full = build(fom, lo, hi)
-    return AvailableTwistSet(H=H, h=h, E=E, poses=fom.poses, mode=fom.mode, full_rank=full,
-                             model=fom, limits=limits)
+    ats = AvailableTwistSet(H=H, h=h, E=E, poses=fom.poses, mode=fom.mode, full_rank=full,
+                            model=fom, limits=limits)
+    if single:
+        ats = replace(unbatch(ats, ("H", "h", "E", "poses", "full_rank"), True),
+                      model=unbatch(fom, FOM_PER_POSE, True))
+    return ats
 
 
 @dataclass(frozen=True)
@@ -166,7 +174,8 @@ class TwistCapacities:
 
     ``positive[b, k]`` is the largest ``s >= 0`` with ``s e_k`` in the ATS (the other five
     twist components zero), ``negative`` the same along ``-e_k``: m/s for ``vx, vy, vz``,
-    rad/s for ``wx, wy, wz``. ``feasible`` (B, n, 2) says whether ``s = 0`` itself is
+    rad/s for ``wx, wy, wz``; ``positive`` and ``negative`` are (B, n), or (n,) for one
+    pose. ``feasible`` (B, n, 2) (one pose: (n, 2)) says whether ``s = 0`` itself is
     available (False when the limits exclude standing still); ``inf`` marks an
     unbounded direction (A rank-deficient).
     """
@@ -188,15 +197,31 @@ def twist_capacities(robot: CableRobot, poses: ArrayLike, limits: MotionLimits |
     ``A (s e) = B q_dot`` (task mode) or ``s e = Ad_P J q_dot`` (navigation),
     ``q_lo <= q_dot <= q_hi``, with HiGHS, one LP per pose and direction (reference
     formulation over joint rates).
+
+    Returns
+    -------
+    TwistCapacities
+        Arrays with a leading axis of B poses for a batch, without it for one pose.
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> cap = twist_capacities(load_cdpr_model("fastkit"), [0.3, 0, 1.0])
+    >>> cap.positive.shape, bool(cap.positive[0] >= 1.0)   # vx: at least the paper's 1 m/s
+    ((6,), True)
     """
     if method not in ("hrep", "lp"):
         raise InvalidInputError("method", "must be 'hrep' or 'lp'")
+    single = is_single(poses)
     limits = fastkit_motion_limits() if limits is None else limits
+    P = as_poses(robot, poses)
     if method == "lp":
-        return _capacities_lp(robot, poses, limits, mode, moving)
-    ats = available_twist_set(robot, poses, limits, mode, moving)
-    pos, neg, reach = ats.axis_ray_lengths(None, tol=ZERO_ROW, zero=ZERO_ROW)
-    return TwistCapacities(pos, neg, reach, TWIST_LABELS[:ats.dim], ats.mode)
+        caps = _capacities_lp(robot, P, limits, mode, moving)
+    else:
+        ats = available_twist_set(robot, P, limits, mode, moving)
+        pos, neg, reach = ats.axis_ray_lengths(None, tol=ZERO_ROW, zero=ZERO_ROW)
+        caps = TwistCapacities(pos, neg, reach, TWIST_LABELS[:ats.dim], ats.mode)
+    return unbatch(caps, ("positive", "negative", "feasible"), single)
 
 
 def _capacities_lp(robot: CableRobot, poses: ArrayLike, limits: MotionLimits,

@@ -27,13 +27,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import product
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_count, require_instance
 from ..errors import InvalidInputError
+from ._batching import first, is_single, unbatch
 from ._common import (constraints, feas_tol, renamed_keyword, required_wrench, svd_split,
                       wrench_vertices)
 from ._farkas import certificates, combine, nonempty
@@ -81,10 +82,11 @@ class AvailableWrenchSet(HPolytopeBatch):
     gravity_wrench: np.ndarray
     sliding: bool = False
 
-    def contains(self, wrench: ArrayLike, tol: float = CONTAINS_TOL) -> np.ndarray:
-        """Whether cable wrenches ``wrench`` ((n,) or (B, n)) lie in the AWS -> (B,) bool."""
-        w = np.broadcast_to(as_array(wrench, "wrench"), self.H.shape[::2])
-        return super().contains(w, tol) & self.full_rank & self.nonempty
+    def contains(self, wrench: ArrayLike, tol: float = CONTAINS_TOL) -> Any:
+        """Whether cable wrenches ``wrench`` ((n,) or (B, n)) lie in the AWS -> (B,) bool
+        (a bool for the set at one pose)."""
+        ok = self._contains(wrench, tol) & np.atleast_1d(self.full_rank & self.nonempty)
+        return self._out(ok)
 
 
 def _prepare(robot: CableRobot, poses: Any, tipping: bool, sliding: bool = False
@@ -115,25 +117,29 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = Tr
     Returns
     -------
     AvailableWrenchSet
-        Set of cable wrenches ``W t`` (forces N, moments N m about P, world frame).
+        Set of cable wrenches ``W t`` (forces N, moments N m about P, world frame): one
+        set (``H`` (S, n), ``contains`` a bool) for one pose, B sets for B poses.
 
     Examples
     --------
     >>> from taut.io.cdpr_model import load_cdpr_model
     >>> robot = load_cdpr_model("fastkit")
     >>> aws = available_wrench_set(robot, [0, 0, 0.6])
-    >>> aws.contains(-aws.gravity_wrench).tolist()      # it can hold its own weight
-    [True]
+    >>> aws.contains(-aws.gravity_wrench)               # it can hold its own weight
+    True
     """
+    single = is_single(poses)
     P = as_poses(robot, poses)
     slide = bool(sliding and robot.has_sliding)
     parts = [_aws_block(robot, P[i:i + 256], tipping, slide)
              for i in range(0, P.shape[0], 256)]
     H, h, ok, nonempty_, wg = (np.concatenate(x) for x in zip(*parts))
-    return AvailableWrenchSet(H=H, h=h, E=np.zeros((P.shape[0], 0, robot.dof)), poses=P,
-                              full_rank=ok, nonempty=nonempty_,
-                              tipping=bool(tipping and robot.has_tipping), gravity_wrench=wg,
-                              sliding=slide)
+    aws = AvailableWrenchSet(H=H, h=h, E=np.zeros((P.shape[0], 0, robot.dof)), poses=P,
+                             full_rank=ok, nonempty=nonempty_,
+                             tipping=bool(tipping and robot.has_tipping), gravity_wrench=wg,
+                             sliding=slide)
+    return unbatch(aws, ("H", "h", "E", "poses", "full_rank", "nonempty", "gravity_wrench"),
+                   single)
 
 
 def _aws_block(robot: CableRobot, P: np.ndarray, tipping: bool, sliding: bool
@@ -191,7 +197,7 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
 
     Parameters
     ----------
-    poses : array_like (B, 6) or (B, 3), m and rad
+    poses : array_like (6,), (3,), (B, 6) or (B, 3), m and rad
     tipping : bool, default True
     external_wrench : array_like (V, n) or (n,), optional
         Extra external wrenches (vertices of a convex set, e.g.
@@ -207,16 +213,20 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
 
     Returns
     -------
-    ndarray (B,) of bool
+    ndarray (B,) of bool, or a bool for one pose
 
     Examples
     --------
     >>> from taut.io.cdpr_model import load_cdpr_model
-    >>> wrench_feasible(load_cdpr_model("fastkit"), [[0, 0, 0.6], [2, 0, 1.8]]).tolist()
+    >>> robot = load_cdpr_model("fastkit")
+    >>> wrench_feasible(robot, [[0, 0, 0.6], [2, 0, 1.8]]).tolist()
     [True, False]
+    >>> wrench_feasible(robot, [0, 0, 0.6])
+    True
     """
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
+    single = is_single(poses)
     P = as_poses(robot, poses)
     chunk = as_count(chunk, "chunk", minimum=1)
     D = wrench_vertices(robot, ext, field)
@@ -236,7 +246,7 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
             slack = b - np.einsum("bkm,bm->bk", A, tp)                    # (B, K)
             good &= nonempty(G, slack, VERTEX_SLACK * tol, cert)
         out[sl] = good
-    return out
+    return first(out) if single else out
 
 
 @dataclass(frozen=True)
@@ -246,10 +256,10 @@ class AxisCapacities:
 
     Attributes
     ----------
-    positive, negative : (B, n)
+    positive, negative : (B, n), or (n,) for one pose
         Magnitudes along ``+axis`` and ``-axis`` (N for forces, N m for moments); 0 where
         even no extra wrench can be held.
-    feasible : (B, n, 2) bool
+    feasible : (B, n, 2) bool, or (n, 2) for one pose
         Whether some non-negative magnitude is feasible along (+, -) of each axis.
     labels : tuple of str
     tipping : bool
@@ -263,7 +273,8 @@ class AxisCapacities:
 
 
 def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
-                    method: str = "hrep", *, sliding: bool = True) -> AxisCapacities:
+                    method: Literal["hrep", "lp"] = "hrep", *, sliding: bool = True
+                    ) -> AxisCapacities:
     """Axis capacities ``max s >= 0`` with ``W t + w_e + s e = 0`` (eq. 17) inside the tension
     limits (eq. 20) and, if ``tipping``, the tipping limits (eqs. 21-23), for ``e`` each of
     ``+-x, +-y, +-z`` forces and (6-DoF) moments about P.
@@ -276,22 +287,26 @@ def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
     --------
     >>> from taut.io.cdpr_model import load_cdpr_model
     >>> cap = axis_capacities(load_cdpr_model("fastkit"), [0, 0, 0.6])
-    >>> cap.positive.shape, bool(cap.positive[0, 2] > 0)
-    ((1, 6), True)
+    >>> cap.positive.shape, bool(cap.positive[2] > 0)      # one pose: (n,)
+    ((6,), True)
     """
     if method not in ("hrep", "lp"):
         raise InvalidInputError("method", "must be 'hrep' or 'lp'")
     n = require_instance(robot, CableRobot, "robot").dof
     labels = AXIS_LABELS[:n]
+    single = is_single(poses)
+    P = as_poses(robot, poses)
     if method == "lp":
-        return _axis_lp(robot, poses, tipping, labels, sliding)
-    aws = available_wrench_set(robot, poses, tipping, sliding=sliding)
-    pos, neg, reach = aws.axis_ray_lengths(-aws.gravity_wrench, tol=feas_tol(robot),
-                                           sign=-1.0, zero=ZERO_ROW)
-    ok = (aws.full_rank & aws.nonempty)[:, None]
-    reach &= ok[..., None]
-    return AxisCapacities(np.where(ok, pos, 0.0), np.where(ok, neg, 0.0), reach, labels,
-                          aws.tipping)
+        caps = _axis_lp(robot, P, tipping, labels, sliding)
+    else:
+        aws = available_wrench_set(robot, P, tipping, sliding=sliding)
+        pos, neg, reach = aws.axis_ray_lengths(-aws.gravity_wrench, tol=feas_tol(robot),
+                                               sign=-1.0, zero=ZERO_ROW)
+        ok = (aws.full_rank & aws.nonempty)[:, None]
+        reach &= ok[..., None]
+        caps = AxisCapacities(np.where(ok, pos, 0.0), np.where(ok, neg, 0.0), reach, labels,
+                              aws.tipping)
+    return unbatch(caps, ("positive", "negative", "feasible"), single)
 
 
 def _axis_lp(robot: CableRobot, poses: ArrayLike, tipping: bool,
@@ -322,7 +337,7 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
                     external_wrench: ArrayLike | None = None, tipping: bool = True, *,
                     sliding: bool = True, disturbance: ArrayLike | None = None
                     ) -> np.ndarray:
-    """Capacity margin of the required wrench set at poses, (B,).
+    """Capacity margin of the required wrench set at poses, (B,) (a float for one pose).
 
     The required set is platform and payload weight plus the extra external wrenches
     ``external_wrench`` (V, n) (vertices of a convex set, default none). The margin is
@@ -331,12 +346,23 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     positive; negative when some required wrench is not available. ``-inf`` at singular
     poses or when the AWS is empty. ``disturbance`` is the deprecated name of
     ``external_wrench``.
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> bool(capacity_margin(robot, [0, 0, 0.6]) > 0)           # one pose: a float
+    True
+    >>> (capacity_margin(robot, [[0, 0, 0.6], [2, 0, 1.8]]) > 0).tolist()
+    [True, False]
     """
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
-    aws = available_wrench_set(robot, poses, tipping, sliding=sliding)
+    single = is_single(poses)
+    aws = available_wrench_set(robot, as_poses(robot, poses), tipping, sliding=sliding)
     D = wrench_vertices(robot, ext, field)
     w = -(aws.gravity_wrench[:, None, :] + D[None, :, :])        # required cable wrenches
     hw = np.einsum("bsn,bvn->bsv", aws.H, w).max(axis=2)
     margin = np.min(aws.h - hw, axis=1)
-    return np.where(aws.full_rank & aws.nonempty, margin, -np.inf)
+    out = np.where(aws.full_rank & aws.nonempty, margin, -np.inf)
+    return first(out) if single else out

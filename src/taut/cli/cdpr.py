@@ -68,7 +68,7 @@ def _tensions(model: str, pose: Any, rpy: Any, method: Method, tipping: bool,
     res = distribute_tensions(robot, P, method.value, tipping=tipping)
     doc = tensions_to_dict(robot, P, res)
     code = 0 if doc["feasible"] else 1
-    t = res.tensions[0]
+    t = res.tensions
     names = [c.name for c in robot.cables]
     if as_json:
         typer.echo(to_json(doc))
@@ -82,10 +82,10 @@ def _tensions(model: str, pose: Any, rpy: Any, method: Method, tipping: bool,
     rows = [[n, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if lo - 1e-6 <= v <= hi + 1e-6 else "!"]
             for n, v, lo, hi in zip(names, t, robot.t_min, robot.t_max)]
     typer.echo(_table(["cable", "tension [N]", "min", "max", ""], rows))
-    typer.echo(f"feasible: {'yes' if res.success[0] else 'no'}   "
-               f"residual max|W t + w_e| = {res.residual[0]:.2e}")
+    typer.echo(f"feasible: {'yes' if res.success else 'no'}   "
+               f"residual max|W t + w_e| = {res.residual:.2e}")
     if robot.has_tipping:
-        M = res.tipping_moments[0]
+        M = res.tipping_moments
         for k, base in enumerate(robot.bases):
             sel = robot.edge_base == k
             if np.any(sel):
@@ -111,9 +111,9 @@ def _wrench_set(model: str, pose: Any, rpy: Any, disturbance: Any, stabilisers: 
         aws = available_wrench_set(robot, P, tipping=tip)
         modes["with_tipping" if tip else "tension_limits_only"] = {
             "capacities": axis_capacities(robot, P, tipping=tip),
-            "halfspaces": aws.facets(0),
-            "margin": float(capacity_margin(robot, P, D, tipping=tip)[0]),
-            "gravity_feasible": bool(aws.contains(-aws.gravity_wrench)[0])}
+            "halfspaces": aws.facets(),
+            "margin": float(capacity_margin(robot, P, D, tipping=tip)),
+            "gravity_feasible": bool(aws.contains(-aws.gravity_wrench))}
     out = wrench_set_to_dict(robot, P, modes)
     caps = {key: m["capacities"] for key, m in modes.items()}
     if plot is not None:
@@ -135,7 +135,7 @@ def _wrench_set(model: str, pose: Any, rpy: Any, disturbance: Any, stabilisers: 
     for lab_i, lab in enumerate(caps["tension_limits_only"].labels):
         row = [lab]
         for key in caps:
-            row += [f"{caps[key].positive[0, lab_i]:.2f}", f"{caps[key].negative[0, lab_i]:.2f}"]
+            row += [f"{caps[key].positive[lab_i]:.2f}", f"{caps[key].negative[lab_i]:.2f}"]
         rows.append(row)
     head = ["axis", "+ (cables)", "- (cables)"]
     if len(caps) == 2:

@@ -50,10 +50,10 @@ def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, bas
         caps = twist_capacities(robot, P, lim, mode, mv)
         fixed = twist_capacities(robot, P, lim, "task", ()) if mode == "task" else None
         ats = available_twist_set(robot, P, lim, mode, mv)
-    out = twist_set_to_dict(robot, P, mode, caps, fixed, int(np.isfinite(ats.h[0]).sum()))
-    series = {f"{mode}: {', '.join(caps.mode.names) or 'none'} moving": caps.positive[0]}
+    out = twist_set_to_dict(robot, P, mode, caps, fixed, int(np.isfinite(ats.h).sum()))
+    series = {f"{mode}: {', '.join(caps.mode.names) or 'none'} moving": caps.positive}
     if fixed is not None:
-        series["bases fixed"] = fixed.positive[0]
+        series["bases fixed"] = fixed.positive
     if plot is not None:
         from ..viz.cdpr_motion import plot_capacity_bars
         n = len(caps.labels)
@@ -68,9 +68,9 @@ def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, bas
                f"moving: {', '.join(caps.mode.names) or 'none'}; {out['facets']} facets)")
     typer.echo("axis   +max      -max" + ("    fixed +max" if fixed is not None else ""))
     for k, lab in enumerate(caps.labels):
-        row = f"{lab:4s} {caps.positive[0, k]:8.4f}  {caps.negative[0, k]:8.4f}"
+        row = f"{lab:4s} {caps.positive[k]:8.4f}  {caps.negative[k]:8.4f}"
         if fixed is not None:
-            row += f"  {fixed.positive[0, k]:10.4f}"
+            row += f"  {fixed.positive[k]:10.4f}"
         typer.echo(row)
 
 

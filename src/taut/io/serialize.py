@@ -183,14 +183,15 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
 # --- cable-driven parallel robots -----------------------------------------------------------
 
 def tensions_to_dict(robot: CableRobot, pose: np.ndarray, res: TensionResult) -> dict[str, Any]:
-    """One pose of a tension distribution (tensions keyed by cable name, N)."""
+    """One pose of a tension distribution (``res`` of one pose; tensions keyed by cable
+    name, N)."""
     names = [c.name for c in robot.cables]
-    M = res.tipping_moments[0]
+    M = res.tipping_moments
     return {
         "model": robot.name, "pose": _floats(pose), "method": res.method,
-        "tipping": res.tipping, "feasible": bool(_attr(res, "success", "feasible")[0]),
-        "residual": finite_or_none(res.residual[0]),
-        "tensions": {n: finite_or_none(v) for n, v in zip(names, res.tensions[0])},
+        "tipping": res.tipping, "feasible": bool(_attr(res, "success", "feasible")),
+        "residual": finite_or_none(res.residual),
+        "tensions": {n: finite_or_none(v) for n, v in zip(names, res.tensions)},
         "tipping_moments": None if not np.all(np.isfinite(M)) else [float(x) for x in M],
         "tipping_edge_base": [robot.bases[k].name for k in robot.edge_base],
     }
@@ -198,7 +199,7 @@ def tensions_to_dict(robot: CableRobot, pose: np.ndarray, res: TensionResult) ->
 
 def wrench_set_to_dict(robot: CableRobot, pose: np.ndarray,
                        modes: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """Axis capacities, margin and half-spaces per constraint set.
+    """Axis capacities (of one pose), margin and half-spaces per constraint set.
 
     ``modes`` maps ``"tension_limits_only"`` / ``"with_tipping"`` to the analyses' outputs
     ``{"capacities": AxisCapacities, "halfspaces": (H, h), "margin": float,
@@ -209,9 +210,9 @@ def wrench_set_to_dict(robot: CableRobot, pose: np.ndarray,
         H, h = m["halfspaces"]
         out[key] = {
             "capacity_positive": {lab: finite_or_none(v, 3)
-                                  for lab, v in zip(cap.labels, cap.positive[0])},
+                                  for lab, v in zip(cap.labels, cap.positive)},
             "capacity_negative": {lab: finite_or_none(v, 3)
-                                  for lab, v in zip(cap.labels, cap.negative[0])},
+                                  for lab, v in zip(cap.labels, cap.negative)},
             "capacity_margin": finite_or_none(m["margin"], 4),
             "gravity_feasible": bool(m["gravity_feasible"]),
             "halfspaces": {"H": np.round(H, 9).tolist(), "h": np.round(h, 9).tolist()},
@@ -235,16 +236,16 @@ def workspace_to_dict(robot: CableRobot, region: np.ndarray, ws: WorkspaceResult
 def twist_set_to_dict(robot: CableRobot, pose: np.ndarray, mode: str,
                       caps: TwistCapacities, fixed: TwistCapacities | None,
                       facets: int) -> dict[str, Any]:
-    """Available twist set capacities (m/s, rad/s) with the mode's bases moving and, in task
-    mode, with every base fixed."""
+    """Available twist set capacities (m/s, rad/s) of one pose with the mode's bases moving
+    and, in task mode, with every base fixed."""
     out: dict[str, Any] = {
         "model": robot.name, "pose": _floats(pose), "mode": mode,
         "moving": list(caps.mode.names), "labels": list(caps.labels),
-        "positive": [finite_or_none(v, 4) for v in caps.positive[0]],
-        "negative": [finite_or_none(v, 4) for v in caps.negative[0]]}
+        "positive": [finite_or_none(v, 4) for v in caps.positive],
+        "negative": [finite_or_none(v, 4) for v in caps.negative]}
     if fixed is not None:
-        out["bases_fixed"] = {"positive": [finite_or_none(v, 4) for v in fixed.positive[0]],
-                              "negative": [finite_or_none(v, 4) for v in fixed.negative[0]]}
+        out["bases_fixed"] = {"positive": [finite_or_none(v, 4) for v in fixed.positive],
+                              "negative": [finite_or_none(v, 4) for v in fixed.negative]}
     out["facets"] = int(facets)
     return out
 

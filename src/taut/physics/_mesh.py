@@ -96,7 +96,7 @@ def _unobstructed(nodes: np.ndarray, pairs: np.ndarray, spacing: float) -> np.nd
         t = np.einsum("pnk,pk->pn", rel, d[s:s + step]) / L2[s:s + step, None]
         foot = rel - t[..., None] * d[s:s + step, None, :]
         off = np.linalg.norm(foot, axis=2)
-        inside = (t > 1e-9) & (t < 1 - 1e-9)
+        inside = (t > _tol.SEGMENT_END) & (t < 1 - _tol.SEGMENT_END)
         keep[s:s + step] = ~np.any(inside & (off < _tol.ON_SEGMENT * spacing), axis=1)
     return keep
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _tol
+
 __all__ = ["point_triangle_distance", "surface_below", "clearance_lift"]
 
 
@@ -53,14 +55,15 @@ def surface_below(nodes: np.ndarray, triangles: np.ndarray, point: np.ndarray
     A, B, C = (nodes[triangles[:, k]] for k in range(3))
     e1, e2 = (B - A)[:, :2], (C - A)[:, :2]
     det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    ok = np.abs(det) > 1e-15
+    ok = np.abs(det) > _tol.FLAT_TRIANGLE
     rel = point[None, :2] - A[:, :2]
     with np.errstate(divide="ignore", invalid="ignore"):
         u = (rel[:, 0] * e2[:, 1] - rel[:, 1] * e2[:, 0]) / det
         v = (e1[:, 0] * rel[:, 1] - e1[:, 1] * rel[:, 0]) / det
-    hit = ok & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9)
+    eps = _tol.BARYCENTRIC_SLACK
+    hit = ok & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
     z = A[:, 2] + u * (B - A)[:, 2] + v * (C - A)[:, 2]
-    hit &= z <= point[2] + 1e-12
+    hit &= z <= point[2] + _tol.BELOW_SLACK
     if not np.any(hit):
         return None
     k = int(np.flatnonzero(hit)[np.argmax(z[hit])])
@@ -75,7 +78,7 @@ def clearance_lift(nodes: np.ndarray, triangles: np.ndarray, apex: np.ndarray,
 
     def clear(h: float) -> bool:
         return bool(np.min(point_triangle_distance(apex + [0.0, 0.0, h], A, B, C))
-                    >= radius * (1 - 1e-6))
+                    >= radius * (1 - _tol.CLEARANCE_REL))
 
     lo, hi = 0.0, radius
     while not clear(hi):

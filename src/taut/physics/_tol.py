@@ -82,3 +82,24 @@ SLIDE_DISTANCE = 0.005
 #: Damping time constant of the platform's free joint, s: slows the drift of a platform
 #: under constant tensions (unstable for most poses) while the bases are watched.
 PLATFORM_DAMPING_TIME = 0.05
+
+# --- formerly inline thresholds (issue 10: one home per core) ---------------------------
+#: |2D cross product| (scenario units squared, scaled mesh) below which a sheet triangle
+#: is degenerate in plan view and skipped by the vertical ray cast: far below any triangle
+#: of a mesh with SPACING-sized elements.
+FLAT_TRIANGLE = 1e-15
+#: Barycentric slack (dimensionless) of the vertical ray cast, so a point on a shared edge
+#: is inside both triangles rather than neither.
+BARYCENTRIC_SLACK = 1e-9
+#: Height slack (scenario units) of "the sheet point lies below the query point".
+BELOW_SLACK = 1e-12
+#: Relative slack on the ball radius in the clearance bisection (dimensionless): contact
+#: within 1e-6 of the radius counts as clear (rounding, not penetration).
+CLEARANCE_REL = 1e-6
+#: Segment parameter slack (dimensionless): nodes within 1e-9 of a segment's ends are its
+#: endpoints, not interior points.
+SEGMENT_END = 1e-9
+#: Floor on the platform mass (kg) and on its inertia diagonal (kg m^2) of the MuJoCo
+#: model: MuJoCo rejects a massless free body; 1e-6 is negligible next to FASTKIT's 12 kg.
+MIN_BODY_MASS = 1e-6
+MIN_BODY_INERTIA = 1e-6

@@ -137,13 +137,13 @@ def _build(robot: CableRobot, pose: np.ndarray, tensions: np.ndarray, friction: 
     R = rotation_matrices(pose[None, 3:])[0]
     plat = spec.worldbody.add_body(name="platform", pos=pose[:3].tolist(), quat=_quat(R))
     mp, mq = robot.platform.mass, robot.payload.mass
-    mass = max(mp + mq, 1e-6)
+    mass = max(mp + mq, _tol.MIN_BODY_MASS)
     com = (mp * robot.platform.com + mq * robot.payload.com) / mass
     inertia = np.array(robot.platform.inertia, dtype=float)
     for m_, c_ in ((mp, robot.platform.com), (mq, robot.payload.com)):
         d = c_ - com
         inertia = inertia + m_ * (d @ d * np.eye(3) - np.outer(d, d))
-    inertia = inertia + 1e-6 * np.eye(3)
+    inertia = inertia + _tol.MIN_BODY_INERTIA * np.eye(3)
     plat.mass = mass
     plat.ipos = com.tolist()
     plat.fullinertia = [inertia[0, 0], inertia[1, 1], inertia[2, 2],
@@ -216,7 +216,7 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
     >>> from taut.cdpr import distribute_tensions
     >>> robot = load_cdpr_model("fastkit")
     >>> pose = [-2.0, 0.0, 0.2, 0.0, 0.0, 0.0]
-    >>> t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions[0]
+    >>> t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions
     >>> r = check_tipping(robot, pose, t)
     >>> r.verdicts, r.taut_stays, bool(r.success)
     (('stays', 'stays'), True, True)
@@ -258,7 +258,12 @@ def check_tipping_grid(robot: CableRobot, poses: Any, *,
                        ) -> TippingGridCheck:
     """:func:`check_tipping` at every pose of a batch (e.g. a workspace grid from
     :func:`taut.cdpr.grid_points`), with tensions from
-    :func:`taut.cdpr.distribute_tensions` (``method``, ``tipping`` passed explicitly)."""
+    :func:`taut.cdpr.distribute_tensions` (``method``, ``tipping`` passed explicitly).
+
+    ``tipping`` defaults to False here, unlike every analysis of :mod:`taut.cdpr`: this
+    check asks whether taut's tipping verdict for tensions chosen *without* the tipping
+    constraints agrees with the simulated bases; tensions that already avoid tipping would
+    leave nothing to check."""
     P = as_poses(robot, poses)
     dist = distribute_tensions(robot, P, method, tipping=tipping)
     B, nb = P.shape[0], len(robot.bases)

@@ -27,3 +27,14 @@ __all__ = [
     "FKSolver",
     "IKCertificate", "Simulator", "SimulatorState",
 ]
+
+# Re-exports of every name the submodules' __all__ list (one public import path: taut.sheet).
+from .fk import Method  # noqa: E402
+from .model import check_hold_height  # noqa: E402
+from .random import random_convex_polygon, random_scattered_team, random_team  # noqa: E402
+from .results import Status  # noqa: E402
+from .simulate import EventKind  # noqa: E402
+from .solver import COMPILED_MAX_N, HAVE_NUMBA, Backend  # noqa: E402
+
+__all__ += ["Method", "check_hold_height", "random_convex_polygon", "random_scattered_team",
+            "random_team", "Status", "EventKind", "COMPILED_MAX_N", "HAVE_NUMBA", "Backend"]

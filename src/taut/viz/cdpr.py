@@ -105,7 +105,8 @@ def plot_axis_capacities(without: AxisCapacities, with_tipping: AxisCapacities |
                          pose_index: int = 0):
     """Bar chart of the largest force (N) and moment (N m) the platform can resist along
     and about each axis (the smaller of the + and - directions, as in FASTKIT Fig. 14),
-    tension limits only vs. with tipping. Returns the figure; saves it when ``path``."""
+    tension limits only vs. with tipping, for capacities of one pose (or pose
+    ``pose_index`` of a batch). Returns the figure; saves it when ``path``."""
     sets = [("tension limits", without)]
     if with_tipping is not None:
         sets.append(("with tipping", with_tipping))
@@ -118,7 +119,9 @@ def plot_axis_capacities(without: AxisCapacities, with_tipping: AxisCapacities |
         kl = list(ks)
         x = np.arange(len(kl))
         for s, (sname, cap) in enumerate(sets):
-            val = np.minimum(cap.positive[pose_index, kl], cap.negative[pose_index, kl])
+            pos, neg = ((cap.positive, cap.negative) if cap.positive.ndim == 1 else
+                        (cap.positive[pose_index], cap.negative[pose_index]))
+            val = np.minimum(pos[kl], neg[kl])
             ax.bar(x + (s - (len(sets) - 1) / 2) * width, val, width, label=sname)
         ax.set_xticks(x, [without.labels[k] for k in kl])
         ax.set_ylabel(gname)
