@@ -15,7 +15,7 @@ from taut.sheet._ik_branch import (BranchProof, _arc_min, _cut, branch_proof,
                                    verify_branch_proof)
 from taut.sheet._ik_certificate import (closure_lp_certificate, radial_certificate,
                                         verify_certificate)
-from taut.sheet.random import random_team
+from taut.sheet import random_team
 
 DATA = json.loads((Path(__file__).parents[1] / "data" / "ik_missed_targets.json").read_text())
 

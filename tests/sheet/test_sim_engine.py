@@ -17,8 +17,8 @@ from taut.io.trajectory import load_trajectory
 from taut.sheet import Sheet, Simulator, forward_kinematics
 from taut.sheet._branch import Tracker, solve_support_one, solve_taut_sets
 from taut.sheet._jit import HAVE_NUMBA
-from taut.sheet.random import random_team
-from taut.sheet.simulate import simulate
+from taut.sheet import random_team
+from taut.sheet import simulate
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples/sheet/trajectories"
 pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from taut.sheet import FKSolver, Sheet
 from taut.sheet._jit import HAVE_NUMBA
-from taut.sheet.random import random_team
+from taut.sheet import random_team
 
 pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
 

@@ -13,7 +13,8 @@ from .results import GRAVITY, BatchFKResult, Equilibrium, FKResult, Funnel
 from .simulate import SimulationEvent, SimulationResult, simulate
 from .solver import FKSolver
 from .ik import IKCertificate
-from .simulate import Simulator, SimulatorState
+from .simulate import SimulatorState
+from .simulator import Simulator
 
 __all__ = [
     "Sheet", "check_formation", "check_formations",

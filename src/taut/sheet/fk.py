@@ -40,6 +40,7 @@ from ._finalize import Classified, classify
 from ._kernel import (STATUS_NAMES, STATUS_NOT_EQUILIBRIUM, STATUS_STABLE, Frame, Solved,
                       height_ok, in_hull_2d, maximiser_masks, pad_groups, solve_candidates,
                       solve_table)
+from ._similar import similar_copy
 from ._tol import FAST_CHECK_RTOL, SNAP_MIN, SNAP_TOL
 from .exhaustive import exhaustive_search, funnel_from
 from .model import Sheet, check_formations, check_hold_height
@@ -153,24 +154,6 @@ def _solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
     return frame, c, counts
 
 
-def similar_copy(vertices: np.ndarray, formations: np.ndarray
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Closest similar copy ``s Q V + t`` of the sheet to each formation (Procrustes fit,
-    rotation only, no reflection; centroid kept).
-
-    Returns the copies (B, N, 2), their scale factors ``s`` (B,) and the largest robot
-    displacement to reach them (B,), in the formations' unit (inf where the best fit
-    needs a reflection)."""
-    A = vertices - vertices.mean(axis=0)
-    rc = formations.mean(axis=1, keepdims=True)
-    M = np.einsum("ni,bnj->bij", A, formations - rc)              # (B, 2, 2)
-    U, S, Wt = np.linalg.svd(M)
-    Q = np.swapaxes(U @ Wt, 1, 2)                                 # rotation: A -> formation
-    scale = S.sum(axis=1) / np.sum(A * A)
-    copies = scale[:, None, None] * (A @ np.swapaxes(Q, 1, 2)) + rc
-    dist = np.abs(copies - formations).max(axis=(1, 2))
-    dist[np.linalg.det(Q) < 0] = np.inf
-    return copies, scale, dist
 
 
 def _snap_near_similar(sheet: Sheet, R: np.ndarray, hold_height: float, method: str,

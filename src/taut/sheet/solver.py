@@ -29,7 +29,9 @@ from ._kernel import Frame, pad_groups
 from ._tol import (CURVATURE_TOL, GEOMETRY_RTOL, SCREEN_SLACK, SNAP_MIN, SNAP_TOL,
                    WEIGHT_TOL)
 from .fk import (Method, _check_mass, _check_method, _check_sheet,
-                 _forward_numpy, _forward_numpy_batch, similar_copy)
+                 _forward_numpy, _forward_numpy_batch)
+from ._batch_result import batch_result
+from ._similar import similar_copy
 from .model import Sheet, check_formation, check_formations, check_hold_height
 from .results import BatchFKResult, FKResult
 
@@ -332,7 +334,7 @@ class FKSolver:
             check_formations(self.sheet, Rb)        # raises with the step index
             return _forward_numpy_batch(self.sheet, Rb, self.hold_height, mass, self.method)
         rows, form = self._fix_batch(Rb, rows, form)
-        return _batch_result(self, Rb, rows, form, mass)
+        return batch_result(self, Rb, rows, form, mass)
 
     def _solve_batch_hull(self, Rb: np.ndarray, mass: float | None) -> BatchFKResult:
         """Batch of larger teams: one hull and one kernel call per formation."""
@@ -347,7 +349,7 @@ class FKSolver:
             forms.append(np.full(len(rows), b, dtype=np.int64))
         rows = np.vstack(parts) if parts else np.zeros((0, self._width))
         form = np.concatenate(forms) if forms else np.zeros(0, np.int64)
-        return _batch_result(self, Rb, rows, form, mass)
+        return batch_result(self, Rb, rows, form, mass)
 
     def _fix_batch(self, Rb: np.ndarray, rows: np.ndarray, form: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
@@ -401,37 +403,6 @@ def _formation_array(formation: ArrayLike, sheet: Sheet) -> np.ndarray:
     return np.ascontiguousarray(R)
 
 
-def _batch_result(solver: FKSolver, Rb: np.ndarray, rows: np.ndarray, form: np.ndarray,
-                  mass: float | None) -> BatchFKResult:
-    """Kernel rows of many formations as a padded :class:`BatchFKResult`."""
-    B, N = Rb.shape[:2]
-    count = np.bincount(form, minlength=B) if len(form) else np.zeros(B, dtype=np.intp)
-    K = int(count.max()) if B else 0
-    starts = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.intp)
-    slot = np.arange(len(form)) - starts[form]
-    valid = np.zeros((B, K), dtype=bool)
-    valid[form, slot] = True
-    taut = np.zeros((B, K, N), dtype=bool)
-    taut[form, slot] = rows[:, 8:8 + N] > 0.5
-    obj = np.full((B, K, 3), np.nan)
-    obj[form, slot] = rows[:, 2:5]
-    con = np.full((B, K, 2), np.nan)
-    con[form, slot] = rows[:, 5:7]
-    wts = np.zeros((B, K, N))
-    wts[form, slot] = rows[:, 8 + N:8 + 2 * N]
-    status = np.full((B, K), -1, dtype=np.int8)
-    status[form, slot] = rows[:, 0].astype(np.int8)
-    ten = None
-    if mass is not None:
-        from .results import GRAVITY
-        lengths_n = rows[:, 8 + 2 * N:8 + 3 * N] / solver.sheet.size
-        t = rows[:, 8 + N:8 + 2 * N] * (mass * GRAVITY) * lengths_n / rows[:, 7:8]
-        held = taut[form, slot] & (rows[:, :1] != sk.NOT_EQUILIBRIUM)
-        t = np.where(held, t, np.where(taut[form, slot], np.nan, 0.0))
-        ten = np.zeros((B, K, N))
-        ten[form, slot] = t
-    return BatchFKResult(count, valid, taut, obj, con, wts, ten, status, solver.sheet, Rb,
-                         solver.hold_height, mass, solver.method)
 
 
 # -- cached solvers for the functional front end ------------------------------------------
