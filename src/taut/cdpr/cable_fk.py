@@ -27,6 +27,7 @@ from ._bases import as_base_poses, moved_exits
 from ._tol import FK_MAX_ITER, FK_POLISH_TOL, FK_RESIDUAL_TOL, FK_SAME_SOLUTION
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
+from .._validate import as_count, require_instance
 
 __all__ = ["CableFKResult", "cable_forward_kinematics"]
 
@@ -181,6 +182,9 @@ def cable_forward_kinematics(robot: CableRobot, lengths: Any, *, base_poses: Any
     >>> bool(fk.success[0]), bool(np.allclose(fk.poses[0], pose, atol=1e-9))
     (True, True)
     """
+    require_instance(robot, CableRobot, "robot")
+    as_count(restarts, "restarts", maximum=1000)
+    as_count(seed, "seed")
     lengths_arr = as_array(lengths, "lengths")
     if lengths_arr.ndim == 1:
         lengths_arr = lengths_arr[None]

@@ -18,6 +18,7 @@ from ._common import svd_split
 from ._tol import CLOSURE_TOL
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
+from .._validate import as_tolerance
 
 __all__ = ["wrench_closure"]
 
@@ -44,6 +45,7 @@ def wrench_closure(robot: CableRobot, poses: ArrayLike, *,
     >>> wrench_closure(load_cdpr_model("fastkit"), [0, 0, 1.2]).tolist()   # suspended
     [False]
     """
+    closure_tol = as_tolerance(closure_tol, "closure_tol")
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     _, _, full = svd_split(st.W)

@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 from ._tol import BOX_REL
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
+from .._validate import as_tolerance, require_instance
 
 __all__ = ["segment_distance", "Interference", "cable_interference"]
 
@@ -119,6 +120,9 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     >>> res.cable_cable.tolist(), res.free.tolist()    # level: crossing pairs meet
     ([True, False], [False, True])
     """
+    require_instance(robot, CableRobot, "robot")
+    as_tolerance(min_distance, "min_distance")
+    as_tolerance(box_tol, "box_tol")
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     att = P[:, None, :3] + st.r                                  # (B, m, 3)

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import as_array, require_instance
+from .._validate import MAX_CDPR_LENGTH_M, check_range
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ._tol import BOX_REL, ZERO_LENGTH_REL
 from .model import CableRobot
@@ -31,7 +32,7 @@ def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
     :class:`InfeasiblePoseError` when a position lies outside ``robot.bounds``.
     """
     require_instance(robot, CableRobot, "robot")
-    arr = as_array(poses, field)
+    arr = check_range(poses, field, MAX_CDPR_LENGTH_M, "m or rad")
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] not in (3, 6):
@@ -57,6 +58,7 @@ def as_poses(robot: CableRobot, poses: Any, field: str = "pose",
 
 def rotation_matrices(rpy: np.ndarray) -> np.ndarray:
     """``Rz(yaw) Ry(pitch) Rx(roll)`` for ``rpy`` of shape (B, 3) (rad) -> (B, 3, 3)."""
+    rpy = as_array(rpy, "rpy", shape=(None, 3))
     cr, cp, cy = np.cos(rpy.T)
     sr, sp, sy = np.sin(rpy.T)
     R = np.empty((rpy.shape[0], 3, 3))
@@ -150,6 +152,8 @@ def gravity_wrench(robot: CableRobot, R: np.ndarray) -> np.ndarray:
     ``w_e = [f_e; m_e]`` with ``f_e = (m_p + m_l) g`` (N) and ``m_e`` the moment of both
     weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3).
     """
+    require_instance(robot, CableRobot, "robot")
+    R = as_array(R, "R", shape=(None, 3, 3))
     g = robot.gravity
     f = np.broadcast_to(robot.total_mass * g, (R.shape[0], 3))
     if robot.dof == 3:
@@ -166,4 +170,6 @@ def tipping_matrix(robot: CableRobot, unit: np.ndarray) -> np.ndarray:
     ``T[j, i] = u_Cj . ((c_j - b_i) x u_i)`` for a cable ``i`` leaving the base of edge
     ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``.
     """
+    require_instance(robot, CableRobot, "robot")
+    unit = as_array(unit, "unit", shape=(None, robot.m, 3))
     return np.einsum("jik,bik->bji", robot._tip_V, unit)

@@ -34,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from .model import CableRobot
+from .._validate import as_array, require_instance
 
 __all__ = ["sliding_rows"]
 
@@ -72,6 +73,8 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
     >>> S.shape, base.tolist() == [0] * 8 + [1] * 8
     ((1, 16, 8), True)
     """
+    require_instance(robot, CableRobot, "robot")
+    unit = as_array(unit, "unit", shape=(None, robot.m, 3))
     B, m, _ = unit.shape
     rows, rhs, owner = [], [], []
     g_z = float(robot.gravity[2])
