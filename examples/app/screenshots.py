@@ -85,4 +85,7 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from taut.cli._progress import working  # progress on stderr past 2 s
+    with working("screenshots"):
+        code = main()
+    sys.exit(code)

@@ -41,4 +41,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from taut.cli._progress import working  # progress on stderr past 2 s
+    with working("caspr_workspace"):
+        main()

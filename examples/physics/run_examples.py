@@ -61,8 +61,10 @@ def tipping_table() -> None:
 
 
 if __name__ == "__main__":
-    np.set_printoptions(precision=2)
-    sheet_table("FK paper Example 1 (4 robots)", SHEET / "example1.yaml", "example1_settled.png")
-    sheet_table("FK paper Example 2 (8 robots, r2 and r4 at +-353 mm)",
-                SHEET / "example2_r2_r4_353mm.yaml", "example2_settled.png")
-    tipping_table()
+    from taut.cli._progress import working  # progress on stderr past 2 s
+    with working("physics examples"):
+        np.set_printoptions(precision=2)
+        sheet_table("FK paper Example 1 (4 robots)", SHEET / "example1.yaml", "example1_settled.png")
+        sheet_table("FK paper Example 2 (8 robots, r2 and r4 at +-353 mm)",
+                    SHEET / "example2_r2_r4_353mm.yaml", "example2_settled.png")
+        tipping_table()

@@ -11,7 +11,7 @@ from .errors import InvalidInputError
 
 __all__ = ["as_array", "as_points", "as_positive", "as_finite_scalar", "as_nonnegative",
            "check_range", "as_mass", "as_count", "as_box", "require_instance",
-           "require_nonempty", "LIMITS"]
+           "require_nonempty", "LIMITS", "require_instances", "as_tolerance", "as_path", "as_choice"]
 
 
 def as_array(value: Any, field: str, *, ndim: int | None = None,
@@ -20,6 +20,9 @@ def as_array(value: Any, field: str, *, ndim: int | None = None,
 
     ``shape`` entries that are ``None`` accept any length on that axis.
     """
+    if value is None:            # np.array(None, float) is NaN: say what is missing instead
+        raise InvalidInputError(field, "must be a number or an array of numbers, got null "
+                                       "(None)")
     try:
         arr = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -53,6 +56,8 @@ def as_finite_scalar(value: Any, field: str) -> float:
     """A finite Python float."""
     if isinstance(value, bool):
         raise InvalidInputError(field, "must be a number, got a boolean")
+    if value is None:
+        raise InvalidInputError(field, "must be a number, got null (None)")
     arr = as_array(value, field)
     if arr.ndim != 0:
         raise InvalidInputError(field, "must be a single number")
@@ -219,13 +224,52 @@ def as_box(value: Any, field: str, *, limit: float = MAX_CDPR_LENGTH_M, unit: st
     return b
 
 
-def require_instance(value: Any, cls: type, field: str) -> Any:
-    """``value`` if it is an instance of ``cls``, else an error naming the expected type
-    (so ``None`` in place of a model is a typed error, not an ``AttributeError``)."""
-    if not isinstance(value, cls):
-        raise InvalidInputError(field, f"must be a {cls.__module__.replace('._', '.')}"
-                                       f".{cls.__name__}, got {type(value).__name__}")
+def _type_name(cls: type) -> str:
+    """``taut.cdpr.model.CableRobot`` -> ``taut.cdpr.model.CableRobot`` (private modules'
+    leading underscores dropped), builtins by their bare name."""
+    if cls.__module__ == "builtins":
+        return cls.__name__
+    return f"{cls.__module__.replace('._', '.')}.{cls.__name__}"
+
+
+def require_instance(value: Any, cls: type | tuple[type, ...], field: str) -> Any:
+    """``value`` if it is an instance of ``cls`` (a type or a tuple of types), else an error
+    naming the expected type (so ``None`` in place of a model is a typed error, not an
+    ``AttributeError``).
+
+    Examples
+    --------
+    >>> require_instance(None, int, "robot")
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: robot: must be a int, got NoneType
+    """
+    classes = cls if isinstance(cls, tuple) else (cls,)
+    if not isinstance(value, classes) or (isinstance(value, bool) and bool not in classes
+                                          and int in classes):
+        want = " or ".join(_type_name(c) for c in classes)
+        raise InvalidInputError(field, f"must be a {want}, got {type(value).__name__}")
     return value
+
+
+def require_instances(values: Any, cls: type, field: str, *, min_count: int = 0) -> tuple:
+    """``values`` as a tuple whose every item is a ``cls`` (at least ``min_count``), else an
+    error naming the item (``bases[1]: must be a ...Base, got str``)."""
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise InvalidInputError(field, f"must be a sequence of {_type_name(cls)}, got "
+                                       f"{type(values).__name__}")
+    items = tuple(values)
+    for k, v in enumerate(items):
+        require_instance(v, cls, f"{field}[{k}]")
+    if len(items) < min_count:
+        raise InvalidInputError(field, f"needs at least {min_count} item(s), got {len(items)}")
+    return items
+
+
+def as_tolerance(value: Any, field: str) -> float:
+    """A tolerance or margin: a finite float in ``[0, 1e6]`` (any unit; larger is no longer a
+    tolerance and would make every comparison true)."""
+    return as_bounded(value, field, 1e6, "units", positive=False)
 
 
 def require_nonempty(arr: np.ndarray, field: str) -> np.ndarray:
@@ -233,3 +277,43 @@ def require_nonempty(arr: np.ndarray, field: str) -> np.ndarray:
     if arr.size == 0:
         raise InvalidInputError(field, f"is empty (shape {'x'.join(map(str, arr.shape))})")
     return arr
+
+
+def as_path(value: Any, field: str = "path") -> Any:
+    """``value`` as a :class:`pathlib.Path` if it is a non-empty ``str`` or path-like, else
+    an error (``None`` or a number in place of a file name).
+
+    Examples
+    --------
+    >>> as_path(None)
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: path: must be a file name (str or path), got NoneType
+    """
+    import os
+    from pathlib import Path
+    if isinstance(value, bool) or not isinstance(value, (str, os.PathLike)):
+        raise InvalidInputError(field, f"must be a file name (str or path), got "
+                                       f"{type(value).__name__}")
+    if str(value) == "":
+        raise InvalidInputError(field, "is empty")
+    return Path(value)
+
+
+def as_choice(value: Any, choices: Any, field: str) -> str:
+    """``value`` if it is one of the strings ``choices``, else an error listing them (a
+    non-string, e.g. an array, is an error rather than an ambiguous comparison).
+
+    Examples
+    --------
+    >>> as_choice("task", ("task", "navigation"), "mode")
+    'task'
+    >>> as_choice(3, ("task", "navigation"), "mode")
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: mode: unknown mode 3; choose one of task, navigation
+    """
+    if not isinstance(value, str) or value not in tuple(choices):
+        raise InvalidInputError(field, f"unknown {field} {value!r}; choose one of "
+                                       + ", ".join(map(str, choices)))
+    return value

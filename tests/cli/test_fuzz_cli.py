@@ -233,6 +233,10 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("physics", ["physics", sheet, "--plot", o]) for o in outs]
     cases += [("physics", ["physics", sheet, "--video", o]) for o in outs + [str(tmp / "a.png")]]
     cases += [("physics", ["physics", sheet, "--mesh", v]) for v in BAD_COUNTS + ["2", "61"]]
+    # app: every check (file, port, host) comes before the server starts
+    cases += [("app", ["app", f]) for f in files]
+    cases += [("app", ["app", "--port", v]) for v in ("-1", "65536", "x", "1e308", "nan", "")]
+    cases += [("app", ["app", "--host", "999.1.1.1"])]
     cases += [("taut", [w]) for w in ("nosuch", "--nosuch", "cdpr nosuch")]
     return cases
 

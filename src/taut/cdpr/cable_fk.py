@@ -29,6 +29,7 @@ from ._tol import (FK_DAMPING_MAX, FK_DAMPING_MIN, FK_DAMPING_START, FK_MAX_ITER
 from ._batching import unbatch
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
+from .._validate import as_count, require_instance
 
 __all__ = ["CableFKResult", "cable_forward_kinematics"]
 
@@ -187,6 +188,9 @@ def cable_forward_kinematics(robot: CableRobot, lengths: ArrayLike, *,
     >>> fk.success, bool(np.allclose(fk.poses, pose, atol=1e-9))
     (True, True)
     """
+    require_instance(robot, CableRobot, "robot")
+    as_count(restarts, "restarts", maximum=1000)
+    as_count(seed, "seed")
     lengths_arr = as_array(lengths, "lengths")
     single = lengths_arr.ndim == 1
     if single:

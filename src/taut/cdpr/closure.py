@@ -19,6 +19,7 @@ from ._batching import first, is_single
 from ._tol import CLOSURE_TOL
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
+from .._validate import as_tolerance
 
 __all__ = ["wrench_closure"]
 
@@ -45,6 +46,7 @@ def wrench_closure(robot: CableRobot, poses: ArrayLike, *,
     >>> wrench_closure(load_cdpr_model("fastkit"), [0, 0, 1.2])   # suspended
     False
     """
+    closure_tol = as_tolerance(closure_tol, "closure_tol")
     single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)

@@ -45,6 +45,7 @@ from .placement import footprint_overlap, place_bases, workspace_box
 from .twist import available_twist_set
 from .workspace import grid_points
 from .wrench_set import capacity_margin, wrench_feasible
+from .._validate import require_instance
 
 __all__ = ["DeploymentOptions", "DeploymentResult", "plan_deployment", "evaluate_deployment"]
 
@@ -177,6 +178,8 @@ def evaluate_deployment(robot: CableRobot, points: np.ndarray,
     ``twists`` (T, n) or None: required twists, the worst ATS margin over points and
     twists is returned (None without twists). Raises :class:`TautError` (e.g. a sample
     point outside the frame box)."""
+    require_instance(robot, CableRobot, "robot")
+    points = as_array(points, "points", shape=(None, 3))
     pm = capacity_margin(robot, points, external_wrench=external_wrench, tipping=True)
     tm = None
     if twists is not None:
@@ -302,6 +305,7 @@ def plan_deployment(robot: CableRobot, workspace: ArrayLike, *,
         ``success=False``, ``status="refuted"``, the certificate's sentence as ``message``
         and empty verification arrays.
     """
+    require_instance(robot, CableRobot, "robot")
     box = workspace_box(workspace)
     mobile = [b for b in robot.bases if b.mobile]
     if not mobile:

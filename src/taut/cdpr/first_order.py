@@ -41,6 +41,7 @@ from ._batching import is_single, unbatch
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
 from .motion_modes import BASE_JOINTS, Mode, ModeName, resolve_mode
+from .._validate import as_array, require_instance
 
 __all__ = ["FirstOrderModel", "first_order_model", "parallel_jacobian", "base_jacobians"]
 
@@ -68,6 +69,8 @@ def base_jacobians(robot: CableRobot, positions: np.ndarray) -> np.ndarray:
     ndarray (B, K, 6, 3)
         Rows ``[v; w]``, columns ``(theta_dot, rho1_dot, rho2_dot)``.
     """
+    require_instance(robot, CableRobot, "robot")
+    positions = as_array(positions, "positions", shape=(None, 3))
     K = len(robot.bases)
     out = np.zeros((positions.shape[0], K, 6, 3))
     for k, base in enumerate(robot.bases):
@@ -86,6 +89,7 @@ def parallel_jacobian(robot: CableRobot, poses: ArrayLike) -> np.ndarray:
     """Parallel Jacobian ``A`` (B, m, n) with ``l_dot = A t`` for fixed bases (eqs. 1-3);
     n = 6 (``t = [v; w]``, m/s and rad/s) or 3 for a point-mass platform. One pose gives
     (m, n)."""
+    require_instance(robot, CableRobot, "robot")
     return np.swapaxes(-cable_state(robot, poses).W, -1, -2)
 
 

@@ -24,6 +24,7 @@ from ._batching import is_single, unbatch
 from ._tol import BOX_REL, SEGMENT_PARALLEL, TINY
 from .kinematics import as_poses, cable_state
 from .model import CableRobot
+from .._validate import as_tolerance, require_instance
 
 __all__ = ["segment_distance", "Interference", "cable_interference"]
 
@@ -120,6 +121,9 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     >>> res.cable_cable.tolist(), res.free.tolist()    # level: crossing pairs meet
     ([True, False], [False, True])
     """
+    require_instance(robot, CableRobot, "robot")
+    as_tolerance(min_distance, "min_distance")
+    as_tolerance(box_tol, "box_tol")
     single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._validate import as_array, require_instance
+from .._validate import MAX_CDPR_LENGTH_M, check_range
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ._batching import is_single, unbatch
 from ._tol import BOX_REL, ZERO_LENGTH_REL
@@ -33,7 +34,7 @@ def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose",
     :class:`InfeasiblePoseError` when a position lies outside ``robot.bounds``.
     """
     require_instance(robot, CableRobot, "robot")
-    arr = as_array(poses, field)
+    arr = check_range(poses, field, MAX_CDPR_LENGTH_M, "m or rad")
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] not in (3, 6):
@@ -59,7 +60,7 @@ def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose",
 
 def rotation_matrices(rpy: ArrayLike) -> np.ndarray:
     """``Rz(yaw) Ry(pitch) Rx(roll)`` for ``rpy`` of shape (B, 3) (rad) -> (B, 3, 3)."""
-    rpy = np.asarray(rpy, dtype=float)
+    rpy = as_array(rpy, "rpy", shape=(None, 3))
     cr, cp, cy = np.cos(rpy.T)
     sr, sp, sy = np.sin(rpy.T)
     R = np.empty((rpy.shape[0], 3, 3))
@@ -173,9 +174,11 @@ def gravity_wrench(robot: CableRobot, R: ArrayLike) -> np.ndarray:
     weights about the platform reference point P (N m), for rotations ``R`` (B, 3, 3);
     one rotation (3, 3) gives one wrench (n,).
     """
-    R = np.asarray(R, dtype=float)
+    require_instance(robot, CableRobot, "robot")
+    R = as_array(R, "R")
     if R.ndim == 2:
         return gravity_wrench(robot, R[None])[0]
+    R = as_array(R, "R", shape=(None, 3, 3))
     g = robot.gravity
     f = np.broadcast_to(robot.total_mass * g, (R.shape[0], 3))
     if robot.dof == 3:
@@ -193,7 +196,9 @@ def tipping_matrix(robot: CableRobot, unit: ArrayLike) -> np.ndarray:
     ``j`` at exit point ``b_i``; the base is stable when every ``m_C <= 0``. One pose's
     unit vectors (m, 3) give (E, m).
     """
-    unit = np.asarray(unit, dtype=float)
+    require_instance(robot, CableRobot, "robot")
+    unit = as_array(unit, "unit")
     if unit.ndim == 2:
         return tipping_matrix(robot, unit[None])[0]
+    unit = as_array(unit, "unit", shape=(None, robot.m, 3))
     return np.einsum("jik,bik->bji", robot._tip_V, unit)

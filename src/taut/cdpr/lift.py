@@ -20,6 +20,8 @@ from ._tol import LIFT_FTOL, LIFT_GTOL, LIFT_RTOL, REFUTE_REL
 from .model import CableRobot
 from .placement import workspace_box
 from .workspace import grid_points
+from .._validate import as_tolerance, require_instance
+from .._validate import require_instance
 
 __all__ = ["LiftBound", "lift_bound", "upward_force_bound"]
 
@@ -48,6 +50,7 @@ def upward_force_bound(robot: CableRobot, points: ArrayLike) -> np.ndarray:
     points : (B, 3) or (3,)
         Platform positions (orientation zero), m. Not checked against the frame box.
     """
+    require_instance(robot, CableRobot, "robot")
     P = as_array(points, "points")
     single = P.ndim == 1
     P = P[None, :] if single else P
@@ -307,6 +310,8 @@ def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
     tipping, the averaging and the free exits all leave the bound above the true capacity,
     so a bound above the required force proves nothing.
     """
+    require_instance(robot, CableRobot, "robot")
+    as_tolerance(refute_tol, "refute_tol")
     box = workspace_box(workspace, allow_flat=True)
     sm = np.asarray(samples, dtype=float)
     if sm.shape != (2,) or np.any(sm < 1) or np.any(sm != np.round(sm)):

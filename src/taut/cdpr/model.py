@@ -23,6 +23,7 @@ from .._validate import MAX_TENSION_N, as_array, as_finite_scalar, check_range
 from ..errors import InvalidModelError
 from .footprint import check_footprint
 from .parts import Base, Cable, Payload, Platform
+from .._validate import require_instance, require_instances
 
 __all__ = ["Base", "Platform", "Payload", "Cable", "CableRobot", "check_footprint",
            "with_stabilisers", "with_friction"]
@@ -94,8 +95,10 @@ class CableRobot:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "bases", tuple(self.bases))
-        s(self, "cables", tuple(self.cables))
+        s(self, "bases", require_instances(self.bases, Base, "bases"))
+        s(self, "cables", require_instances(self.cables, Cable, "cables"))
+        require_instance(self.platform, Platform, "platform")
+        require_instance(self.payload, Payload, "payload")
         if not self.bases:
             raise InvalidModelError("bases", "at least one base is required")
         names = [b.name for b in self.bases]
@@ -255,6 +258,7 @@ def with_friction(robot: CableRobot, friction: float | None,
     >>> [b.friction for b in with_friction(load_cdpr_model("fastkit"), 0.3).bases]
     [0.3, 0.3]
     """
+    require_instance(robot, CableRobot, "robot")
     from dataclasses import replace
     bases = tuple(replace(b, exit_points=dict(b.exit_points), friction=friction,
                           friction_sides=b.friction_sides if sides is None else sides)
@@ -266,6 +270,7 @@ def with_stabilisers(robot: CableRobot, deployed: bool = True) -> CableRobot:
     """The same robot with the stabilisers of every mobile base that has them deployed
     (or retracted). Deployed stabilisers replace the support polygon by the convex hull of
     wheels and stabiliser feet, so tipping limits can only get looser."""
+    require_instance(robot, CableRobot, "robot")
     from dataclasses import replace
     bases = tuple(replace(b, exit_points=dict(b.exit_points),
                           stabilisers_deployed=bool(deployed and b.stabilisers is not None))

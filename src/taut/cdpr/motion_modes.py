@@ -20,6 +20,7 @@ import numpy as np
 from .._validate import as_array
 from ..errors import InvalidInputError
 from .model import CableRobot
+from .._validate import as_choice, require_instance, require_instances
 
 __all__ = ["MotionLimits", "fastkit_motion_limits", "MODES", "ModeName", "Mode",
            "resolve_mode", "TWIST_LABELS", "BASE_JOINTS", "joint_bounds"]
@@ -125,9 +126,10 @@ def resolve_mode(robot: CableRobot, mode: ModeName = "task",
         Unknown mode, a base name the model lacks, a fixed (non-mobile) base asked to move,
         or no mobile base to drive in navigation mode.
     """
-    if mode not in MODES:
-        raise InvalidInputError("mode", f"unknown mode {mode!r}; choose one of "
-                                        + ", ".join(MODES))
+    require_instance(robot, CableRobot, "robot")
+    as_choice(mode, MODES, "mode")
+    if moving is not None and not isinstance(moving, str):
+        require_instances(moving, str, "moving")
     names = [b.name for b in robot.bases]
     mobile = [b.name for b in robot.bases if b.mobile]
     if moving is None:
@@ -154,6 +156,9 @@ def resolve_mode(robot: CableRobot, mode: ModeName = "task",
 def joint_bounds(robot: CableRobot, limits: MotionLimits, md: Mode
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper joint-rate bounds in the column order of ``FirstOrderModel.B``."""
+    require_instance(robot, CableRobot, "robot")
+    require_instance(limits, MotionLimits, "limits")
+    require_instance(md, Mode, "md")
     lo = [limits.base_min] * len(md.moving)
     hi = [limits.base_max] * len(md.moving)
     if md.kind == "task":

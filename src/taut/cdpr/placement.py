@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 from .._validate import as_array
 from ..errors import InvalidInputError
 from .model import CableRobot
+from .._validate import require_instance
 
 __all__ = ["workspace_box", "place_bases", "footprint_overlap"]
 
@@ -45,6 +46,7 @@ def place_bases(robot: CableRobot, poses: Mapping[str, Any] | Any) -> CableRobot
 
     ``poses`` maps base names to poses, or is a (k, 3) array in the order of the mobile
     bases. The frame box (``bounds``) is recomputed from the moved exit points."""
+    require_instance(robot, CableRobot, "robot")
     mobile = [b.name for b in robot.bases if b.mobile]
     if isinstance(poses, Mapping):
         new = {str(k): as_array(v, f"poses[{k}]", shape=(3,)) for k, v in poses.items()}
@@ -69,6 +71,8 @@ def footprint_overlap(robot: CableRobot, box: np.ndarray) -> float:
     >>> footprint_overlap(load_cdpr_model("fastkit"), np.array([[-1.0, -1, 0], [1, 1, 1]]))
     0.0
     """
+    require_instance(robot, CableRobot, "robot")
+    box = as_array(box, "box", shape=(2, None))
     rect = np.array([[box[0, 0], box[0, 1]], [box[1, 0], box[0, 1]],
                      [box[1, 0], box[1, 1]], [box[0, 0], box[1, 1]]])
     worst = 0.0

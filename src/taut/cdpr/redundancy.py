@@ -34,6 +34,7 @@ from ._tol import LEAST_BASE_CABLE_WEIGHT, RATE_FLOOR, REDUNDANCY_TOL, SCALE_ONE
 from .first_order import FirstOrderModel, first_order_model
 from .model import CableRobot
 from .motion_modes import ModeName, MotionLimits, fastkit_motion_limits, joint_bounds
+from .._validate import as_tolerance, require_instance
 
 __all__ = ["OBJECTIVES", "RedundancyResult", "resolve_redundancy"]
 
@@ -138,6 +139,8 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     >>> res.success, res.status, res.scale
     (True, 'ok', 1.0)
     """
+    require_instance(robot, CableRobot, "robot")
+    as_tolerance(tol, "tol")
     if objective not in OBJECTIVES:
         raise InvalidInputError("objective", "must be one of " + ", ".join(OBJECTIVES))
     limits = fastkit_motion_limits() if limits is None else limits

@@ -34,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from .model import CableRobot
+from .._validate import as_array, require_instance
 
 __all__ = ["sliding_rows"]
 
@@ -72,10 +73,12 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
     >>> S.shape, base.tolist() == [0] * 8 + [1] * 8
     ((16, 8), True)
     """
-    unit = np.asarray(unit, dtype=float)
+    require_instance(robot, CableRobot, "robot")
+    unit = as_array(unit, "unit")
     if unit.ndim == 2:
         S1, s1, base1 = sliding_rows(robot, unit[None])
         return S1[0], s1, base1
+    unit = as_array(unit, "unit", shape=(None, robot.m, 3))
     B, m, _ = unit.shape
     rows, rhs, owner = [], [], []
     g_z = float(robot.gravity[2])

@@ -32,6 +32,7 @@ from .motion_modes import (BASE_JOINTS, MODES, TWIST_LABELS, Mode, ModeName, Mot
                            fastkit_motion_limits, joint_bounds, resolve_mode)
 from .polytope import HPolytopeBatch, lp_max_step
 from .zonotope import _facets_base_and_identity, zonotope_hrep
+from .._validate import as_count, require_instance
 
 __all__ = ["AvailableTwistSet", "available_twist_set", "TwistCapacities", "twist_capacities",
            "support"]
@@ -254,4 +255,6 @@ def _capacities_lp(robot: CableRobot, poses: ArrayLike, limits: MotionLimits,
 def support(ats: AvailableTwistSet, direction: ArrayLike, k: int = 0) -> float:
     """Support function ``max d . t`` over the ATS of pose ``k`` (LP over the H-rep, HiGHS);
     ``inf`` when unbounded, ``-inf`` when the set is empty. Same as ``ats.support``."""
+    require_instance(ats, AvailableTwistSet, "ats")
+    k = as_count(k, "k", maximum=ats.H.shape[0] - 1)
     return ats.support(direction, k)

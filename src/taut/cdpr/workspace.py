@@ -15,6 +15,7 @@ from ._common import renamed_keyword
 from ._tol import BOX_REL
 from .model import CableRobot
 from .wrench_set import wrench_feasible
+from .._validate import as_count, require_instance
 
 __all__ = ["WorkspaceResult", "grid_points", "wrench_feasible_workspace"]
 
@@ -99,6 +100,8 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
     :func:`taut.cdpr.wrench_set.wrench_feasible`). ``progress(done, total)`` is called after
     each block of ``chunk`` poses. Positions outside the frame raise :class:`InfeasiblePoseError`.
     """
+    require_instance(robot, CableRobot, "robot")
+    chunk = as_count(chunk, "chunk", minimum=1)
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     pts = as_array(points, "points", shape=(None, 3))
     ori = np.zeros((1, 3)) if orientations is None else \

@@ -26,6 +26,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from ..cdpr.model import Base, Cable, CableRobot, Payload, Platform
 from ..errors import InvalidModelError, ScenarioError, TautError
 from .files import read_mapping, validate_mapping
+from .._validate import as_path
 
 __all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
 
@@ -166,6 +167,7 @@ def load_cdpr_model(source: str | Path) -> CableRobot:
 
     A bare word without a path separator or suffix is taken as a preset name.
     """
+    as_path(source, "source")
     s = str(source)
     p = Path(s)
     if not p.exists() and p.suffix == "" and "/" not in s and "\\" not in s:

@@ -16,6 +16,7 @@ import yaml
 from pydantic import BaseModel, ValidationError
 
 from ..errors import ScenarioError
+from .._validate import as_path, require_instance
 
 __all__ = ["read_text", "read_mapping", "validate_mapping", "write_json"]
 
@@ -25,6 +26,7 @@ M = TypeVar("M", bound=BaseModel)
 def read_text(path: str | Path) -> str:
     """The UTF-8 text of a file; a missing or unreadable file is a :class:`ScenarioError`
     naming the path."""
+    path = as_path(path)
     p = Path(path)
     if not p.is_file():
         raise ScenarioError(str(path), "file not found")
@@ -72,6 +74,7 @@ def read_mapping(path: str | Path) -> dict[str, Any]:
         Missing or unreadable file, a syntax error, a key given twice, or a top level that
         is not a mapping.
     """
+    path = as_path(path)
     p = Path(path)
     text = read_text(p)
     try:
@@ -135,6 +138,9 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
 
     A boolean in the file that the model turned into a number is an error too (pydantic's
     lax mode accepts ``true`` for a float); booleans kept as booleans are fine."""
+    if not (isinstance(model, type) and issubclass(model, BaseModel)):
+        raise ScenarioError("model", "must be a pydantic model class")
+    require_instance(data, dict, "data")
     try:
         validated = model.model_validate(data)
     except ValidationError as exc:
@@ -156,6 +162,7 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
 
 def write_json(obj: Any, path: str | Path) -> None:
     """Write ``obj`` as indented, valid JSON (non-finite numbers become ``null``)."""
+    path = as_path(path)
     from .serialize import to_json
 
     Path(path).write_text(to_json(obj) + "\n", encoding="utf-8")

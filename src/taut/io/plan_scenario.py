@@ -32,6 +32,7 @@ from ..errors import ScenarioError, TautError
 from ..plan.world import MAX_TEAM_ROBOTS, Obstacle, Scenario, Team, World
 from ..sheet import Sheet
 from .files import read_mapping, validate_mapping
+from .._validate import require_instance
 
 __all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]
 
@@ -150,6 +151,7 @@ def load_plan_scenario(path: str | Path) -> Scenario:
 
 def plan_scenario_to_mapping(scenario: Scenario) -> dict:
     """The file mapping of a scenario (inverse of :func:`plan_scenario_from_mapping`)."""
+    require_instance(scenario, Scenario, "scenario")
     team = scenario.team
     obstacles = []
     for o in scenario.world.obstacles:

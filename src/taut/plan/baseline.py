@@ -14,6 +14,7 @@ from __future__ import annotations
 from . import _tol
 from .result import PlanResult, attempt, compact_formation
 from .world import Scenario
+from .._validate import MAX_SHEET_LENGTH, as_bounded, require_instance
 
 __all__ = ["plan_baseline"]
 
@@ -27,5 +28,7 @@ def plan_baseline(scenario: Scenario, *, sheet_margin: float = _tol.SHEET_MARGIN
     PlanningError
         The team cannot hold the object at all.
     """
+    require_instance(scenario, Scenario, "scenario")
+    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
     return attempt(scenario, compact_formation(scenario, sheet_margin), allow_crossing=False,
                    planner="disc", sheet_margin=sheet_margin)

@@ -30,6 +30,7 @@ from shapely.ops import unary_union
 
 from . import _tol
 from .world import Scenario
+from .._validate import as_count, require_instance
 
 __all__ = ["Certificate", "find_certificate"]
 
@@ -95,6 +96,8 @@ def _check_line(scenario: Scenario, p: np.ndarray, u: np.ndarray, tall: list
 
 def find_certificate(scenario: Scenario, directions: int = 72) -> Certificate | None:
     """A cut certificate (module docstring) when one of the candidate lines is one."""
+    require_instance(scenario, Scenario, "scenario")
+    directions = as_count(directions, "directions", minimum=1, maximum=100_000)
     tall = _tall(scenario)
     a = np.pi * np.arange(directions) / directions
     dirs = np.column_stack([np.cos(a), np.sin(a)])

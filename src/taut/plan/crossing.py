@@ -38,6 +38,7 @@ from .formation import Formation, crossing_pairs, offset_crossings
 from ..sheet import forward_kinematics
 from .route import Leg, Route
 from .world import Scenario
+from .._validate import require_instance, require_instances
 
 __all__ = ["CrossingRecord", "Motion", "motion_from_legs", "STEP", "TURN_STEP"]
 
@@ -209,6 +210,10 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
     -------
     Motion
     """
+    require_instance(scenario, Scenario, "scenario")
+    require_instance(formation, (Formation, Route), "formation")
+    if legs is not None:
+        legs = require_instances(legs, Leg, "legs")
     if isinstance(formation, Route):
         forms, legs, first = formation.formations, formation.legs, formation.first
     else:

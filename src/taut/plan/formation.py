@@ -61,6 +61,7 @@ from . import _tol
 from ._formation_problem import (MIN_DEPTH_FRACTION, CostWeights, _curvature_constraint,
                                  _Decision, _nominal_ik, _problem)
 from .world import Team
+from .._validate import MAX_SHEET_LENGTH, as_bounded, as_count, require_instance
 
 __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
            "offset_crossings", "MIN_DEPTH_FRACTION"]
@@ -148,6 +149,8 @@ def crossing_pairs(formation: Formation, clearance: float) -> list[tuple[float, 
         :math:`\\Delta` (rad, counter-clockwise positive) made at the obstacle, sorted by
         :math:`|\\Delta|`.
     """
+    require_instance(formation, Formation, "formation")
+    as_bounded(clearance, "clearance", MAX_SHEET_LENGTH, "m", positive=False)
     p = formation.robots
     order = _hull_order(p)
     mids = (p[order] + p[np.roll(order, -1)]) / 2
@@ -187,6 +190,9 @@ def offset_crossings(formation: Formation, clearance: float, directions: int = 3
     lo, hi : ndarray, shape (K,)
         Offset interval :math:`[e_{lo}, e_{hi}]` of the obstacle's path from the object, m.
     """
+    require_instance(formation, Formation, "formation")
+    as_bounded(clearance, "clearance", MAX_SHEET_LENGTH, "m", positive=False)
+    directions = as_count(directions, "directions", minimum=1, maximum=100_000)
     a = 2 * np.pi * np.arange(directions) / directions
     n = np.column_stack([-np.sin(a), np.cos(a)])
     proj = np.sort(formation.robots @ n.T, axis=0)          # (N, K)
@@ -243,6 +249,16 @@ def optimal_formation(team: Team, *, kind: str = "crossing", height: float = 0.0
     >>> round(f.max_height, 6), bool(f.max_diameter >= 0.3 - 1e-9)
     (0.2, True)
     """
+    require_instance(team, Team, "team")
+    as_bounded(height, "height", MAX_SHEET_LENGTH, "m", positive=False)
+    as_bounded(diameter, "diameter", MAX_SHEET_LENGTH, "m", positive=False)
+    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
+    if width is not None:
+        as_bounded(width, "width", MAX_SHEET_LENGTH, "m", positive=False)
+    if max_reach is not None:
+        as_bounded(max_reach, "max_reach", MAX_SHEET_LENGTH, "m", positive=False)
+    if weights is not None:
+        require_instance(weights, CostWeights, "weights")
     prob, start = _problem(team, kind, height, diameter, width, max_reach, weights,
                            float(sheet_margin))
     if prob is None:

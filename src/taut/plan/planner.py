@@ -41,6 +41,7 @@ from .result import PlanResult, _summary, attempt, compact_formation, failure, r
 from .route import crossable
 from .verify import verify_motion
 from .world import Scenario
+from .._validate import MAX_DURATION_S, MAX_SHEET_LENGTH, as_bounded, require_instance
 
 __all__ = ["plan", "formation_library", "MAX_CLASSES"]
 
@@ -74,6 +75,8 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
     """The compact formation; the others (the narrow one when it differs, and the crossing
     formations, one per obstacle-height class, eqs. 11-15, preferring one that fits the
     widest passage); and why some height classes have none."""
+    require_instance(scenario, Scenario, "scenario")
+    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
     world, team = scenario.world, scenario.team
     compact = compact_formation(scenario, sheet_margin)
     crossing, notes = [], []
@@ -309,6 +312,11 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     >>> r.success, r.status, r.crossed                             # doctest: +SKIP
     (True, 'ok', ('1', '2'))
     """
+    require_instance(scenario, Scenario, "scenario")
+    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
+    if time_budget is not None:
+        as_bounded(time_budget, "time_budget", MAX_DURATION_S, "s")
+    as_count(iterations, "iterations", minimum=1, maximum=10_000_000)
     budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
                               iterations, seed)
     engine(search)                      # validates the name and that OMPL is installed

@@ -38,6 +38,7 @@ from .._outcome import check_status, deprecated_alias
 from . import _tol
 from .formation import Formation, crossing_pairs, offset_crossings
 from .world import Obstacle, Scenario
+from .._validate import require_instance, require_instances
 
 __all__ = ["Leg", "Route", "find_route", "crossable", "reform_time", "DIRECTIONS"]
 
@@ -374,6 +375,11 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
         ``success`` False (status ``no_route``) with a message when the start or goal has
         no room for the formation or no route connects them.
     """
+    require_instance(scenario, Scenario, "scenario")
+    if isinstance(formation, (list, tuple)):
+        require_instances(formation, Formation, "formation", min_count=1)
+    else:
+        require_instance(formation, Formation, "formation")
     team = scenario.team
     forms = [formation] if isinstance(formation, Formation) else list(formation)
     layers = [_Layer(scenario, f, allow_crossing, straight_crossings) for f in forms]

@@ -33,10 +33,11 @@ import numpy as np
 import shapely
 
 from .._outcome import check_status, deprecated_alias
-from ..errors import TautError
+from ..errors import InvalidInputError, TautError
 from ..sheet import check_formations, forward_kinematics, simulate
 from . import _tol
 from .world import Scenario
+from .._validate import MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance, require_nonempty
 
 __all__ = ["Verification", "verify_motion", "resample_motion", "TOLERANCE"]
 
@@ -250,6 +251,13 @@ def verify_motion(scenario: Scenario, robots: np.ndarray, planned_object: np.nda
     Verification
         ``success`` False with the first failed check in ``message``.
     """
+    require_instance(scenario, Scenario, "scenario")
+    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
+    as_bounded(max_object_step, "max_object_step", MAX_SHEET_LENGTH, "m", positive=False)
+    robots = as_array(robots, "robots", shape=(None, scenario.team.sheet.n, 2))
+    if _shape(planned_object) != (len(robots), 3):        # NaN marks unplanned samples
+        raise InvalidInputError("planned_object", f"must have shape {len(robots)}x3")
+    require_nonempty(robots, "robots")
     team = scenario.team
     robots = np.asarray(robots, dtype=float)
     planned = np.asarray(planned_object, dtype=float)
@@ -295,6 +303,10 @@ def resample_motion(robots: np.ndarray, planned_object: np.ndarray, factor: int
     robots : ndarray, shape ((T - 1) * factor + 1, N, 2)
     planned_object : ndarray, shape ((T - 1) * factor + 1, 3)
     """
+    robots = require_nonempty(as_array(robots, "robots", shape=(None, None, 2)), "robots")
+    if _shape(planned_object) != (len(robots), 3):
+        raise InvalidInputError("planned_object", f"must have shape {len(robots)}x3")
+    factor = as_count(factor, "factor", minimum=1, maximum=10_000)
     robots = np.asarray(robots, dtype=float)
     obj = np.asarray(planned_object, dtype=float)
     T = len(robots)
@@ -320,3 +332,11 @@ def resample_motion(robots: np.ndarray, planned_object: np.ndarray, factor: int
                 out_r.append(a * (1 - sk) + b * sk)
                 out_o.append(obj[t + 1] if k == factor - 1 else np.full(3, np.nan))
     return np.asarray(out_r), np.asarray(out_o)
+
+
+def _shape(value: object) -> tuple[int, ...] | None:
+    """Shape of an array-like, None when ragged or not numeric."""
+    try:
+        return np.asarray(value, dtype=float).shape
+    except (TypeError, ValueError):
+        return None

@@ -16,6 +16,7 @@ import shapely
 from shapely.geometry import Point, Polygon
 
 from .._validate import as_array, as_nonnegative, as_points, as_positive
+from .._validate import require_instances
 from ..errors import InvalidInputError, PlanningError
 from ..sheet.model import Sheet, check_hold_height
 
@@ -145,7 +146,7 @@ class World:
         if not geom.is_valid or not geom.area > 0:
             raise InvalidInputError("free_space", "must be a simple polygon with positive "
                                                   "area (no self-intersections)")
-        obs = tuple(self.obstacles)
+        obs = require_instances(self.obstacles, Obstacle, "obstacles")
         seen: set[str] = set()
         for k, o in enumerate(obs):
             if not isinstance(o, Obstacle):

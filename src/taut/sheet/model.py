@@ -9,6 +9,7 @@ import numpy as np
 from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, as_array, as_points, as_positive, check_range
 from ..errors import InfeasibleFormationError, InvalidInputError, InvalidSheetError
 from ._tol import GEOMETRY_RTOL, WINDING_TOL
+from .._validate import require_instance
 
 __all__ = ["Sheet", "check_formation", "check_formations", "check_hold_height"]
 
@@ -165,6 +166,7 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
         Some pair of robots is farther apart than its sheet vertices; ``step`` holds the
         batch index for batched input.
     """
+    require_instance(sheet, Sheet, "sheet")
     r = check_range(as_array(formations, field, ndim=3), field, MAX_SHEET_LENGTH, "sheet units")
     if r.shape[2] != 2:
         raise InvalidInputError(field, f"last axis must have length 2 (x, y), got {r.shape[2]}")
@@ -203,5 +205,6 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
 def check_formation(sheet: Sheet, formation: np.ndarray, field: str = "formation"
                     ) -> np.ndarray:
     """Validate one formation, shape (N, 2); see :func:`check_formations`."""
+    require_instance(sheet, Sheet, "sheet")
     r = as_array(formation, field, ndim=2)
     return check_formations(sheet, r[None], field)[0]

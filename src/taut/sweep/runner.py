@@ -25,6 +25,8 @@ from .points import chunk_bounds, expand, point_seeds
 from .spec import SweepSpec
 from .store import Store
 from .tasks import TASKS, Columns
+from .._validate import require_instance
+from .._validate import as_path
 
 __all__ = ["SweepResult", "run_sweep", "evaluate_chunk", "chunk_size_of"]
 
@@ -66,6 +68,7 @@ class SweepResult:
 
 def chunk_size_of(spec: SweepSpec) -> int:
     """Points per chunk: the spec's, else the task's default."""
+    require_instance(spec, SweepSpec, "spec")
     return int(spec.chunk_size) or TASKS[spec.task].default_chunk
 
 
@@ -83,6 +86,7 @@ def evaluate_chunk(spec: SweepSpec, start: int, stop: int,
     ``params`` (the chunk's parameter columns) may be passed in; by default they are
     expanded from the spec.
     """
+    require_instance(spec, SweepSpec, "spec")
     task = TASKS[spec.task]
     ctx = _context(spec)
     cols = dict(params) if params is not None else expand(spec, start, stop)
@@ -176,6 +180,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     >>> columns["scale"].tolist(), meta["sweep_task"]
     ([0.8, 0.8, 0.9, 0.9, 1.0, 1.0], 'fk_stability_map')
     """
+    require_instance(spec, SweepSpec, "spec")
+    out = as_path(out, "out")
     t0 = time.perf_counter()
     total = spec.size if limit is None else min(int(limit), spec.size)
     if total < 1:

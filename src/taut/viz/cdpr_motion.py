@@ -51,7 +51,7 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
     workspace box and its verification points (green feasible, red not). Returns the
     figure."""
     robot = result.robot
-    fig, ax = plt.subplots(figsize=(7, 4.2))
+    fig, ax = plt.subplots(figsize=(8.5, 5.2))
     box = result.workspace
     ax.add_patch(plt.Rectangle((float(box[0, 0]), float(box[0, 1])),
                                *(box[1, :2] - box[0, :2]), fill=False, lw=1.5,
@@ -69,8 +69,10 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
             x, y, th = base.pose
             ax.annotate("", xy=(x + 0.4 * np.cos(th), y + 0.4 * np.sin(th)), xytext=(x, y),
                         arrowprops=dict(arrowstyle="->"))
-            ax.text(x, y - 0.9, f"{base.name}\n({x:.2f}, {y:.2f}, {np.degrees(th):.1f}°)",
-                    ha="center", fontsize=7)
+            # below the footprint (not a fixed offset, which overlapped large footprints)
+            ax.text(x, float(c[:, 1].min()) - 0.08,
+                    f"{base.name}\nx {x:.2f} m, y {y:.2f} m, {np.degrees(th):.1f}°",
+                    ha="center", va="top", fontsize=7)
     ex = robot.exits_world
     ax.scatter(ex[:, 0], ex[:, 1], marker="v", c="k", s=14, label="exit points")
     ax.set_aspect("equal")
@@ -79,7 +81,8 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
     ax.margins(0.08, 0.25)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=4,
               frameon=False)
-    ax.set_title(title or (f"deployment: margin {result.margin:.3g}"
+    ax.set_title(title or (f"deployment, top view: worst wrench margin {result.margin:.3g} "
+                           "N (N m for moments)"
                            + ("" if result.success else " (not feasible)")), fontsize=10)
     fig.tight_layout()
     if path is not None:

@@ -27,6 +27,8 @@ def _draw_sheet(ax: Any, nodes: np.ndarray, triangles: np.ndarray, formation: np
         ax.plot([x, x], [y, y], [0, hold_height], color="0.35", lw=1.2)
         ax.text(x, y, hold_height * 1.05, str(i + 1), fontsize=8, ha="center")
     ax.set_zlim(0, hold_height * 1.1)
+    for axis in "xyz":           # sheets use any consistent length unit (examples: mm)
+        getattr(ax, f"set_{axis}label")(f"{axis} [sheet units]", fontsize=7)
     span = np.ptp(np.vstack([nodes[:, :2], formation]), axis=0)
     ax.set_box_aspect((max(span[0], 1e-9), max(span[1], 1e-9), hold_height * 1.1))
 

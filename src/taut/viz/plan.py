@@ -37,6 +37,8 @@ def draw_world(ax, scenario: Scenario) -> None:
     ax.plot(*scenario.start, "go")
     ax.plot(*scenario.goal, "r*", ms=10)
     ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
     pad = 0.2
     ax.set_xlim(fs[:, 0].min() - pad, fs[:, 0].max() + pad)
     ax.set_ylim(fs[:, 1].min() - pad, fs[:, 1].max() + pad)

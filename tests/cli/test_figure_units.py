@@ -1,0 +1,137 @@
+"""Every figure type rendered headless (Agg) and inspected: each data panel has a title
+(its own or the figure's), axis labels with units (``[m]``, ``(N)``, ...) unless the axis is
+categorical (named ticks), and a legend wherever more than one labelled artist is drawn. The
+wrench-capacity chart says which direction it plots."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = Path(__file__).parents[2]
+UNIT = re.compile(r"\[[^\]]+\]|\([^)]*(m|N|s|%|deg|rad|mm)[^)]*\)|/")
+
+
+def _panels(fig):
+    """Data panels (colorbars, which only carry a label, are left out)."""
+    return [ax for ax in fig.axes if ax.get_label() != "<colorbar>" and ax.has_data()]
+
+
+def _check(fig, *, min_panels: int = 1):
+    panels = _panels(fig)
+    assert len(panels) >= min_panels
+    suptitle = fig._suptitle.get_text() if fig._suptitle is not None else ""
+    for ax in panels:
+        assert ax.get_title() or suptitle, "panel without a title"
+        axes = [("x", ax.get_xlabel(), ax.get_xticklabels()),
+                ("y", ax.get_ylabel(), ax.get_yticklabels())]
+        if hasattr(ax, "get_zlabel"):
+            axes.append(("z", ax.get_zlabel(), []))
+        for name, label, ticks in axes:
+            categorical = name == "x" and any(re.search("[A-Za-z]", t.get_text())
+                                               for t in ticks)
+            assert categorical or UNIT.search(label), f"{name} axis {label!r} has no unit"
+        labelled = [h for h in ax.get_legend_handles_labels()[1] if not h.startswith("_")]
+        if len(labelled) > 1:
+            assert ax.get_legend() is not None or fig.legends, f"no legend for {labelled}"
+    plt.close(fig)
+
+
+def test_fk_figure():
+    from taut.io.sheet_scenario import load_sheet_scenario
+    from taut.sheet import forward_kinematics
+    from taut.viz.sheet import plot_fk
+    sc = load_sheet_scenario(ROOT / "examples" / "sheet" / "example1.yaml")
+    r = forward_kinematics(sc.sheet, sc.formation, sc.hold_height)
+    _check(plot_fk(r, units="mm"))
+
+
+def test_plan_top_view_has_metres_on_both_axes(tmp_path):
+    from taut.plan import generate_scenario, plan_baseline
+    from taut.viz.plan import plot_plan
+    from taut.viz.plan import draw_world
+    sc = generate_scenario(0)
+    fig, ax = plt.subplots()
+    draw_world(ax, sc)                  # the top view of plot_plan and animate_plan
+    assert ax.get_xlabel() == "x [m]" and ax.get_ylabel() == "y [m]"
+    plt.close(fig)
+    r = plan_baseline(sc)
+    if not r.success:
+        pytest.skip("baseline found no plan on this scenario")
+    captured = {}
+    real = plt.Figure.savefig
+    plt.Figure.savefig = lambda self, *a, **k: captured.setdefault("fig", self)
+    try:
+        plot_plan(sc, r, tmp_path / "p.png")
+    finally:
+        plt.Figure.savefig = real
+    fig = captured["fig"]
+    top = fig.axes[0]
+    assert top.get_xlabel() == "x [m]" and top.get_ylabel() == "y [m]"
+    _check(fig, min_panels=3)
+
+
+def test_cdpr_figures():
+    from taut.cdpr import (axis_capacities, grid_points, twist_capacities,
+                           wrench_feasible_workspace)
+    from taut.io import load_cdpr_model
+    from taut.viz.cdpr import plot_axis_capacities, plot_workspace
+    from taut.viz.cdpr_binding import plot_binding
+    from taut.viz.cdpr_motion import plot_capacity_bars
+    robot = load_cdpr_model("fastkit")
+    pts, shape = grid_points([[-1.0, 0.0, 0.5], [1.0, 0.0, 1.5]], (5, 1, 3))
+    ws = wrench_feasible_workspace(robot, pts, shape=shape)
+    _check(plot_workspace(ws, robot))
+    _check(plot_binding(ws, robot))
+    pose = [0.0, 0.0, 1.0]
+    fig = plot_axis_capacities(axis_capacities(robot, pose, tipping=False),
+                               axis_capacities(robot, pose))
+    assert "direction" in fig._suptitle.get_text()
+    _check(fig, min_panels=2)
+    tc = twist_capacities(robot, pose)
+    v = np.minimum(tc.positive[0], tc.negative[0])
+    _check(plot_capacity_bars({"bases moving": v}, tc.labels,
+                              ["m/s"] * 3 + ["rad/s"] * 3, "twist capacity (+ and - min)"))
+
+
+@pytest.mark.slow
+def test_deployment_figure_readable():
+    from taut.cdpr import DeploymentOptions, plan_deployment
+    from taut.io import load_cdpr_model
+    from taut.viz.cdpr_motion import plot_deployment
+    robot = load_cdpr_model("fastkit")
+    r = plan_deployment(robot, [-0.5, 0.5, -0.05, 0.05, 0.6, 1.2],
+                        options=DeploymentOptions(maxiter=1, popsize=2))
+    fig = plot_deployment(r)
+    w, h = fig.get_size_inches()
+    assert w >= 8 and h >= 5
+    fig.canvas.draw()
+    texts = [t for t in fig.axes[0].texts if t.get_text()]
+    boxes = [t.get_window_extent() for t in texts]
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            assert not boxes[i].overlaps(boxes[j]), (texts[i].get_text(), texts[j].get_text())
+    _check(fig)
+
+
+def test_sweep_figure(tmp_path):
+    from taut.viz.sweep import plot_sweep
+    cols = {"scale": np.repeat([0.8, 0.9, 1.0], 2), "stretch": np.tile([1.0, 1.1], 3),
+            "count": np.array([1.0, 2, 2, 3, 1, 1])}
+    captured = {}
+    real = plt.Figure.savefig
+    plt.Figure.savefig = lambda self, *a, **k: captured.setdefault("fig", self)
+    try:
+        plot_sweep(cols, "scale", "count", tmp_path / "s.png", y="stretch",
+                   labels={"scale": "scale [-]", "stretch": "stretch [-]",
+                           "count": "equilibria"})
+    finally:
+        plt.Figure.savefig = real
+    _check(captured["fig"])
