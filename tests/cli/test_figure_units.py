@@ -96,7 +96,7 @@ def test_cdpr_figures():
     assert "direction" in fig._suptitle.get_text()
     _check(fig, min_panels=2)
     tc = twist_capacities(robot, pose)
-    v = np.minimum(tc.positive[0], tc.negative[0])
+    v = np.minimum(tc.positive, tc.negative)          # one pose: one result (m,)
     _check(plot_capacity_bars({"bases moving": v}, tc.labels,
                               ["m/s"] * 3 + ["rad/s"] * 3, "twist capacity (+ and - min)"))
 

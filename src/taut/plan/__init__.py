@@ -26,16 +26,3 @@ __all__ = [
     "UnknownObstacleError",
 ]
 
-# Re-exports of every name the submodules' __all__ list (one public import path: taut.plan).
-from .crossing import STEP, TURN_STEP  # noqa: E402
-from .formation import MIN_DEPTH_FRACTION  # noqa: E402
-from .planner import MAX_CLASSES  # noqa: E402
-from .result import attempt, compact_formation, failure  # noqa: E402
-from .robustness import monte_carlo  # noqa: E402
-from .route import DIRECTIONS, crossable, reform_time  # noqa: E402
-from .verify import TOLERANCE  # noqa: E402
-from .world import CIRCLE_SEGMENTS  # noqa: E402
-
-__all__ += ["STEP", "TURN_STEP", "MIN_DEPTH_FRACTION", "MAX_CLASSES", "attempt",
-            "compact_formation", "failure", "monte_carlo", "DIRECTIONS", "crossable",
-            "reform_time", "TOLERANCE", "CIRCLE_SEGMENTS"]

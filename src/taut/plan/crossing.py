@@ -40,7 +40,7 @@ from .route import Leg, Route
 from .world import Scenario
 from .._validate import require_instance, require_instances
 
-__all__ = ["CrossingRecord", "Motion", "motion_from_legs", "STEP", "TURN_STEP"]
+__all__ = ["CrossingRecord", "Motion", "motion_from_legs"]
 
 #: Largest translation between samples, m.
 STEP = 0.04

@@ -64,7 +64,7 @@ from .world import Team
 from .._validate import MAX_SHEET_LENGTH, as_bounded, as_count, require_instance
 
 __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
-           "offset_crossings", "MIN_DEPTH_FRACTION"]
+           "offset_crossings"]
 
 
 @dataclass(frozen=True, eq=False)

@@ -43,7 +43,7 @@ from .verify import verify_motion
 from .world import Scenario
 from .._validate import MAX_DURATION_S, MAX_SHEET_LENGTH, as_bounded, require_instance
 
-__all__ = ["plan", "formation_library", "MAX_CLASSES"]
+__all__ = ["plan", "formation_library"]
 
 #: Most obstacle-height classes for which a crossing formation is optimised.
 MAX_CLASSES = 4

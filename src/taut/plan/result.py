@@ -18,7 +18,7 @@ from .route import find_route
 from .verify import Verification, verify_motion
 from .world import Scenario
 
-__all__ = ["PlanResult", "Robustness", "attempt", "compact_formation", "failure"]
+__all__ = ["PlanResult", "Robustness"]
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,7 +22,7 @@ from .world import Scenario
 if TYPE_CHECKING:
     from .result import PlanResult, Robustness
 
-__all__ = ["monte_carlo"]
+__all__: list[str] = []
 
 
 def _beneath(scenario: Scenario, robots: np.ndarray) -> np.ndarray:

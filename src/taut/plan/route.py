@@ -40,7 +40,7 @@ from .formation import Formation, crossing_pairs, offset_crossings
 from .world import Obstacle, Scenario
 from .._validate import require_instance, require_instances
 
-__all__ = ["Leg", "Route", "find_route", "crossable", "reform_time", "DIRECTIONS"]
+__all__ = ["Leg", "Route", "find_route"]
 
 #: Number of crossing headings tried per crossable obstacle.
 DIRECTIONS = 24

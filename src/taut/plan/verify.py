@@ -39,7 +39,7 @@ from . import _tol
 from .world import Scenario
 from .._validate import MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance, require_nonempty
 
-__all__ = ["Verification", "verify_motion", "resample_motion", "TOLERANCE"]
+__all__ = ["Verification", "verify_motion", "resample_motion"]
 
 #: Absolute tolerance of the geometric checks, m (see ``taut.plan._tol``).
 TOLERANCE = _tol.GEOMETRY_TOL

@@ -20,7 +20,7 @@ from .._validate import require_instances
 from ..errors import InvalidInputError, PlanningError
 from ..sheet.model import Sheet, check_hold_height
 
-__all__ = ["Obstacle", "World", "Team", "Scenario", "UnknownObstacleError", "CIRCLE_SEGMENTS"]
+__all__ = ["Obstacle", "World", "Team", "Scenario", "UnknownObstacleError"]
 
 
 class UnknownObstacleError(InvalidInputError, KeyError):

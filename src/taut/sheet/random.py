@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance
 from ..errors import InvalidInputError
 from .model import Sheet
 
@@ -17,8 +18,9 @@ def random_convex_polygon(n: int, rng: np.random.Generator, *, radius: float = 1
     Vertices on a random ellipse (semi-axes in ``[0.6, 1.0] * radius``, random tilt) at
     jittered, evenly spread angles, so no two vertices nearly coincide.
     """
-    if n < 3:
-        raise InvalidInputError("n", f"must be at least 3, got {n}")
+    n = as_count(n, "n", minimum=3, maximum=MAX_ROBOTS)
+    require_instance(rng, np.random.Generator, "rng")
+    radius = as_bounded(radius, "radius", MAX_SHEET_LENGTH, "sheet units")
     base = 2 * np.pi * np.arange(n) / n
     t = base + rng.uniform(-0.35, 0.35, n) * (2 * np.pi / n) + rng.uniform(0, 2 * np.pi)
     a, b = radius * rng.uniform(0.6, 1.0, 2)
@@ -42,6 +44,7 @@ def random_team(n: int, rng: np.random.Generator, *, slack: tuple[float, float] 
     sheet : Sheet
     formation : ndarray, shape (n, 2)
     """
+    slack = _slack(slack)
     V = random_convex_polygon(n, rng)
     R = random_convex_polygon(n, rng)
     # Keep robot i roughly "behind" vertex i: rotate R's first vertex onto V's.
@@ -65,9 +68,19 @@ def random_scattered_team(n: int, rng: np.random.Generator,
     sheet : Sheet
     formation : ndarray, shape (n, 2)
     """
+    slack = _slack(slack)
     V = random_convex_polygon(n, rng)
     R = rng.normal(size=(n, 2))
     iu, ju = np.triu_indices(n, 1)
     ratio = np.linalg.norm(V[iu] - V[ju], axis=1) / np.linalg.norm(R[iu] - R[ju], axis=1)
     R = R * ratio.min() * rng.uniform(*slack) + rng.normal(scale=0.3, size=2)
     return Sheet(V), R
+
+
+def _slack(slack: object) -> tuple[float, float]:
+    """``slack`` as ``(low, high)`` with 0 < low <= high < 1 (a feasible formation)."""
+    lo, hi = as_array(slack, "slack", shape=(2,))
+    if not 0.0 < lo <= hi < 1.0:
+        raise InvalidInputError("slack", f"must be (low, high) with 0 < low <= high < 1, got "
+                                         f"({lo:g}, {hi:g})")
+    return float(lo), float(hi)
