@@ -5,7 +5,10 @@
   fraction;
 * how much of the desired slice sliding of the bases removes at mu = 0.3 and 0.6 (and
   0.1, 0.2 for context), stabilisers retracted and deployed;
-* the interference-free fraction of the desired slice (level platform);
+* the interference-free fraction of the desired slice (level platform; ideal and 2 mm
+  cables), and the coverage with the platform kept inside the exits' bounding box;
+* ``fastkit_suspended_vs_fc.png``: the two presets side by side (binding condition,
+  wrench-closure rings);
 * ``fastkit_binding_slice.png``: the binding condition per position (mu = 0.3, stabilisers
   deployed) and ``fastkit_binding_3d.png``: the same over a 3D grid (mu = 0.2, retracted).
 
@@ -15,6 +18,7 @@ Writes ``fastkit_conditions.json``. Run: ``python examples/cdpr/fastkit_conditio
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -23,10 +27,12 @@ from taut.cdpr import (cable_interference, grid_points, with_friction, with_stab
                        wrench_closure, wrench_feasible_workspace)
 from taut.io.cdpr_model import load_cdpr_model
 from taut.viz.cdpr_binding import plot_binding
+from taut.viz.cdpr_compare import plot_workspace_comparison
 
 HERE = Path(__file__).resolve().parent
 GRID = (41, 1, 21)                       # the desired slice y = 0: 861 positions
 MUS = (0.1, 0.2, 0.3, 0.6)
+CABLE_DIAMETERS = (0.0, 0.002)        # m: ideal cables, and the 2 mm braid the preset assumes
 
 
 def pct(x: float | None) -> float | None:
@@ -44,23 +50,49 @@ def coverage(robot) -> dict:
     return out
 
 
+def interference(robot, pts) -> dict:
+    """Interference-free fraction, level platform, for ideal (0) and 2 mm cables."""
+    names = [c.name for c in robot.cables]
+    out = {}
+    for d in CABLE_DIAMETERS:
+        itf = cable_interference(robot, pts, min_distance=d)
+        meet = itf.distance <= d + 1e-9
+        pairs = sorted({f"{names[i]}/{names[j]}" for i, j in zip(*np.nonzero(meet.any(0)))
+                        if i < j})
+        out[f"d={d}"] = {"free_%": pct(float(itf.free.mean())),
+                         "cable_cable_%": pct(float(itf.cable_cable.mean())),
+                         "cable_platform_%": pct(float(itf.cable_platform.any(axis=1).mean())),
+                         "pairs_that_meet": pairs}
+    return out
+
+
 def main() -> None:
     out: dict = {"grid": list(GRID), "points": int(np.prod(GRID))}
+    compare = []
     for name in ("fastkit", "fastkit_fc"):
         robot = load_cdpr_model(name)
-        pts, _ = grid_points(robot.desired_workspace, GRID)
+        pts, shape = grid_points(robot.desired_workspace, GRID)
+        ws = wrench_feasible_workspace(robot, pts, shape=shape, closure=True)
+        compare.append((ws, robot))
+        boxed = wrench_feasible_workspace(replace(robot, platform_inside_exits=True), pts,
+                                          shape=shape)
         out[name] = {"retracted": coverage(robot),
                      "stabilisers": coverage(with_stabilisers(robot)),
-                     "closure_%": pct(float(wrench_closure(robot, pts).mean()))}
+                     "closure_%": pct(ws.coverage_closure),
+                     "closure_check_%": pct(float(wrench_closure(robot, pts).mean())),
+                     "inside_exits_box_%": pct(boxed.coverage_inside),
+                     "sliding": {f"{'stabilisers' if stab else 'retracted'} mu={mu}":
+                                 coverage(with_friction(with_stabilisers(robot, stab), mu))
+                                 for stab in (False, True) for mu in (0.3, 0.6)}}
         light = robot.__class__(robot.bases, robot.platform, robot.cables,
                                 gravity=robot.gravity, desired_workspace=robot.desired_workspace,
                                 name=robot.name + " without payload")
         out[name]["no_payload"] = coverage(light)
-        itf = cable_interference(robot, pts)
-        out[name]["interference"] = {
-            "free_%": pct(float(itf.free.mean())),
-            "cable_cable_%": pct(float(itf.cable_cable.mean())),
-            "cable_platform_%": pct(float(itf.cable_platform.any(axis=1).mean()))}
+        out[name]["interference"] = interference(robot, pts)
+    plot_workspace_comparison([w for w, _ in compare], [r for _, r in compare],
+                              HERE / "fastkit_suspended_vs_fc.png",
+                              titles=["suspended FASTKIT (fastkit)",
+                                      "fully constrained FASTKIT (fastkit_fc)"])
     robot = load_cdpr_model("fastkit")
     sliding = {}
     for stab in (False, True):

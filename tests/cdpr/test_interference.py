@@ -68,3 +68,51 @@ def test_preset_crossing_cables_meet_at_level_poses(fastkit):
     assert res.cable_cable.all()
     yawed = cable_interference(fastkit, [[0.5, 0.0, 1.0, 0.0, 0.0, 0.05]])
     assert yawed.distance[0, i, j] > 1e-3
+
+
+def test_cables_sharing_an_anchor_are_compared_beyond_it(point_mass):
+    """Four cables share the point-mass attachment: the trimmed distance of every pair is
+    2 l sin(theta / 2) (l = anchor_length, theta the angle between them), so they
+    interfere exactly when that is below the cable diameter."""
+    pose = np.array([[0.3, -0.2, 1.2]])
+    st_ = cable_state(point_mass, pose)
+    u = st_.unit[0]
+    ell = 0.05
+    res = cable_interference(point_mass, pose, anchor_length=ell)
+    cos = np.clip(u @ u.T, -1, 1)
+    expect = 2 * ell * np.sin(np.arccos(cos) / 2)
+    off = ~np.eye(4, dtype=bool)
+    np.testing.assert_allclose(res.distance[0][off], expect[off], rtol=1e-9)
+    assert res.free[0]                         # in contact only at the shared point
+    d_min = expect[off].min()
+    assert not cable_interference(point_mass, pose, anchor_length=ell,
+                                  min_distance=0.99 * d_min).cable_cable[0]
+    assert cable_interference(point_mass, pose, anchor_length=ell,
+                              min_distance=1.01 * d_min).cable_cable[0]
+
+
+def test_shared_attachment_pairs_of_ipanema_match_sampling():
+    """IPAnema 1 (CASPR) has four pairs of cables on a common attachment point: their
+    distance equals brute-force sampling of the cables trimmed at the shared end."""
+    from pathlib import Path
+
+    from taut.io.caspr import load_caspr_model
+    d = Path(__file__).resolve().parents[2] / "examples" / "cdpr" / "caspr"
+    robot = load_caspr_model(d / "IPAnema_1_bodies.xml", d / "IPAnema_1_cables.xml")
+    P = random_poses(robot, 4, seed=5, angle=0.3)
+    ell = 0.1
+    res = cable_interference(robot, P, anchor_length=ell)
+    st_ = cable_state(robot, P)
+    att = P[:, None, :3] + st_.r
+    share = np.all(robot.attach_local[:, None] == robot.attach_local[None], axis=2)
+    pairs = [(i, j) for i in range(robot.m) for j in range(i + 1, robot.m) if share[i, j]]
+    assert len(pairs) == 4
+    for b in range(len(P)):
+        for i, j in pairs:
+            a_i = att[b, i] + ell * st_.unit[b, i]
+            a_j = att[b, j] + ell * st_.unit[b, j]
+            sampled = _sampled_distance(a_i, robot.exits_world[i], a_j,
+                                        robot.exits_world[j], n=2001)
+            assert res.distance[b, i, j] <= sampled + 1e-12
+            assert sampled <= res.distance[b, i, j] + 0.01
+            assert res.distance[b, i, j] > 0    # not interfering: they only meet at the ring

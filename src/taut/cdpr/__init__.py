@@ -89,3 +89,10 @@ __all__ += [
     "VelocityController", "ControlEvent", "BaseMotion", "ControlResult", "MonteCarloResult",
     "monte_carlo", "simulate",
 ]
+
+from .base_motion import (MovingDeploymentResult, plan_moving_deployment,  # noqa: E402
+                          slice_box, staged_lift_bound)
+from .exit_box import exits_box, platform_corners, platform_inside_exits  # noqa: E402
+
+__all__ += ["MovingDeploymentResult", "plan_moving_deployment", "slice_box",
+            "staged_lift_bound", "exits_box", "platform_corners", "platform_inside_exits"]

@@ -111,6 +111,15 @@ LIFT_RTOL = 1e-5
 #: than REFUTE_REL times the weight (dimensionless): guards round-off at the boundary.
 REFUTE_REL = 1e-6
 
+# --- cable interference ----------------------------------------------------------------
+#: Length along each cable from an anchor it shares with another cable (a common exit
+#: eyelet or attachment ring) over which the two are in contact by design, m. Beyond it
+#: the pair interferes like any other (closest distance below the cable diameter); two
+#: cables leaving one anchor at angle theta then interfere iff 2 ANCHOR_LENGTH sin(theta/2)
+#: < min_distance, e.g. below 5.7 deg for 2 mm cables. 20 mm is the size of a typical
+#: eyelet or swivel ring of 1-5 mm cables (not from the papers: an assumption).
+ANCHOR_LENGTH = 0.02
+
 # --- wrench closure -------------------------------------------------------------------
 #: A pose has wrench closure when the most balanced self-stress ``W t = 0`` with
 #: ``max t = 1`` has ``min t > CLOSURE_TOL`` (dimensionless): far above HiGHS's 1e-7

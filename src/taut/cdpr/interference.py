@@ -6,8 +6,15 @@ exit point. The platform is the box spanned by its attachment points in the plat
 
 * Cable-cable: the exact closest distance between two segments (clamped closest points of
   the two supporting lines, C. Ericson, "Real-Time Collision Detection", §5.1.9), batched
-  over poses and all pairs; pairs sharing an attachment or an exit point always touch and
-  are skipped.
+  over poses and all pairs. A pair interferes when its distance is at most
+  ``min_distance`` (the cable diameter: the axes of two touching cables are one diameter
+  apart). Two cables whose endpoints merely come close count like any others (they rub
+  at the eyelets). Pairs *sharing* an anchor (the same attachment point, as in IPAnema 1,
+  or the same exit point) touch there by design; they are compared beyond
+  ``anchor_length`` from the shared anchor (each segment trimmed by that much at the
+  shared end), so they interfere only if they run together: overlap along a length, or
+  leave the anchor at an angle ``theta`` with ``2 anchor_length sin(theta / 2)`` below
+  ``min_distance``.
 * Cable-platform: a cable collides with the platform when its segment enters the open box
   (the box shrunk by ``box_tol``, so a cable leaving from a corner or face does not count)
   - a slab test.
@@ -21,8 +28,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._batching import is_single, unbatch
-from ._tol import BOX_REL, SEGMENT_PARALLEL, TINY
+from ._tol import ANCHOR_LENGTH, BOX_REL, SEGMENT_PARALLEL, TINY
 from .kinematics import as_poses, cable_state
+from ..errors import InvalidInputError
 from .model import CableRobot
 from .._validate import as_tolerance, require_instance
 
@@ -65,8 +73,8 @@ class Interference:
     Attributes
     ----------
     distance : (B, m, m)
-        Closest distance between cables i and j, m (``inf`` on the diagonal and for pairs
-        sharing an endpoint).
+        Closest distance between cables i and j, m (``inf`` on the diagonal; for pairs
+        sharing an endpoint, between their parts beyond ``anchor_length`` from it).
     cable_cable : (B,) bool
         Some pair is closer than ``min_distance``.
     cable_platform : (B, m) bool
@@ -97,8 +105,19 @@ def _through_box(a: np.ndarray, e: np.ndarray, lo: np.ndarray, hi: np.ndarray) -
     return enter < leave
 
 
+def _ends(plain: np.ndarray, trimmed: np.ndarray, shared: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Pairwise segment ends (B, m, m, 3) for cable i (first) and j (second): the trimmed
+    end where the pair shares that anchor, else the plain one."""
+    sh = shared[None, :, :, None]
+    first = np.where(sh, trimmed[:, :, None], plain[:, :, None])
+    second = np.where(sh, trimmed[:, None, :], plain[:, None, :])
+    return first, second
+
+
 def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: float = 0.0,
-                       box_tol: float = BOX_REL) -> Interference:
+                       box_tol: float = BOX_REL, anchor_length: float = ANCHOR_LENGTH
+                       ) -> Interference:
     """Cable-cable distances and cable-platform collisions at poses.
 
     Parameters
@@ -112,6 +131,9 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     box_tol : float
         The platform box is shrunk by ``box_tol * (1 + its largest extent)`` m before the
         collision test (so cables leaving from its surface do not count).
+    anchor_length : float
+        Length along two cables from an anchor they share over which their contact is by
+        design and ignored, m (see the module docstring).
 
     Examples
     --------
@@ -130,10 +152,17 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     att = P[:, None, :3] + st.r                                  # (B, m, 3)
     ex = np.broadcast_to(robot.exits_world, att.shape)
     m = robot.m
-    D = segment_distance(att[:, :, None], ex[:, :, None], att[:, None, :], ex[:, None, :])
-    same = (np.all(robot.attach_local[:, None] == robot.attach_local[None], axis=2)
-            | np.all(robot.exits_world[:, None] == robot.exits_world[None], axis=2))
-    D = np.where(same[None] | np.eye(m, dtype=bool)[None], np.inf, D)
+    if not (np.isfinite(anchor_length) and anchor_length >= 0):
+        raise InvalidInputError("anchor_length", "must be a non-negative length, m")
+    if not (np.isfinite(min_distance) and min_distance >= 0):
+        raise InvalidInputError("min_distance", "must be a non-negative length, m")
+    share_a = np.all(robot.attach_local[:, None] == robot.attach_local[None], axis=2)
+    share_e = np.all(robot.exits_world[:, None] == robot.exits_world[None], axis=2)
+    trim = np.minimum(anchor_length, st.lengths)[..., None] * st.unit      # (B, m, 3)
+    a_i, a_j = _ends(att, att + trim, share_a)
+    e_i, e_j = _ends(ex, ex - trim, share_e)
+    D = segment_distance(a_i, e_i, a_j, e_j)
+    D = np.where(np.eye(m, dtype=bool)[None], np.inf, D)
     touch = min_distance + BOX_REL * (1.0 + float(np.abs(robot.exits_world).max()))
     close = np.any(D.reshape(len(P), -1) <= touch, axis=1)
     lo, hi = robot.attach_local.min(axis=0), robot.attach_local.max(axis=0)

@@ -48,6 +48,11 @@ class CableRobot:
     desired_workspace : (2, 3), optional
         ``[lower, upper]`` corners of the desired workspace, m (a flat box is a slice).
     name : str
+    platform_inside_exits : bool, default False
+        Whether the whole platform (the box of its attachment points) must stay inside the
+        exits' bounding box from the ground up; checked by
+        :func:`taut.cdpr.exit_box.platform_inside_exits` and, when True, a fourth
+        workspace condition (``"exits_box"``).
 
     Attributes
     ----------
@@ -79,6 +84,7 @@ class CableRobot:
     bounds: Any = None
     desired_workspace: Any = None
     name: str = "cable robot"
+    platform_inside_exits: bool = False
     # Derived fields, filled by __post_init__ (declared so that type checkers see them).
     m: int = field(init=False)
     dof: int = field(init=False)

@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 from ..errors import InvalidInputError
 from ._common import renamed_keyword, wrench_vertices
 from ._tol import TALLEST_CERTIFICATE_TOL
+from .base_motion import plan_moving_deployment, staged_lift_bound
 from .deploy import DeploymentResult, plan_deployment
 from .lift import LiftBound, lift_bound
 from .model import CableRobot
@@ -31,7 +32,7 @@ class TallestWorkspace:
         ``zmax`` of the tallest box with a verified deployment, m (NaN if none was found).
     workspace : (2, 3) or None
         That box.
-    deployment : DeploymentResult or None
+    deployment : DeploymentResult, MovingDeploymentResult (``stages > 1``) or None
         Its verified deployment (``deployment.success`` is True).
     certified_limit : float
         Lowest ``zmax`` at which :func:`lift_bound` refutes the box, m: every box reaching
@@ -81,7 +82,7 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
                       external_wrench: ArrayLike | None = None,
                       tol: float = 0.05, certificate_tol: float = TALLEST_CERTIFICATE_TOL,
                       samples: Sequence[int] = (41, 5), warm_start: bool = True,
-                      disturbance: ArrayLike | None = None,
+                      disturbance: ArrayLike | None = None, stages: int = 1,
                       **plan_options: Any) -> TallestWorkspace:
     """Tallest box with a verified deployment, by bisection on ``zmax``.
 
@@ -103,6 +104,12 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
     warm_start : bool
         Centre each search on the last verified placement (the previous box is a slice of
         the taller one, so that placement is a good start).
+    stages : int
+        1: one fixed placement (:func:`plan_deployment`). More: the active base moves
+        during the task, one placement per slice of the box along x
+        (:func:`taut.cdpr.base_motion.plan_moving_deployment`, whose per-slice
+        certificate :func:`taut.cdpr.base_motion.staged_lift_bound` then replaces
+        :func:`lift_bound`); ``deployment`` is then a ``MovingDeploymentResult``.
     **plan_options
         Passed to :func:`plan_deployment` (``required_twist``, ``grid``, ``maxiter``, ...).
 
@@ -126,6 +133,8 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
     ``certified_limit`` a proved upper bound.
     """
     box = workspace_box(workspace)
+    if not (isinstance(stages, (int, np.integer)) and 1 <= stages <= 50):
+        raise InvalidInputError("stages", "must be an integer from 1 to 50")
     if not (np.isfinite(tol) and tol > 0):
         raise InvalidInputError("tol", "must be a positive number of metres")
     if not (np.isfinite(certificate_tol) and certificate_tol > 0):
@@ -141,7 +150,16 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
         return b
 
     def certify(z: float) -> LiftBound:
+        if stages > 1:
+            return staged_lift_bound(robot, at(z), stages, external_wrench=D,
+                                     samples=samples)
         return lift_bound(robot, at(z), external_wrench=D, samples=samples)
+
+    def plan(start: CableRobot, z: float) -> Any:
+        if stages > 1:
+            return plan_moving_deployment(start, at(z), stages=stages, external_wrench=D,
+                                          **plan_options)
+        return plan_deployment(start, at(z), external_wrench=D, **plan_options)
 
     cert = certify(ztop)
     limit = np.inf
@@ -155,7 +173,7 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
             else:
                 lo = mid
         limit, cert = hi, hi_cert
-    best: DeploymentResult | None = None
+    best: Any = None
     height = np.nan
     tried: list[tuple[float, bool]] = []
     start = robot
@@ -163,7 +181,7 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
     hi = min(ztop, limit)                        # infeasible when refuted
     z = ztop if not cert.refutes else 0.5 * (lo + hi)
     while True:
-        res = plan_deployment(start, at(z), external_wrench=D, **plan_options)
+        res = plan(start, z)
         tried.append((z, bool(res.success)))
         if res.success:
             best, height, lo = res, z, z

@@ -12,7 +12,8 @@ from numpy.typing import ArrayLike
 from .._validate import as_array
 from ..errors import InvalidInputError
 from ._common import renamed_keyword
-from ._tol import BOX_REL
+from ._tol import BOX_REL, CLOSURE_TOL
+from .closure_workspace import closure_pass, inside_pass
 from .model import CableRobot
 from .wrench_set import wrench_feasible
 from .._validate import as_count, require_instance
@@ -67,8 +68,19 @@ class WorkspaceResult:
         Coverage with all three conditions.
     binding : (P,) str
         Per position, the first condition (in the order ``"limits"``, ``"tipping"``,
-        ``"sliding"``) whose addition makes it infeasible; ``""`` where feasible with every
-        condition the model has.
+        ``"sliding"``, ``"exits_box"``) whose addition makes it infeasible; ``""`` where
+        feasible with every condition the model has.
+    closure : (P,) bool or None
+        Wrench closure (positive tensions balance every wrench, no tension limits) at
+        every orientation; None unless asked for (``closure=True``).
+    coverage_closure : float or None
+        Fraction of positions (in the desired workspace) with wrench closure.
+    inside_exits : (P,) bool or None
+        The whole platform inside the exits' bounding box at every orientation
+        (:func:`taut.cdpr.exit_box.platform_inside_exits`); None unless the model has
+        ``platform_inside_exits``.
+    coverage_inside : float or None
+        Coverage with every condition of the model and the exits' box.
     """
 
     points: np.ndarray
@@ -82,6 +94,10 @@ class WorkspaceResult:
     feasible_sliding: np.ndarray | None = None
     coverage_sliding: float | None = None
     binding: np.ndarray | None = None
+    closure: np.ndarray | None = None
+    coverage_closure: float | None = None
+    inside_exits: np.ndarray | None = None
+    coverage_inside: float | None = None
 
 
 def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
@@ -89,7 +105,8 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
                               external_wrench: ArrayLike | None = None,
                               shape: tuple[int, ...] | None = None, chunk: int = 2048,
                               progress: Callable[[int, int], None] | None = None,
-                              disturbance: ArrayLike | None = None) -> WorkspaceResult:
+                              disturbance: ArrayLike | None = None, closure: bool = False,
+                              closure_tol: float = CLOSURE_TOL) -> WorkspaceResult:
     """Evaluate the wrench-feasible workspace at positions ``points`` (P, 3), m.
 
     A position belongs to the WFW when, at every orientation of ``orientations`` ((O, 3)
@@ -99,6 +116,20 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
     and, for ``feasible_tipping``, without tipping a mobile base. Vectorised (see
     :func:`taut.cdpr.wrench_set.wrench_feasible`). ``progress(done, total)`` is called after
     each block of ``chunk`` poses. Positions outside the frame raise :class:`InfeasiblePoseError`.
+
+    With ``closure=True`` the result also holds the wrench-closure workspace (exact test
+    per pose, positivity only, :mod:`taut.cdpr.closure_workspace`; ``closure_tol`` as for
+    :func:`taut.cdpr.wrench_closure`). When the model has ``platform_inside_exits``, the
+    platform staying inside the exits' bounding box is a fourth condition
+    (``inside_exits``, binding ``"exits_box"``).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> fc = load_cdpr_model("fastkit_fc")
+    >>> ws = wrench_feasible_workspace(fc, [[0, 0, 1.2], [-1.5, 0, 0.2]], closure=True)
+    >>> ws.feasible.tolist(), ws.closure.tolist()    # with gravity neither contains the other
+    ([False, True], [True, False])
     """
     require_instance(robot, CableRobot, "robot")
     chunk = as_count(chunk, "chunk", minimum=1)
@@ -113,22 +144,32 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
         passes.append(("tipping", True, False))
     if robot.has_sliding:
         passes.append(("sliding", True, True))
-    counter = _Progress(progress, poses.shape[0] * len(passes))
+    extra = int(closure) + int(robot.platform_inside_exits)
+    counter = _Progress(progress, poses.shape[0] * (len(passes) + extra))
     res = {name: _feasible_pass(robot, poses, tip, slide, ext, chunk, counter).reshape(Pn, On)
            for name, tip, slide in passes}
     feas = {name: np.asarray(r.all(axis=1)) for name, r in res.items()}
+    if robot.platform_inside_exits:
+        feas["exits_box"] = np.asarray(inside_pass(robot, poses, counter).reshape(Pn, On)
+                                       .all(axis=1))
     inside = _inside_desired(robot, pts)
     denom = max(int(inside.sum()), 1)
-    cov = {name: float((f & inside).sum() / denom) for name, f in feas.items()}
-    binding = np.full(Pn, "", dtype="<U7")
+    binding = np.full(Pn, "", dtype="<U9")
     so_far = np.ones(Pn, dtype=bool)
+    cov: dict[str, float] = {}
     for name, f in feas.items():               # the first condition that fails binds
         binding[so_far & ~f] = name
         so_far &= f
+        # limits, tipping and sliding are nested passes; the exits' box adds to all of them
+        cov[name] = float(((so_far if name == "exits_box" else f) & inside).sum() / denom)
+    wc = None if not closure else np.asarray(closure_pass(
+        robot, poses, closure_tol, chunk, counter).reshape(Pn, On).all(axis=1))
     last = "tipping" if "tipping" in res else "limits"
     return WorkspaceResult(pts, ori, feas["limits"], feas.get("tipping"), res[last], shape,
                            cov["limits"], cov.get("tipping"), feas.get("sliding"),
-                           cov.get("sliding"), binding)
+                           cov.get("sliding"), binding, wc,
+                           None if wc is None else float((wc & inside).sum() / denom),
+                           feas.get("exits_box"), cov.get("exits_box"))
 
 
 class _Progress:

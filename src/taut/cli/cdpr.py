@@ -163,7 +163,8 @@ def _orientations(rpy: Any, sweep: float) -> np.ndarray:
 
 
 def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
-               stabilisers: bool, as_json: bool, sweep: float = 0.0) -> None:
+               stabilisers: bool, as_json: bool, sweep: float = 0.0,
+               closure: bool = False) -> None:
     from ..cdpr import grid_points, wrench_feasible_workspace
 
     nx, ny, nz = (as_count(n, "grid", minimum=1) for n in grid)
@@ -177,14 +178,16 @@ def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
         region = robot.desired_workspace if robot.desired_workspace is not None \
             else robot.bounds
     pts, shape = grid_points(region, (nx, ny, nz))
-    total = len(pts) * len(ori) * (2 if robot.has_tipping else 1)
     with working("cdpr workspace") as update:
         ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape,
-                                       chunk=2048, progress=lambda d, t: update(d, total))
+                                       chunk=2048, progress=update, closure=closure)
     if plot is not None:
         from ..viz.cdpr import plot_workspace
+        from ..viz.cdpr_binding import plot_binding
         import matplotlib.pyplot as plt
-        fig = plot_workspace(ws, robot, plot)
+        three_d = min(shape) > 1              # a 3D grid: the binding condition as colour
+        fig = plot_binding(ws, robot, plot, view="3d") if three_d else \
+            plot_workspace(ws, robot, plot)
         plt.close(fig)
     if as_json:
         typer.echo(to_json(workspace_to_dict(robot, region, ws, len(pts), plot)))
@@ -196,9 +199,25 @@ def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
     if ws.feasible_tipping is not None and ws.coverage_tipping is not None:
         rows.append(["+ tipping", str(int(ws.feasible_tipping.sum())),
                      f"{100 * ws.coverage_tipping:.1f} %"])
+    rows += _extra_rows(ws)
     typer.echo(_table(["constraints", f"feasible of {len(pts)}", "coverage"], rows))
     if plot is not None:
         typer.echo(f"figure written to {plot}")
+
+
+def _extra_rows(ws: Any) -> list[list[str]]:
+    """Table rows of the conditions beyond limits and tipping the result carries."""
+    rows = []
+    if ws.feasible_sliding is not None and ws.coverage_sliding is not None:
+        rows.append(["+ sliding", str(int(ws.feasible_sliding.sum())),
+                     f"{100 * ws.coverage_sliding:.1f} %"])
+    if ws.inside_exits is not None and ws.coverage_inside is not None:
+        rows.append(["+ inside exits' box", str(int((ws.binding == "").sum())),
+                     f"{100 * ws.coverage_inside:.1f} %"])
+    if ws.closure is not None and ws.coverage_closure is not None:
+        rows.append(["wrench closure", str(int(ws.closure.sum())),
+                     f"{100 * ws.coverage_closure:.1f} %"])
+    return rows
 
 
 def register(app: typer.Typer) -> None:
@@ -258,10 +277,13 @@ def register(app: typer.Typer) -> None:
                                             ".pdf, .svg)."),
         stabilisers: bool = _STAB_OPT,
         as_json: bool = _JSON_OPT,
+        closure: bool = typer.Option(False, "--closure", help="Also compute the "
+                                     "wrench-closure workspace (positive tensions, no "
+                                     "limits; exact LP per pose)."),
     ) -> None:
         """Wrench-feasible workspace with and without tipping; coverage of the desired one."""
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
-        _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep)
+        _workspace(model, grid, box, rpy, plot, stabilisers, as_json, sweep, closure)
 
     add_commands(sub)
     add_simulate(sub)

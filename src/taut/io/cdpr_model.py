@@ -10,7 +10,9 @@ Top-level keys (unknown keys are errors; SI units):
 ``platform`` (``mass``, ``com``, ``inertia`` (3 numbers or 3x3), ``attachment_points``
 {name: [x, y, z]}), ``payload`` (``mass``, ``com``), ``cables`` (list; each ``name``,
 ``exit`` "base.point", ``attachment``, ``t_min``, ``t_max``), optional ``bounds`` and
-``desired_workspace`` ({``min``: [x, y, z], ``max``: [x, y, z]}).
+``desired_workspace`` ({``min``: [x, y, z], ``max``: [x, y, z]}), optional
+``platform_inside_exits`` (bool, default false: the platform must stay inside the exits'
+bounding box, a workspace condition).
 
 :func:`load_cdpr_model` accepts a preset name (``fastkit``, ``ipanema``) or a file path.
 """
@@ -91,6 +93,7 @@ class _ModelFile(_Strict):
     cables: list[_Cable] = Field(min_length=1)
     bounds: _Box | None = None
     desired_workspace: _Box | None = None
+    platform_inside_exits: bool = False
     # Elastic cables and winches, read by taut.io.cdpr_dynamics (validated there).
     dynamics: dict[str, Any] | None = None
 
@@ -146,7 +149,7 @@ def cdpr_model_from_mapping(data: dict[str, Any]) -> CableRobot:
             bounds=None if raw.bounds is None else (raw.bounds.min, raw.bounds.max),
             desired_workspace=(None if raw.desired_workspace is None else
                                (raw.desired_workspace.min, raw.desired_workspace.max)),
-            name=raw.name)
+            name=raw.name, platform_inside_exits=raw.platform_inside_exits)
     except InvalidModelError as exc:
         raise InvalidModelError(_file_field(exc, raw), exc.problem) from None
     except TautError as exc:

@@ -230,7 +230,12 @@ def workspace_to_dict(robot: CableRobot, region: np.ndarray, ws: WorkspaceResult
         "feasible": ws.feasible.astype(int).tolist(),
         "feasible_tipping": (None if ws.feasible_tipping is None else
                              ws.feasible_tipping.astype(int).tolist()),
-        "plot": None if plot is None else str(plot)}
+        "plot": None if plot is None else str(plot),
+        "coverage_sliding": ws.coverage_sliding,
+        "coverage_inside_exits": ws.coverage_inside,
+        "coverage_closure": ws.coverage_closure,
+        "closure": None if ws.closure is None else ws.closure.astype(int).tolist(),
+        "binding": None if ws.binding is None else [str(b) for b in ws.binding]}
 
 
 def twist_set_to_dict(robot: CableRobot, pose: np.ndarray, mode: str,

@@ -19,7 +19,8 @@ from ..cdpr.workspace import WorkspaceResult  # noqa: E402
 __all__ = ["plot_binding"]
 
 _STYLE = {"": ("tab:blue", "feasible"), "limits": ("0.8", "tension limits bind"),
-          "tipping": ("tab:orange", "tipping binds"), "sliding": ("tab:red", "sliding binds")}
+          "tipping": ("tab:orange", "tipping binds"), "sliding": ("tab:red", "sliding binds"),
+          "exits_box": ("tab:purple", "platform leaves the exits' box")}
 
 
 def _box_edges(box: np.ndarray) -> list[np.ndarray]:
