@@ -33,7 +33,7 @@ NOT_CALLED: dict[str, str] = {
         "LiftBound TallestWorkspace Mode HPolytopeBatch Interference CableFKResult "
         "ControlEvent ControlResult MonteCarloResult SettleResult StateCheck "
         "EquilibriaCheck TippingCheck TippingGridCheck SweepResult SheetScenario "
-        "Reference Task").split()},
+        "Reference Task MovingDeploymentResult").split()},
     **{name: "typing alias (Literal), not a function" for name in
        ("ModeName", "QPSolver", "TensionMethod")},
     "UnknownObstacleError": "an exception class",
@@ -47,7 +47,7 @@ HEAVY = frozenset(
     "check_tipping_grid run_sweep tallest_workspace plan_deployment lift_bound "
     "generate_suite find_route formation_library optimal_formation inverse_kinematics "
     "find_certificate motion_from_legs verify_motion Simulator cable_forward_kinematics "
-    "evaluate_chunk".split())
+    "evaluate_chunk plan_moving_deployment staged_lift_bound".split())
 
 
 @functools.lru_cache(maxsize=None)
@@ -100,7 +100,7 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         "md": f["mode"], "ats": f["ats"], "direction": np.eye(6)[0], "lengths":
         f["state"].lengths[0], "waypoints": [[0, 0, 1.0], [0.05, 0, 1.0]],
         "times": [0.0, 0.1], "reference": f["reference"], "controller": TorqueController(),
-        "model_errors": [], "friction": 0.5, "deployed": True,
+        "model_errors": [], "friction": 0.5, "deployed": True, "stages": 2,
         "positions": np.zeros((1, len(f["robot"].bases), 3)), "fld": "footprint",
         "scenario": f["scenario"], "team": f["scenario"].team, "clearance": 0.05,
         "robots": np.zeros((2, f["scenario"].team.sheet.n, 2)),

@@ -40,6 +40,7 @@ CASES = {
     "capacity_margin": (lambda r, p: cdpr.capacity_margin(r, p), "fastkit"),
     "wrench_closure": (lambda r, p: cdpr.wrench_closure(r, p), "fastkit_fc"),
     "cable_interference": (lambda r, p: cdpr.cable_interference(r, p), "fastkit"),
+    "platform_inside_exits": (lambda r, p: cdpr.platform_inside_exits(r, p), "fastkit"),
     "first_order_model": (lambda r, p: cdpr.first_order_model(r, p), "fastkit"),
     "available_twist_set": (lambda r, p: cdpr.available_twist_set(r, p), "fastkit"),
     "twist_capacities": (lambda r, p: cdpr.twist_capacities(r, p), "fastkit"),

@@ -5,8 +5,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from taut.cdpr import (lift_bound, place_bases, plan_moving_deployment, slice_box,
-                       staged_lift_bound, with_stabilisers, wrench_feasible)
+from taut.cdpr import (lift_bound, place_bases, plan_moving_deployment, staged_lift_bound,
+                       with_stabilisers, wrench_feasible)
+from taut.cdpr.base_motion import slice_box
 from taut.errors import InvalidInputError
 
 FULL = [[-2.5, -0.05, 0.2], [2.5, 0.05, 2.2]]

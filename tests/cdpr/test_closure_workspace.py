@@ -97,7 +97,7 @@ def test_inside_matches_sampling_the_platform_body(x, y, z, r, p, w):
     included) is inside the exits' box iff the corners are."""
     robot = load_cdpr_model("fastkit")
     pose = np.array([x, y, z, r, p, w])
-    got = bool(platform_inside_exits(robot, pose)[0])
+    got = platform_inside_exits(robot, pose)          # one pose: one bool
     lo, hi = robot.attach_local.min(0), robot.attach_local.max(0)
     s = np.linspace(0, 1, 7)
     lat = np.stack(np.meshgrid(s, s, s, indexing="ij"), -1).reshape(-1, 3)

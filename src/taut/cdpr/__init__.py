@@ -91,8 +91,8 @@ __all__ += [
 ]
 
 from .base_motion import (MovingDeploymentResult, plan_moving_deployment,  # noqa: E402
-                          slice_box, staged_lift_bound)
-from .exit_box import exits_box, platform_corners, platform_inside_exits  # noqa: E402
+                          staged_lift_bound)
+from .exit_box import platform_inside_exits  # noqa: E402
 
-__all__ += ["MovingDeploymentResult", "plan_moving_deployment", "slice_box",
-            "staged_lift_bound", "exits_box", "platform_corners", "platform_inside_exits"]
+__all__ += ["MovingDeploymentResult", "plan_moving_deployment", "staged_lift_bound",
+            "platform_inside_exits"]

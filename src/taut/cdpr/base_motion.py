@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._outcome import check_status
+from .._validate import as_count, require_instance
 from ..errors import InvalidInputError, TautError
 from ._common import wrench_vertices
 from .deploy import (DeploymentResult, _options, _PlacementScore, _required_twists, _search,
@@ -44,7 +45,13 @@ from .placement import place_bases, workspace_box
 from .workspace import grid_points
 from .wrench_set import wrench_feasible
 
-__all__ = ["MovingDeploymentResult", "plan_moving_deployment", "slice_box", "staged_lift_bound"]
+#: Most stages (placements of the moving base) a deployment may use: each adds a full
+#: placement search, and the per-slice certificate already stops refuting at 5 (FASTKIT).
+MAX_STAGES = 50
+#: Most interpolated base poses checked per change of stage.
+MAX_TRANSITIONS = 100
+
+__all__ = ["MovingDeploymentResult", "plan_moving_deployment", "staged_lift_bound"]
 
 
 def slice_box(box: np.ndarray, stages: int) -> np.ndarray:
@@ -61,6 +68,11 @@ def staged_lift_bound(robot: CableRobot, workspace: ArrayLike, stages: int, *,
     """The lift certificate of a staged deployment: :func:`lift_bound` of every slice; the
     one with the least slack (bound minus required force) is returned, and it refutes the
     staged plan when it refutes its slice. Samples along x are split over the slices."""
+    require_instance(robot, CableRobot, "robot")
+    stages = as_count(stages, "stages", minimum=1, maximum=MAX_STAGES)
+    if isinstance(samples, (str, bytes)) or np.ndim(samples) != 1 or len(samples) != 2:
+        raise InvalidInputError("samples", "must be two counts (along x, along z)")
+    samples = tuple(as_count(s, "samples", minimum=2, maximum=100_000) for s in samples)
     box = workspace_box(workspace, allow_flat=True)
     nx = int(samples[0]) if stages == 1 else max(2, int(np.ceil(samples[0] / stages)) + 1)
     certs = [lift_bound(robot, b, external_wrench=external_wrench, samples=(nx, samples[1]))
@@ -173,11 +185,10 @@ def plan_moving_deployment(robot: CableRobot, workspace: ArrayLike, *, stages: i
     -------
     MovingDeploymentResult
     """
+    require_instance(robot, CableRobot, "robot")
     box = workspace_box(workspace)
-    if not (isinstance(stages, (int, np.integer)) and 1 <= stages <= 50):
-        raise InvalidInputError("stages", "must be an integer from 1 to 50")
-    if not (isinstance(transitions, (int, np.integer)) and transitions >= 0):
-        raise InvalidInputError("transitions", "must be a non-negative integer")
+    stages = as_count(stages, "stages", minimum=1, maximum=MAX_STAGES)
+    transitions = as_count(transitions, "transitions", minimum=0, maximum=MAX_TRANSITIONS)
     mobile = [b.name for b in robot.bases if b.mobile]
     if not mobile:
         raise InvalidInputError("robot", "has no mobile base to deploy")

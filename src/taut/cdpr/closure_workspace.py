@@ -44,6 +44,6 @@ def closure_pass(robot: CableRobot, poses: np.ndarray, closure_tol: float, chunk
 
 def inside_pass(robot: CableRobot, poses: np.ndarray, counter: Any) -> np.ndarray:
     """Platform inside the exits' box at poses (B, 6) -> (B,) bool (cheap: one block)."""
-    out = platform_inside_exits(robot, poses)
+    out = np.asarray(platform_inside_exits(robot, poses), dtype=bool)    # poses are (B, 6)
     counter.step(out.size)
     return out

@@ -16,11 +16,13 @@ from itertools import product
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._validate import as_tolerance, require_instance
+from ._batching import is_single
 from ._tol import BOX_REL
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
 
-__all__ = ["exits_box", "platform_corners", "platform_inside_exits"]
+__all__ = ["platform_inside_exits"]
 
 
 def exits_box(robot: CableRobot) -> np.ndarray:
@@ -42,8 +44,9 @@ def platform_corners(robot: CableRobot, poses: np.ndarray) -> np.ndarray:
 
 
 def platform_inside_exits(robot: CableRobot, poses: ArrayLike, *,
-                          box_tol: float = BOX_REL) -> np.ndarray:
-    """Whether the whole platform lies inside the exits' bounding box, (B,) bool.
+                          box_tol: float = BOX_REL) -> np.ndarray | bool:
+    """Whether the whole platform lies inside the exits' bounding box: (B,) bool for a
+    batch of poses, a bool for one pose.
 
     Parameters
     ----------
@@ -60,8 +63,12 @@ def platform_inside_exits(robot: CableRobot, poses: ArrayLike, *,
     >>> platform_inside_exits(robot, [[2.2, 0, 1.0], [2.4, 0, 1.0]]).tolist()
     [True, False]
     """
+    require_instance(robot, CableRobot, "robot")
+    box_tol = as_tolerance(box_tol, "box_tol")
+    single = is_single(poses)
     P = as_poses(robot, poses)
     box = exits_box(robot)
     tol = box_tol * (1.0 + float(np.abs(robot.exits_world).max()))
     c = platform_corners(robot, P)
-    return np.all((c >= box[0] - tol) & (c <= box[1] + tol), axis=(1, 2))
+    inside = np.all((c >= box[0] - tol) & (c <= box[1] + tol), axis=(1, 2))
+    return bool(inside[0]) if single else inside

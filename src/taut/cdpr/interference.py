@@ -32,7 +32,7 @@ from ._tol import ANCHOR_LENGTH, BOX_REL, SEGMENT_PARALLEL, TINY
 from .kinematics import as_poses, cable_state
 from ..errors import InvalidInputError
 from .model import CableRobot
-from .._validate import as_tolerance, require_instance
+from .._validate import MAX_CDPR_LENGTH_M, as_bounded, as_tolerance, require_instance
 
 __all__ = ["segment_distance", "Interference", "cable_interference"]
 
@@ -146,14 +146,14 @@ def cable_interference(robot: CableRobot, poses: ArrayLike, *, min_distance: flo
     require_instance(robot, CableRobot, "robot")
     as_tolerance(min_distance, "min_distance")
     as_tolerance(box_tol, "box_tol")
+    anchor_length = as_bounded(anchor_length, "anchor_length", MAX_CDPR_LENGTH_M, "m",
+                               positive=False)
     single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)
     att = P[:, None, :3] + st.r                                  # (B, m, 3)
     ex = np.broadcast_to(robot.exits_world, att.shape)
     m = robot.m
-    if not (np.isfinite(anchor_length) and anchor_length >= 0):
-        raise InvalidInputError("anchor_length", "must be a non-negative length, m")
     if not (np.isfinite(min_distance) and min_distance >= 0):
         raise InvalidInputError("min_distance", "must be a non-negative length, m")
     share_a = np.all(robot.attach_local[:, None] == robot.attach_local[None], axis=2)

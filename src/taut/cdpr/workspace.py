@@ -132,6 +132,8 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
     ([False, True], [True, False])
     """
     require_instance(robot, CableRobot, "robot")
+    if not isinstance(closure, (bool, np.bool_)):
+        raise InvalidInputError("closure", f"must be true or false, got {closure!r}")
     chunk = as_count(chunk, "chunk", minimum=1)
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     pts = as_array(points, "points", shape=(None, 3))
