@@ -39,7 +39,6 @@ KNOWN_GAPS = frozenset({
     ("distribute_tensions", "external_wrench"), ("capacity_margin", "external_wrench"),
     ("capacity_margin", "disturbance"), ("lift_bound", "samples"), ("lift_bound", "workspace"),
     ("ik_constraints", "weights"), ("footprint_overlap", "box"),
-    ("cable_forward_kinematics", "initial_guess"),
     # flags and mode strings compared with `in`/`if`: an empty array is ambiguous
     *((f, "tipping") for f in ("wrench_feasible", "available_wrench_set", "axis_capacities",
                                "capacity_margin", "distribute_tensions")),
@@ -52,7 +51,7 @@ KNOWN_GAPS = frozenset({
     ("forward_kinematics", "method"), ("FKSolver", "method"), ("FKSolver", "backend"),
     ("find_route", "allow_crossing"), ("workspace_box", "allow_flat"),
     ("with_stabilisers", "deployed"), ("as_poses", "check_bounds"), ("Base", "mobile"),
-    ("cable_forward_kinematics", "all_solutions"), ("inverse_kinematics", "budget"),
+    ("inverse_kinematics", "budget"),
     ("tipping_moments", "tensions"), ("forward_kinematics_batch", "method"),
     ("grid_points", "shape"), ("zonotope_hrep", "center"), ("zonotope_hrep", "gens"),
     ("Parameter", "values"), ("Parameter", "arguments"), ("write_json", "obj"),
@@ -105,6 +104,37 @@ def _call(func, kwargs):
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)
 
+#: Heavy (callable, slot) pairs that still fail when every slot is fuzzed (``-m slow``):
+#: found by the first full run of the heavy cases, listed here as known gaps (strict xfail)
+#: until fixed.
+KNOWN_HEAVY_GAPS = frozenset({
+    ("Simulator", "backend"), ("check_equilibria", "corner_tendons"),
+    ("check_tipping_grid", "duration"), ("check_tipping_grid", "method"),
+    ("check_tipping_grid", "tipping"), ("evaluate_chunk", "params"),
+    ("evaluate_chunk", "start"), ("evaluate_chunk", "stop"), ("generate_suite", "count"),
+    ("generate_suite", "seed"), ("inverse_kinematics", "branch_boxes"),
+    ("monte_carlo", "engine"), ("monte_carlo", "model_errors"), ("monte_carlo", "settle"),
+    ("monte_carlo", "substeps"), ("plan", "search"), ("plan_deployment", "external_wrench"),
+    ("run_sweep", "limit"), ("run_sweep", "resume"), ("settle", "trace"),
+    ("simulate", "backend"), ("simulate", "engine"), ("simulate", "settle"),
+    ("staged_lift_bound", "workspace"), ("tallest_workspace", "certificate_tol"),
+    ("tallest_workspace", "external_wrench"), ("tallest_workspace", "samples"),
+    ("tallest_workspace", "tol"),
+})
+#: Heavy pairs where the wrong value is accepted and the full search runs past ``BOUND_S``
+#: (a deployment or bisection with, e.g., a wrong twist or option): known gaps, not run
+#: (each would cost ``BOUND_S`` of CI time to fail again).
+HEAVY_HANGS = frozenset({
+    ("plan_deployment", "disturbance"), ("plan_deployment", "limits"),
+    ("plan_deployment", "moving"), ("plan_deployment", "options"),
+    ("plan_deployment", "required_twist"), ("plan_deployment", "robot"),
+    ("plan_moving_deployment", "external_wrench"), ("plan_moving_deployment", "limits"),
+    ("plan_moving_deployment", "moving"), ("plan_moving_deployment", "required_twist"),
+    ("plan_moving_deployment", "robot"), ("tallest_workspace", "disturbance"),
+    ("tallest_workspace", "stages"), ("tallest_workspace", "warm_start"),
+    ("tallest_workspace", "robot"),
+})
+
 
 def _cases(heavy: bool) -> list:
     out = []
@@ -113,7 +143,9 @@ def _cases(heavy: bool) -> list:
             if (name in HEAVY) != heavy:
                 continue
             marks = [pytest.mark.xfail(strict=True, reason="known gap")] \
-                if (name, slot) in KNOWN_GAPS else []
+                if (name, slot) in KNOWN_GAPS | KNOWN_HEAVY_GAPS else []
+            if (name, slot) in HEAVY_HANGS:
+                marks = [pytest.mark.xfail(run=False, reason="known gap: runs past the bound")]
             out.append(pytest.param(module, name, slot, id=f"{name}.{slot}", marks=marks))
     return out
 
