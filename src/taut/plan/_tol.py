@@ -74,3 +74,7 @@ MIN_ROTATION_WEIGHT = 1e-9
 #: square root of its area (m/m): ``World.width`` is only a scale that normalises and bounds
 #: the passable-area term of eq. (13), so 0.1 % of it is ample.
 INSCRIBED_CIRCLE_RTOL = 1e-3
+#: The optimised narrow formation joins the formation library only when its narrowest width
+#: is at least this much below the compact formation's, m: one barely narrower opens no
+#: passage the compact one cannot pass and only adds a formation to search with.
+NARROWER_BY = 0.01
