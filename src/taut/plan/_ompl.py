@@ -55,6 +55,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ._rrt import SearchOutcome, rrt_connect
 from ._se2_space import PoseChecker
+from ._tol import MIN_ROTATION_WEIGHT
 
 __all__ = ["OMPL_SEARCHES", "Search", "SEARCHES", "engine", "ompl_search", "unwrap_shortest"]
 
@@ -125,7 +126,8 @@ class _Problem:
             b.setLow(i, float(bounds[0, i]))
             b.setHigh(i, float(bounds[1, i]))
         space.setBounds(b)
-        space.setSubspaceWeight(1, max(checker.radius, 1e-9))   # distance |dp| + R |dpsi|
+        # the SE(2) distance is |dp| + R |dpsi|
+        space.setSubspaceWeight(1, max(checker.radius, MIN_ROTATION_WEIGHT))
         si = self.si = ob.SpaceInformation(space)
         si.setStateValidityChecker(self._valid)
         self.motion = _motion_validator(ob, si, checker)

@@ -64,3 +64,17 @@ VERTEX_INSET = 1e-4
 SAME_POINT = 1e-12
 #: Turns within this of the smallest are equally good (Algorithm 2 side choice), rad.
 TURN_TIE = 1e-9
+#: SLSQP function tolerance of the formation optimiser (its cost, normalised units); the
+#: optimum is then checked by forward kinematics to FORMATION_MATCH_RTOL.
+FORMATION_FTOL = 1e-10
+#: Floor under the disc radius used as the rotation weight of OMPL's SE(2) distance
+#: (|dp| + R |dpsi|), m: a point-sized disc still gives rotation a positive weight.
+MIN_ROTATION_WEIGHT = 1e-9
+#: Precision of shapely's maximum inscribed circle of the free space, as a fraction of the
+#: square root of its area (m/m): ``World.width`` is only a scale that normalises and bounds
+#: the passable-area term of eq. (13), so 0.1 % of it is ample.
+INSCRIBED_CIRCLE_RTOL = 1e-3
+#: The optimised narrow formation joins the formation library only when its narrowest width
+#: is at least this much below the compact formation's, m: one barely narrower opens no
+#: passage the compact one cannot pass and only adds a formation to search with.
+NARROWER_BY = 0.01

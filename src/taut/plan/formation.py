@@ -50,6 +50,7 @@ Two uses: the *crossing* formation for obstacles up to a height and diameter, an
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -65,6 +66,9 @@ from .._validate import MAX_SHEET_LENGTH, as_bounded, as_count, require_instance
 
 __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
            "offset_crossings"]
+
+#: The formations :func:`optimal_formation` designs (its ``kind``).
+FormationKind = Literal["crossing", "compact", "narrow"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,7 +209,7 @@ def offset_crossings(formation: Formation, clearance: float, directions: int = 3
     return a[ok], lo[k, cols][ok], hi[k, cols][ok]
 
 
-def optimal_formation(team: Team, *, kind: str = "crossing", height: float = 0.0,
+def optimal_formation(team: Team, *, kind: FormationKind = "crossing", height: float = 0.0,
                       diameter: float = 0.0, width: float | None = None,
                       max_reach: float | None = None, weights: CostWeights | None = None,
                       sheet_margin: float = 0.0) -> Formation | None:
@@ -269,7 +273,7 @@ def optimal_formation(team: Team, *, kind: str = "crossing", height: float = 0.0
         cons.append({"type": "ineq", "fun": _curvature_constraint(team, prob, s)})
     try:
         z = minimize(prob.cost, prob.from_ik(start, s), method="SLSQP", constraints=cons,
-                     options={"maxiter": 200, "ftol": 1e-10}).x
+                     options={"maxiter": 200, "ftol": _tol.FORMATION_FTOL}).x
     except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - defensive
         z = np.full(prob.dec.length, np.nan)
     if np.all(np.isfinite(z)) and prob.admissible(z):

@@ -84,7 +84,7 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
     narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
                                                         width=world.width,
                                                         sheet_margin=sheet_margin)
-    if narrow is not None and _min_width(narrow) < _min_width(compact) - 0.01:
+    if narrow is not None and _min_width(narrow) < _min_width(compact) - _tol.NARROWER_BY:
         crossing.append(narrow)
     for h in _height_classes(scenario):
         group = [o for o in world.obstacles if o.height <= h]

@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 import shapely
 
 from .._outcome import check_status, deprecated_alias
@@ -229,7 +230,7 @@ def _sheet_slack(scenario: Scenario, robots: np.ndarray) -> tuple[float, int, in
     return float(slack[t, p]), int(t), int(iu[p]), int(ju[p])
 
 
-def verify_motion(scenario: Scenario, robots: np.ndarray, planned_object: np.ndarray, *,
+def verify_motion(scenario: Scenario, robots: ArrayLike, planned_object: ArrayLike, *,
                   sheet_margin: float = 0.0,
                   max_object_step: float = _tol.MAX_OBJECT_STEP) -> Verification:
     """Verify a sampled team motion as a continuous motion (see module docstring).
@@ -292,7 +293,7 @@ def verify_motion(scenario: Scenario, robots: np.ndarray, planned_object: np.nda
                         clear, slack, step)
 
 
-def resample_motion(robots: np.ndarray, planned_object: np.ndarray, factor: int
+def resample_motion(robots: ArrayLike, planned_object: ArrayLike, factor: int
                     ) -> tuple[np.ndarray, np.ndarray]:
     """``factor`` times denser samples of a motion: rigid intervals are interpolated as
     rigid motions (the object carried along), others linearly (planned object NaN at the

@@ -19,6 +19,7 @@ from .._validate import as_array, as_nonnegative, as_points, as_positive
 from .._validate import require_instances
 from ..errors import InvalidInputError, PlanningError
 from ..sheet.model import Sheet, check_hold_height
+from ._tol import INSCRIBED_CIRCLE_RTOL
 
 __all__ = ["Obstacle", "World", "Team", "Scenario", "UnknownObstacleError"]
 
@@ -165,7 +166,8 @@ class World:
         object.__setattr__(self, "free_space", pts)
         object.__setattr__(self, "obstacles", obs)
         object.__setattr__(self, "geometry", geom)
-        radius = shapely.maximum_inscribed_circle(geom, 1e-3 * np.sqrt(geom.area)).length
+        radius = shapely.maximum_inscribed_circle(
+            geom, INSCRIBED_CIRCLE_RTOL * np.sqrt(geom.area)).length
         object.__setattr__(self, "_width", 2.0 * float(radius))
 
     def obstacle(self, oid: str) -> Obstacle:

@@ -20,8 +20,8 @@ import numpy as np
 
 from ._descent import descend
 from ._kernel import Frame
-from ._tol import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL, EVENT_STEP_TOL,
-                   SUBSETS_UP_TO)
+from ._tol import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL, DEGENERATE_STEP,
+                   EVENT_STEP_TOL, SUBSETS_UP_TO)
 from ._jit import HAVE_NUMBA
 from .fk import forward_kinematics, forward_kinematics_batch
 from .model import Sheet
@@ -270,7 +270,7 @@ def resolve_step(tracker: Tracker, state: State, R0: np.ndarray, R1: np.ndarray,
         if tracker.trackable(state):
             lo, hi, before = tracker.crossing(state, R0, R1, s0)
         else:                                   # degenerate (>5 taut): leave it at once
-            lo, hi, before = s0, min(1.0, s0 + 1e-6), state
+            lo, hi, before = s0, min(1.0, s0 + DEGENERATE_STEP), state
         Rh = (1 - hi) * R0 + hi * R1
         if tracker.trackable(before) and branch(tracker.sheet, Rh[None], tracker.z,
                                                  before.support)[3][0] <= 0.0:

@@ -14,6 +14,9 @@ from typing import Callable, TypeVar
 import numpy as np
 from scipy.optimize import nnls
 
+from ._tol import (ARMIJO_C1, ARRIVAL_ACTIVE_TOL, DESCENT_EPS0, DESCENT_GRAD2_TOL,
+                   DESCENT_MIN_EPS, DESCENT_MIN_STEP)
+
 __all__ = ["min_norm_combination", "descend"]
 
 _J = np.array([1.0, 1.0, -1.0, -1.0])
@@ -37,7 +40,8 @@ def min_norm_combination(G: np.ndarray) -> np.ndarray:
 
 def descend(P: np.ndarray, x0: np.ndarray,
             arrive: Callable[[np.ndarray, np.ndarray], _Arrival | None], floor: float,
-            maxit: int = 3000, active_tol: float = 1e-6) -> np.ndarray | _Arrival | None:
+            maxit: int = 3000, active_tol: float = ARRIVAL_ACTIVE_TOL
+            ) -> np.ndarray | _Arrival | None:
     """Steepest descent of F(x) = q(x) + max_i (a_i . x + b_i) from ``x0`` (normalised
     units; P (N, 5) lifted points): epsilon-steepest-descent directions (minimum-norm
     element of the gradients of the epsilon-active pieces) with Armijo backtracking, eps
@@ -53,7 +57,7 @@ def descend(P: np.ndarray, x0: np.ndarray,
 
     x = x0.copy()
     f = F(x)
-    eps, t = 1e-3, 1.0
+    eps, t = DESCENT_EPS0, 1.0
     for it in range(maxit):
         vals = x @ (_J * x) + A @ x + b
         top = vals.max()
@@ -64,8 +68,8 @@ def descend(P: np.ndarray, x0: np.ndarray,
         active = vals >= top - eps
         g = min_norm_combination(2 * _J * x + A[active])
         gn2 = float(g @ g)
-        if gn2 < 1e-22:
-            if eps < 1e-12:
+        if gn2 < DESCENT_GRAD2_TOL:
+            if eps < DESCENT_MIN_EPS:
                 break
             eps *= 0.1
             continue
@@ -73,14 +77,14 @@ def descend(P: np.ndarray, x0: np.ndarray,
         while True:
             trial = x - t * g
             ft = F(trial)
-            if ft <= f - 1e-4 * t * gn2:
+            if ft <= f - ARMIJO_C1 * t * gn2:
                 break
             t *= 0.5
-            if t < 1e-14:
+            if t < DESCENT_MIN_STEP:
                 break
-        if t < 1e-14:
+        if t < DESCENT_MIN_STEP:
             t = 1.0
-            if eps < 1e-12:
+            if eps < DESCENT_MIN_EPS:
                 break
             eps *= 0.1
             continue

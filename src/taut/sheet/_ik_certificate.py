@@ -50,7 +50,8 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ._ik_branch import BranchProof, branch_proof, verify_branch_proof
-from ._tol import CERTIFICATE_MIN_MARGIN, RELAX_COS_SLACK, SPACING_MARGIN
+from ._tol import (CERTIFICATE_MIN_MARGIN, DEPTH_RTOL, MULTIPLIER_SUM_TOL, RELAX_COS_SLACK,
+                   SPACING_MARGIN)
 
 __all__ = ["IKCertificate", "CertificateKind", "depth_certificate", "radial_certificate",
            "triangle_certificate", "closure_lp_certificate", "verify_certificate",
@@ -109,7 +110,7 @@ def depth_certificate(depth: float, lengths: np.ndarray, hold_height: float
     if not depth > 0.0:
         return IKCertificate("depth", f"object height {hold_height - depth:.6g} is not "
                              f"below the holding height {hold_height:.6g}", margin=-depth)
-    short = lengths <= depth * (1 + 1e-12)
+    short = lengths <= depth * (1 + DEPTH_RTOL)
     if not np.any(short):
         return None
     i = int(np.argmin(lengths))
@@ -234,6 +235,6 @@ def verify_certificate(cert: IKCertificate, V: np.ndarray, rho: np.ndarray,
     if cert.kind == "closure_branch":
         return cert.proof is not None and verify_branch_proof(cert.proof, V, rho)
     y, lam = cert.multipliers, cert.direction
-    if y is None or lam is None or np.any(y < 0) or abs(y.sum() - 1.0) > 1e-12:
+    if y is None or lam is None or np.any(y < 0) or abs(y.sum() - 1.0) > MULTIPLIER_SUM_TOL:
         return False
     return bool(_separation(V, rho, y, lam).min() > 0.0)

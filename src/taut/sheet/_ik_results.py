@@ -8,6 +8,7 @@ import numpy as np
 
 from .._outcome import check_status
 from ._ik_certificate import IKCertificate
+from ._tol import IK_FEASIBLE_RTOL, TINY
 from .model import GEOMETRY_RTOL
 
 __all__ = ["IKResult", "IKConstraints"]
@@ -124,7 +125,8 @@ class IKConstraints:
         """Bool (...): every condition holds (tolerances relative to the balance scale)."""
         scale = np.max(np.abs(self.formation - self.formation.mean(axis=-2, keepdims=True)),
                        axis=(-2, -1))
-        return ((np.linalg.norm(self.balance, axis=-1) <= 1e-9 * np.maximum(scale, 1e-300))
-                & (np.abs(self.contact_residual).max(axis=-1) <= 1e-9 * np.maximum(scale, 1))
-                & (self.spacing.min(axis=-1) >= -GEOMETRY_RTOL * np.maximum(scale, 1e-300))
+        tol = IK_FEASIBLE_RTOL
+        return ((np.linalg.norm(self.balance, axis=-1) <= tol * np.maximum(scale, TINY))
+                & (np.abs(self.contact_residual).max(axis=-1) <= tol * np.maximum(scale, 1))
+                & (self.spacing.min(axis=-1) >= -GEOMETRY_RTOL * np.maximum(scale, TINY))
                 & (self.min_weight > 0) & (self.curvature > 0))

@@ -28,13 +28,11 @@ from scipy.optimize import linprog, minimize
 
 from ._ik_weights import closure_directions
 from ._kernel import Frame, reduced_hessian_min_eig
-from ._tol import (BOUNDARY_RTOL, EQUATION_RTOL, MIN_CURVATURE, MIN_WEIGHT)
+from ._tol import (BOUNDARY_RTOL, EQUATION_RTOL, IK_PAIR_SHRINK, IK_SLSQP_FTOL, MIN_CURVATURE,
+                   MIN_WEIGHT, RANK_TOL, TINY)
 
 __all__ = ["robots", "curvature", "check_solution", "joint_optimise", "multistart_search",
            "Candidate"]
-
-#: Rank tolerance (relative) of the tangent-space rows, as in the kernel's stability test.
-_RANK_RTOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -57,7 +55,7 @@ def _independent_rows(D: np.ndarray, rank: int) -> list[int]:
     for i in np.argsort(-np.linalg.norm(D, axis=1)):
         trial = chosen + [int(i)]
         sv = np.linalg.svd(D[trial], compute_uv=False)
-        if sv[-1] > _RANK_RTOL * max(float(sv[0]), 1e-300):
+        if sv[-1] > RANK_TOL * max(float(sv[0]), TINY):
             chosen = trial
         if len(chosen) == rank:
             break
@@ -80,7 +78,7 @@ def curvature(R: np.ndarray, V: np.ndarray) -> np.ndarray:
     A = frame.P[..., :4]
     D = A[:, 1:, :] - A[:, :1, :]
     sv = np.linalg.svd(D, compute_uv=False)
-    rank = np.sum(sv > _RANK_RTOL * np.maximum(sv[:, :1], 1e-300), axis=1)
+    rank = np.sum(sv > RANK_TOL * np.maximum(sv[:, :1], TINY), axis=1)
     out = np.full(B, np.inf)
     low = np.flatnonzero(rank < 4)
     if len(low):
@@ -211,7 +209,7 @@ def _slsqp(obj: Callable[[np.ndarray], tuple[float, np.ndarray]], z0: np.ndarray
     try:
         res = minimize(obj, z0, jac=True, method="SLSQP", constraints=cons,
                        bounds=[(None, None)] * N + [(0.0, 1.0)] * N,
-                       options={"maxiter": maxiter, "ftol": 1e-12})
+                       options={"maxiter": maxiter, "ftol": IK_SLSQP_FTOL})
     except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - defensive
         return None
     return np.asarray(res.x)
@@ -225,7 +223,7 @@ def joint_optimise(V: np.ndarray, rho: np.ndarray, phi: np.ndarray, w0: np.ndarr
     (theta, w) or None."""
     N = len(rho)
     obj = _alignment_objective(rho, phi) if ref is None else _motion_objective(rho, ref)
-    cons = _constraints(V, rho, 1 - 1e-7, MIN_WEIGHT * 10, need_curv)
+    cons = _constraints(V, rho, 1 - IK_PAIR_SHRINK, MIN_WEIGHT * 10, need_curv)
     z = _slsqp(obj, np.concatenate([th0, w0]), cons, N)
     return None if z is None else polish(V, rho, z[N:], z[:N])
 

@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._tol import (ARMIJO_C1, CLOSURE_RTOL, MAXENT_GRAD_TOL, MAXENT_MIN_STEP, MEDIAN_COINCIDE,
+                   MEDIAN_MIN_STEP, MEDIAN_RTOL, TINY)
+
 __all__ = ["maxent_weights", "closure_directions"]
 
 
@@ -45,17 +48,17 @@ def maxent_weights(V: np.ndarray, vo: np.ndarray, scale: float) -> np.ndarray:
     f, w = dual(lam)
     for _ in range(200):
         g = w @ E
-        if np.linalg.norm(g) < 1e-15:
+        if np.linalg.norm(g) < MAXENT_GRAD_TOL:
             break
         H = (E * w[:, None]).T @ E - np.outer(g, g)
         try:
-            step = -np.linalg.solve(H + 1e-300 * np.eye(2), g)
+            step = -np.linalg.solve(H + TINY * np.eye(2), g)
         except np.linalg.LinAlgError:
             step = -g
         t = 1.0
         while True:
             f_new, w_new = dual(lam + t * step)
-            if f_new <= f + 1e-4 * t * float(g @ step) or t < 1e-12:
+            if f_new <= f + ARMIJO_C1 * t * float(g @ step) or t < MAXENT_MIN_STEP:
                 break
             t *= 0.5
         lam, f, w = lam + t * step, f_new, w_new
@@ -65,7 +68,7 @@ def maxent_weights(V: np.ndarray, vo: np.ndarray, scale: float) -> np.ndarray:
 def _median_unit_vectors(p: np.ndarray, m: np.ndarray) -> np.ndarray | None:
     diff = p - m
     n = np.linalg.norm(diff, axis=1)
-    if n.min() <= 1e-13:
+    if n.min() <= MEDIAN_COINCIDE:
         return None
     return diff / n[:, None]
 
@@ -101,7 +104,7 @@ def closure_directions(a: np.ndarray, p: np.ndarray) -> np.ndarray | None:
             return None
         n = np.linalg.norm(p - m, axis=1)
         g = -(a[:, None] * u).sum(axis=0)
-        if np.linalg.norm(g) <= 1e-14 * total:
+        if np.linalg.norm(g) <= MEDIAN_RTOL * total:
             return u
         H = np.einsum("i,ijk->jk", a / n, np.eye(2)[None] - u[:, :, None] * u[:, None, :])
         try:
@@ -112,13 +115,13 @@ def closure_directions(a: np.ndarray, p: np.ndarray) -> np.ndarray | None:
         while True:
             trial = m + t * step
             f_new = phi(trial)
-            if f_new <= f + 1e-4 * t * float(g @ step) or t < 1e-14:
+            if f_new <= f + ARMIJO_C1 * t * float(g @ step) or t < MEDIAN_MIN_STEP:
                 break
             t *= 0.5
-        if t < 1e-14:
+        if t < MEDIAN_MIN_STEP:
             break
         m, f = trial, f_new
     u = _median_unit_vectors(p, m)
     if u is None:
         return None
-    return u if np.linalg.norm((a[:, None] * u).sum(axis=0)) <= 1e-10 * total else None
+    return u if np.linalg.norm((a[:, None] * u).sum(axis=0)) <= CLOSURE_RTOL * total else None

@@ -104,6 +104,18 @@ SNAP_MIN = 1e-13
 #: Relative widening of the compiled pre-screen of the snap test (its closed-form fit
 #: agrees with the SVD-based one to ~1e-12; the exact test runs on what passes).
 SCREEN_SLACK = 1e-6
+#: Circumcircle of three robots (geometry.minimum_enclosing_circle): the triangle counts as
+#: collinear when ``2 ab x ac`` (four times its area) is below this times its longest
+#: squared side (dimensionless; ~50 ulps, so only rounding-level triangles take the
+#: circle on their farthest pair).
+COLLINEAR_RTOL = 1e-14
+#: Slack of "inside the enclosing circle" in Welzl's algorithm, relative to the largest
+#: centred coordinate: rounding of the circle fit must not reject a point on the circle.
+CIRCLE_RTOL = 1e-12
+#: An IK contact point must lie inside the sheet by this much (relative to the sheet size;
+#: ``Sheet.contains(tol=-...)``): the same rounding margin as GEOMETRY_RTOL, on the other side,
+#: so a point given "on" an edge is rejected as not strictly inside.
+CONTACT_INSET_RTOL = 1e-9
 
 # --- Weight families (LP / QP for taut sets larger than the state determines) ---
 
@@ -155,6 +167,46 @@ DEFAULT_BRANCH_BOXES = 800
 #: refutations need fewer (7-40 on the benchmark), and it costs ~0.1 s where the search with
 #: its finite-difference curvature constraint (N <= 4) costs seconds.
 EARLY_BRANCH_BOXES = 64
+#: Residual of the balance equation and the contact equations (relative to the formation's
+#: largest centred coordinate, or 1 for contacts) under which ``IKConstraints.feasible``
+#: holds: a rounding allowance, the same value as the formation check's GEOMETRY_RTOL.
+IK_FEASIBLE_RTOL = 1e-9
+#: A reference robot closer than this horizontally to the object (normalised length) gives
+#: no direction to turn towards; its sheet direction is used instead.
+REFERENCE_MIN_RADIUS = 1e-9
+#: SLSQP function tolerance of the joint (angles, weights) optimisation (dimensionless
+#: objective in normalised units): tight; the result is then polished and checked against
+#: EQUATION_RTOL.
+IK_SLSQP_FTOL = 1e-12
+#: The joint optimisation keeps each robot pair inside ``1 - this`` of its sheet distance
+#: (dimensionless): strictly inside, 1000x BOUNDARY_RTOL, so the small moves of polishing
+#: keep the pairs within their limits.
+IK_PAIR_SHRINK = 1e-7
+#: A cable counts as too short for the depth when its length is at most ``depth * (1 + this)``
+#: (dimensionless): rounding of the given lengths (~1e-16) must not hide a cable at the depth.
+DEPTH_RTOL = 1e-12
+#: A relaxation certificate's multipliers must sum to 1 within this (dimensionless): they
+#: come from an LP solver, so rounding of ~1e-15 per entry is allowed, no more.
+MULTIPLIER_SUM_TOL = 1e-12
+#: Armijo sufficient-decrease constant (dimensionless) of the backtracking line searches
+#: (maximum-entropy weights, geometric median, nonsmooth descent): the usual textbook value.
+ARMIJO_C1 = 1e-4
+#: Maximum-entropy weights: Newton stops when the dual gradient's norm (dimensionless: the
+#: weighted mean of normalised offsets) is below this, i.e. at machine precision ...
+MAXENT_GRAD_TOL = 1e-15
+#: ... and its line search accepts any step once the step factor is below this.
+MAXENT_MIN_STEP = 1e-12
+#: Geometric median: the median counts as on one of the points (no unit vector there) when
+#: closer than this (dimensionless: the points are unit directions).
+MEDIAN_COINCIDE = 1e-13
+#: Geometric median: converged when the gradient's norm is below this times the total weight
+#: (dimensionless; machine precision of a sum of unit vectors) ...
+MEDIAN_RTOL = 1e-14
+#: ... and its damped Newton step is abandoned below this step factor (dimensionless).
+MEDIAN_MIN_STEP = 1e-14
+#: Closure directions are accepted when the weighted sum of the unit vectors is below this
+#: times the total weight (dimensionless): far above the median's convergence (1e-14).
+CLOSURE_RTOL = 1e-10
 
 # --------------------------------------------------------------------------- simulation
 
@@ -172,6 +224,20 @@ ARRIVAL_ACTIVE_TOL = 1e-6
 #: Rank tolerance (relative to the largest singular value) for affine independence of
 #: lifted points when choosing a support; the kernel's SINGULAR_RTOL order of magnitude.
 SUPPORT_RANK_RTOL = 1e-9
+#: Past a degenerate state (more than 5 taut cables, not trackable) the simulation leaves it
+#: at once: the next look is this fraction of a step further (dimensionless), far above
+#: EVENT_STEP_TOL so the state is actually left.
+DEGENERATE_STEP = 1e-6
+#: Nonsmooth descent: initial width (normalised area, as F) of the epsilon-active set of
+#: pieces; it shrinks by 10x whenever the descent stalls ...
+DESCENT_EPS0 = 1e-3
+#: ... down to this width, below which the descent stops at a (Clarke) stationary point.
+DESCENT_MIN_EPS = 1e-12
+#: Nonsmooth descent: a squared norm of the minimum-norm gradient below this (normalised)
+#: means the point is epsilon-stationary (norm 1e-11, rounding of O(1) gradients).
+DESCENT_GRAD2_TOL = 1e-22
+#: Nonsmooth descent: the Armijo line search gives up below this step length (normalised).
+DESCENT_MIN_STEP = 1e-14
 
 # --------------------------------------------------------------------------- backends
 

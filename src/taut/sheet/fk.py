@@ -273,7 +273,7 @@ def _user_units(frame: Frame, sheet: Sheet, c: Classified, hold_height: float,
     return obj, vo, lengths * frame.scale, tensions
 
 
-def forward_kinematics(sheet: Sheet, formation: np.ndarray, hold_height: float, *,
+def forward_kinematics(sheet: Sheet, formation: ArrayLike, hold_height: float, *,
                        mass: float | None = None, method: Method = "fast") -> FKResult:
     """Every rest state of the object for one robot formation.
 
@@ -373,7 +373,7 @@ def _forward_numpy(sheet: Sheet, formation: ArrayLike, z: float, mass: float | N
     return FKResult(tuple(eqs), funnel, method, sheet, R, z, mass)
 
 
-def forward_kinematics_batch(sheet: Sheet, formations: np.ndarray, hold_height: float, *,
+def forward_kinematics_batch(sheet: Sheet, formations: ArrayLike, hold_height: float, *,
                              mass: float | None = None, method: Method = "fast"
                              ) -> BatchFKResult:
     """Forward kinematics of many formations of one sheet at once.

@@ -27,9 +27,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_finite_scalar, as_nonnegative
 from ..errors import InvalidInputError
+from ._tol import CIRCLE_RTOL, COLLINEAR_RTOL
 
 __all__ = ["FormationMetrics", "formation_metrics", "minimum_enclosing_circle",
            "formation_size", "max_obstacle_height", "min_robot_distance",
@@ -56,7 +58,7 @@ def _circle_three(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarr
     ab, ac = b - a, c - a
     den = 2.0 * (ab[0] * ac[1] - ab[1] * ac[0])
     scale = max(np.dot(ab, ab), np.dot(ac, ac), np.dot(c - b, c - b))
-    if abs(den) <= 1e-14 * scale:
+    if abs(den) <= COLLINEAR_RTOL * scale:
         pairs = [(a, b), (a, c), (b, c)]
         p, q = max(pairs, key=lambda pq: float(np.dot(pq[0] - pq[1], pq[0] - pq[1])))
         return _circle_two(p, q)
@@ -67,7 +69,7 @@ def _circle_three(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarr
     return centre, float(np.hypot(ux, uy))
 
 
-def minimum_enclosing_circle(formation: np.ndarray) -> tuple[np.ndarray, float]:
+def minimum_enclosing_circle(formation: ArrayLike) -> tuple[np.ndarray, float]:
     """Smallest circle containing every robot (Welzl's randomised incremental algorithm,
     iterative form; expected O(N)).
 
@@ -88,7 +90,7 @@ def minimum_enclosing_circle(formation: np.ndarray) -> tuple[np.ndarray, float]:
     p = pts - origin
     p = p[np.random.default_rng(0).permutation(len(p))]
     scale = float(np.max(np.abs(p))) or 1.0
-    tol = 1e-12 * scale
+    tol = CIRCLE_RTOL * scale
 
     def inside(c: np.ndarray, r: float, q: np.ndarray) -> bool:
         return float(np.linalg.norm(q - c)) <= r + tol
@@ -108,7 +110,7 @@ def minimum_enclosing_circle(formation: np.ndarray) -> tuple[np.ndarray, float]:
     return c + origin, r
 
 
-def formation_size(formation: np.ndarray, margin: float = 0.0) -> float:
+def formation_size(formation: ArrayLike, margin: float = 0.0) -> float:
     """Formation size :math:`S_f = D_c + 2\\delta_s` (planning paper eq. 1).
 
     Parameters
@@ -130,7 +132,7 @@ def max_obstacle_height(object_height: float, height_margin: float = 0.0) -> flo
         height_margin, "height_margin")
 
 
-def min_robot_distance(formation: np.ndarray) -> tuple[float, tuple[int, int]]:
+def min_robot_distance(formation: ArrayLike) -> tuple[float, tuple[int, int]]:
     """Shortest inter-robot distance :math:`d_{min} = \\min_{i \\ne j} |\\mathbf{r}_i -
     \\mathbf{r}_j|` (planning paper eq. 3).
 
@@ -147,7 +149,7 @@ def min_robot_distance(formation: np.ndarray) -> tuple[float, tuple[int, int]]:
     return float(d[k]), (int(iu[k]), int(ju[k]))
 
 
-def max_obstacle_diameter(formation: np.ndarray, margin: float = 0.0) -> float:
+def max_obstacle_diameter(formation: ArrayLike, margin: float = 0.0) -> float:
     """Maximum traversable obstacle diameter :math:`D_{max} = d_{min} - 2\\delta_s`
     (planning paper eq. 4, our reading): an obstacle passing between the two closest robots
     keeps the side safety distance :math:`\\delta_s` (``margin``) from each. <= 0 means
@@ -187,7 +189,7 @@ class FormationMetrics:
     max_obstacle_height: float | None
 
 
-def formation_metrics(formation: np.ndarray, *, margin: float = 0.0,
+def formation_metrics(formation: ArrayLike, *, margin: float = 0.0,
                       object_height: float | None = None, height_margin: float = 0.0
                       ) -> FormationMetrics:
     """All formation quantities of the planning paper's eqs. (1)-(4) at once.

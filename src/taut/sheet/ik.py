@@ -51,6 +51,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_finite_scalar, as_positive
 from ..errors import InvalidInputError
@@ -58,11 +59,10 @@ from ._ik_certificate import (IKCertificate, closure_branch_certificate,
                               closure_lp_certificate, depth_certificate, radial_certificate,
                               triangle_certificate)
 from ._ik_results import IKConstraints, IKResult
-from ._ik_search import (Candidate, check_solution, curvature, joint_optimise,
-                         multistart_search)
+from ._ik_search import Candidate, check_solution, curvature, joint_optimise, multistart_search
 from ._ik_weights import closure_directions, maxent_weights
-from ._tol import (DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_BRANCH_BOXES, EARLY_SEARCHES,
-                   VERIFY_RTOL)
+from ._tol import (CONTACT_INSET_RTOL, DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_BRANCH_BOXES,
+                   EARLY_SEARCHES, REFERENCE_MIN_RADIUS, VERIFY_RTOL)
 from .fk import _check_mass, _check_sheet, forward_kinematics
 from .model import Sheet, check_hold_height
 from .results import GRAVITY
@@ -91,7 +91,7 @@ class _Target:
 
 def _contact(sheet: Sheet, contact: object | None) -> np.ndarray:
     vo = sheet.centroid if contact is None else as_array(contact, "contact", shape=(2,))
-    if not bool(sheet.contains(vo, tol=-1e-9)):
+    if not bool(sheet.contains(vo, tol=-CONTACT_INSET_RTOL)):
         raise InvalidInputError("contact", f"contact point ({vo[0]:.6g}, {vo[1]:.6g}) "
                                 "is not strictly inside the sheet")
     return vo
@@ -115,7 +115,7 @@ def _target(sheet: Sheet, object_position: object, hold_height: float, contact: 
     return _Target(p, z, d, vo, lengths, (sheet.vertices - vo) / s, rho, s)
 
 
-def contact_weights(sheet: Sheet, contact: object | None = None) -> np.ndarray:
+def contact_weights(sheet: Sheet, contact: ArrayLike | None = None) -> np.ndarray:
     """Maximum-entropy weights of a contact point: the unique :math:`w > 0`, :math:`\\sum
     w_i = 1`, :math:`\\sum w_i \\mathbf{v}_i = \\mathbf{v}_o` maximising :math:`-\\sum w_i
     \\log w_i` (barycentric coordinates when N = 3).
@@ -145,8 +145,8 @@ def contact_weights(sheet: Sheet, contact: object | None = None) -> np.ndarray:
     return maxent_weights(sheet.vertices, _contact(sheet, contact), sheet.size)
 
 
-def formation_from_angles(sheet: Sheet, object_position: object, hold_height: float,
-                          angles: object, *, contact: object | None = None) -> np.ndarray:
+def formation_from_angles(sheet: Sheet, object_position: ArrayLike, hold_height: float,
+                          angles: ArrayLike, *, contact: ArrayLike | None = None) -> np.ndarray:
     """Robot positions from the cable angles (planning paper eq. 10).
 
     :math:`\\mathbf{r}_i = \\mathbf{r}_o + \\sqrt{l_i^2 - d^2}\\,(\\cos\\theta_i, \\sin\\theta_i)`
@@ -199,9 +199,9 @@ def _least_squares_weights(V: np.ndarray, vo: np.ndarray, rel: np.ndarray) -> np
     return np.asarray((np.linalg.pinv(E) @ rhs[..., None])[..., 0])
 
 
-def ik_constraints(sheet: Sheet, object_position: object, hold_height: float,
-                   angles: object, weights: object | None = None, *,
-                   contact: object | None = None) -> IKConstraints:
+def ik_constraints(sheet: Sheet, object_position: ArrayLike, hold_height: float,
+                   angles: ArrayLike, weights: ArrayLike | None = None, *,
+                   contact: ArrayLike | None = None) -> IKConstraints:
     """Evaluate the all-taut stable-equilibrium conditions for given angles (eq. 10).
 
     Parameters
@@ -261,7 +261,7 @@ def _preferred_directions(t: _Target, heading: float, ref_n: np.ndarray | None
     sheet_dir = np.arctan2(t.V[:, 1], t.V[:, 0])
     if ref_n is None:
         return np.asarray(sheet_dir + heading)
-    far = np.linalg.norm(ref_n, axis=1) > 1e-9
+    far = np.linalg.norm(ref_n, axis=1) > REFERENCE_MIN_RADIUS
     return np.asarray(np.where(far, np.arctan2(ref_n[:, 1], ref_n[:, 0]), sheet_dir))
 
 
@@ -332,9 +332,9 @@ def _failure(sheet: Sheet, t: _Target, status: str, message: str,
                     message, cert, runs)
 
 
-def inverse_kinematics(sheet: Sheet, object_position: object, hold_height: float, *,
-                       contact: object | None = None, heading: float = 0.0,
-                       reference: object | None = None, mass: float | None = None,
+def inverse_kinematics(sheet: Sheet, object_position: ArrayLike, hold_height: float, *,
+                       contact: ArrayLike | None = None, heading: float = 0.0,
+                       reference: ArrayLike | None = None, mass: float | None = None,
                        budget: int = DEFAULT_BUDGET, seed: int = 0,
                        branch_boxes: int = DEFAULT_BRANCH_BOXES) -> IKResult:
     """Robot formation that holds the object stably at ``object_position`` with every

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, as_array, as_points, as_positive, check_range
 from ..errors import InfeasibleFormationError, InvalidInputError, InvalidSheetError
@@ -128,7 +129,7 @@ class Sheet:
         d = self.vertices[:, None, :] - self.vertices[None, :, :]
         return np.linalg.norm(d, axis=2)
 
-    def contains(self, point: np.ndarray, *, tol: float = GEOMETRY_RTOL) -> np.ndarray:
+    def contains(self, point: ArrayLike, *, tol: float = GEOMETRY_RTOL) -> np.ndarray:
         """Whether points (..., 2) lie in the closed polygon (tolerance relative to size)."""
         p = np.asarray(point, dtype=float)
         v = self.vertices
@@ -150,7 +151,7 @@ def check_hold_height(hold_height: float) -> float:
     return z
 
 
-def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formations"
+def check_formations(sheet: Sheet, formations: ArrayLike, field: str = "formations"
                      ) -> np.ndarray:
     """Validate a batch of formations, shape (B, N, 2), against the sheet.
 
@@ -202,7 +203,7 @@ def check_formations(sheet: Sheet, formations: np.ndarray, field: str = "formati
     return r
 
 
-def check_formation(sheet: Sheet, formation: np.ndarray, field: str = "formation"
+def check_formation(sheet: Sheet, formation: ArrayLike, field: str = "formation"
                     ) -> np.ndarray:
     """Validate one formation, shape (N, 2); see :func:`check_formations`."""
     require_instance(sheet, Sheet, "sheet")

@@ -46,6 +46,7 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array
 from ..errors import InvalidInputError, InvalidTrajectoryError
@@ -197,8 +198,8 @@ def _outcome(events: list[SimulationEvent] | tuple[SimulationEvent, ...], lost_n
                                f"rest state){'; recovered later' if back else ''}")
 
 
-def simulate(sheet: Sheet, formations: object, hold_height: float, *,
-             start: object | None = None, mass: float | None = None,
+def simulate(sheet: Sheet, formations: ArrayLike, hold_height: float, *,
+             start: ArrayLike | None = None, mass: float | None = None,
              backend: Backend = "auto") -> SimulationResult:
     """Quasi-static simulation of the object along a time series of formations.
 

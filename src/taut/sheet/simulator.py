@@ -6,6 +6,7 @@ docs/sheet_kinematics.md §1-§5, FK paper Sec. II)."""
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_positive
 from ..errors import InvalidInputError, InvalidTrajectoryError
@@ -69,8 +70,8 @@ class Simulator:
     True
     """
 
-    def __init__(self, sheet: Sheet, hold_height: float, formation: object, *,
-                 start: object | None = None, mass: float | None = None,
+    def __init__(self, sheet: Sheet, hold_height: float, formation: ArrayLike, *,
+                 start: ArrayLike | None = None, mass: float | None = None,
                  dt: float = 1.0 / 30.0, backend: Backend = "auto") -> None:
         self.sheet = _check_sheet(sheet)
         self.mass = _check_mass(mass)
@@ -157,7 +158,7 @@ class Simulator:
             check_formation(self.sheet, R1)      # raises with the pair named (and the step)
         return R1, step_dt, float(np.abs(R1 - self._R).max())
 
-    def step(self, formation: object | None = None, *, velocities: object | None = None,
+    def step(self, formation: ArrayLike | None = None, *, velocities: ArrayLike | None = None,
              dt: float | None = None) -> SimulatorState:
         """Advance one step and return the new :attr:`state`.
 

@@ -413,7 +413,7 @@ _SOLVERS: "weakref.WeakKeyDictionary[Sheet, dict[tuple[float, str], FKSolver]]" 
 _PER_SHEET = 16
 
 
-def cached_solver(sheet: Sheet, hold_height: float, method: str) -> FKSolver:
+def cached_solver(sheet: Sheet, hold_height: float, method: Method) -> FKSolver:
     """The :class:`FKSolver` for ``(sheet, hold_height, method)``, built once and reused
     (``sheet`` already a validated :class:`Sheet`; ``hold_height`` a validated float)."""
     per = _SOLVERS.get(sheet)
@@ -424,5 +424,5 @@ def cached_solver(sheet: Sheet, hold_height: float, method: str) -> FKSolver:
     if solver is None:
         if len(per) >= _PER_SHEET:
             per.clear()
-        solver = per[key] = FKSolver(sheet, hold_height, method=method)  # type: ignore[arg-type]
+        solver = per[key] = FKSolver(sheet, hold_height, method=method)
     return solver
