@@ -146,3 +146,16 @@ def solve_packed(R, fpack, ipack, out):
         scale, dist = similar_fit(R, A)
         near = fpack[g + 4] < dist <= fpack[g + 5] and scale <= fpack[g + 6]
     return k, stable, pending, near
+
+
+@jit
+def snap_screen_batch(Rb, A, low, high, top):
+    """The snap screen of ``solve_packed`` on every formation of ``Rb`` (B, N, 2): within
+    ``(low, high]`` of a similar copy of the sheet (centred vertices ``A``), scale at most
+    ``top`` -> (B,) bool (``FKSolver._snap`` makes the exact test on those)."""
+    B = Rb.shape[0]
+    out = np.zeros(B, dtype=np.bool_)
+    for b in range(B):
+        scale, dist = similar_fit(Rb[b], A)
+        out[b] = low < dist <= high and scale <= top
+    return out

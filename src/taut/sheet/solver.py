@@ -355,22 +355,20 @@ class FKSolver:
                    ) -> tuple[np.ndarray, np.ndarray]:
         """Resolve weight families and snap formations next to a similar copy of the
         sheet, per formation (both rare), keeping rows grouped by formation in order."""
-        B = len(Rb)
         pending = np.flatnonzero(rows[:, 0] == sk.PENDING) if len(rows) else rows[:0, 0]
         for b in np.unique(form[pending.astype(np.intp)]) if len(pending) else ():
             sel = np.flatnonzero(form == b)
             block = rows[sel]
             self._resolve_families(Rb[b], block)
             rows[sel] = block
-        todo = np.arange(B)
-        copies, scale, dist = similar_copy(self.sheet.vertices, Rb[todo])
-        size = self.sheet.size
-        near = (dist > SNAP_MIN * size) & (dist <= SNAP_TOL * size) & (scale <= 1.0)
-        if not near.any():
+        # The compiled screen on every formation (a few ns each); the exact test of
+        # ``_snap`` only on the (rare) formations that pass it.
+        near = np.flatnonzero(bk.snap_screen_batch(Rb, self._A, *_snap_screen(self._scale)))
+        if not len(near):
             return rows, form
         parts: dict[int, np.ndarray] = {}
-        for b in todo[near]:
-            snapped = self._snap(Rb[b])
+        for b in near:
+            snapped = self._snap(Rb[b], screened=True)
             if snapped is not None:
                 parts[int(b)] = snapped
         if not parts:
