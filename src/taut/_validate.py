@@ -11,7 +11,8 @@ from .errors import InvalidInputError
 
 __all__ = ["as_array", "as_points", "as_positive", "as_finite_scalar", "as_nonnegative",
            "check_range", "as_mass", "as_count", "as_box", "require_instance",
-           "require_nonempty", "LIMITS", "require_instances", "as_tolerance", "as_path", "as_choice"]
+           "require_nonempty", "LIMITS", "require_instances", "as_tolerance", "as_path", "as_choice",
+           "as_flag"]
 
 
 def as_array(value: Any, field: str, *, ndim: int | None = None,
@@ -317,3 +318,21 @@ def as_choice(value: Any, choices: Any, field: str) -> str:
         raise InvalidInputError(field, f"unknown {field} {value!r}; choose one of "
                                        + ", ".join(map(str, choices)))
     return value
+
+
+def as_flag(value: Any, field: str) -> bool:
+    """``value`` as a Python bool if it is a ``bool`` or a numpy bool, else an error (an
+    array or a string in place of a switch is not silently truthy or ambiguous).
+
+    Examples
+    --------
+    >>> as_flag(True, "tipping")
+    True
+    >>> as_flag("no", "tipping")
+    Traceback (most recent call last):
+    ...
+    taut.errors.InvalidInputError: tipping: must be True or False, got str
+    """
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidInputError(field, f"must be True or False, got {type(value).__name__}")
+    return bool(value)

@@ -133,7 +133,7 @@ def test_cli_twist_set(capsys, tmp_path):
 @pytest.mark.parametrize("args, field", [
     (["twist-set", "fastkit", "--pose", "0", "0", "1", "--moving", "ghost"], "mode.moving"),
     (["twist-set", "fastkit", "--pose", "0", "0", "1", "--mode", "fly"], "mode"),
-    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--cable-speed", "-1"], "limits.cable"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--cable-speed", "-1"], "--cable-speed"),
     (["twist-set", "fastkit", "--pose", "nan", "0", "1"], "pose"),
     (["deploy", "fastkit", "--workspace", "-2.5", "2.5", "0", "0", "0.2", "1"], "workspace"),
     (["deploy", "fastkit", "--workspace", "-2.5", "2.5", "0", "nan", "0.2", "1"], "workspace"),
@@ -438,9 +438,9 @@ def test_cli_deploy_refuted_exit_1(capsys, tmp_path):
      "seed"),
     (["deploy", "fastkit", "--workspace", "-2.5", "2.5", "0", "0.1", "0.2", "1", "--maxiter",
       "-1"], "maxiter"),
-    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--base-speed", "-1"], "limits.base"),
-    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--yaw-rate", "0"], "limits.base"),
-    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--cable-speed", "0"], "limits.cable"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--base-speed", "-1"], "--base-speed"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--yaw-rate", "0"], "--yaw-rate"),
+    (["twist-set", "fastkit", "--pose", "0", "0", "1", "--cable-speed", "0"], "--cable-speed"),
 ])
 def test_cli_settings_errors(args, field):
     """Optimiser settings and speed limits a user can mistype: typed errors, no search run."""

@@ -90,6 +90,16 @@ def test_huge_numbers_refused(capsys, argv, field):
     assert field in _error(capsys, argv)
 
 
+@pytest.mark.parametrize("option, value", [("--cable-speed", "1e308"), ("--cable-speed", "0"),
+                                           ("--base-speed", "1e308"), ("--yaw-rate", "-1")])
+def test_twist_set_speed_errors_name_the_option(capsys, option, value):
+    """The refused speed limit is named by the option the user typed (it used to say
+    ``limits.cable`` / ``limits.base``, the model's field)."""
+    err = _error(capsys, ["cdpr", "twist-set", "fastkit", *POSE, option, value])
+    assert err.startswith(f"taut: error: {option}: "), err
+    assert "limits." not in err
+
+
 def test_huge_tension_limit():
     """t_max = 1e308 is outside the accepted range (not "infeasible" by overflow)."""
     from dataclasses import replace

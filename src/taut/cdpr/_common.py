@@ -10,12 +10,16 @@ from typing import Any
 import numpy as np
 
 from .._outcome import check_status
-from .._validate import as_array
+from .._validate import MAX_CDPR_LENGTH_M, MAX_TENSION_N, as_array, check_range
 from ..errors import InvalidInputError
 from .kinematics import CableState, gravity_wrench, tipping_matrix
 from ._tol import FEAS_REL, RANK_TOL
 from .model import CableRobot
 from .sliding import sliding_rows
+
+#: Largest |component| of an external wrench, N or N m (the largest tension limit times the
+#: largest cable-robot length: far beyond any cable's reach, far from float64 overflow).
+MAX_WRENCH = MAX_TENSION_N * MAX_CDPR_LENGTH_M
 
 
 @lru_cache(maxsize=64)
@@ -44,8 +48,9 @@ def required_wrench(robot: CableRobot, state: CableState, external: Any = None,
     """The wrench the cables must apply, ``-(w_e + w_ext)`` (B, n) (FASTKIT eqs. 17, 19)."""
     w = gravity_wrench(robot, state.R)
     if external is not None:
-        ext = as_array(external, field)
-        if ext.shape[-1] != robot.dof or ext.ndim > 2:
+        ext = check_range(external, field, MAX_WRENCH, "N or N m")
+        if (ext.ndim not in (1, 2) or ext.shape[-1] != robot.dof
+                or (ext.ndim == 2 and ext.shape[0] not in (1, w.shape[0]))):
             raise InvalidInputError(field, f"must have {robot.dof} components (forces, N"
                                            + (", then moments, N m)" if robot.dof == 6 else ")"))
         w = w + ext
@@ -109,9 +114,9 @@ def wrench_vertices(robot: CableRobot, external_wrench: Any, field: str = "exter
     (n,) is one vertex."""
     if external_wrench is None:
         return np.zeros((1, robot.dof))
-    D = as_array(external_wrench, field)
+    D = check_range(external_wrench, field, MAX_WRENCH, "N or N m")
     D = D[None, :] if D.ndim == 1 else D
-    if D.ndim != 2 or D.shape[1] != robot.dof:
+    if D.ndim != 2 or D.shape[1] != robot.dof or D.shape[0] == 0:
         raise InvalidInputError(field, f"must be (V, {robot.dof}) vertices of extra "
                                        "external wrenches (N, N m)")
     return D

@@ -29,7 +29,7 @@ from ._tol import (FK_DAMPING_MAX, FK_DAMPING_MIN, FK_DAMPING_START, FK_MAX_ITER
 from ._batching import unbatch
 from .kinematics import as_poses, rotation_matrices
 from .model import CableRobot
-from .._validate import as_count, require_instance
+from .._validate import as_count, as_flag, require_instance
 
 __all__ = ["CableFKResult", "cable_forward_kinematics"]
 
@@ -191,6 +191,7 @@ def cable_forward_kinematics(robot: CableRobot, lengths: ArrayLike, *,
     require_instance(robot, CableRobot, "robot")
     as_count(restarts, "restarts", maximum=1000)
     as_count(seed, "seed")
+    all_solutions = as_flag(all_solutions, "all_solutions")
     lengths_arr = as_array(lengths, "lengths")
     single = lengths_arr.ndim == 1
     if single:
@@ -208,7 +209,11 @@ def cable_forward_kinematics(robot: CableRobot, lengths: ArrayLike, *,
         bp = as_base_poses(robot, base_poses)
         exits = np.broadcast_to(moved_exits(robot, bp), (B, robot.m, 3))
     start = _default_start(robot) if initial_guess is None else initial_guess
-    x0 = np.broadcast_to(as_poses(robot, start, "initial_guess", check_bounds=False), (B, 6))
+    x0 = as_poses(robot, start, "initial_guess", check_bounds=False)
+    if x0.shape[0] not in (1, B):
+        raise InvalidInputError("initial_guess", f"must be one pose (6,) or ({B}, 6), one per "
+                                                 "sample")
+    x0 = np.broadcast_to(x0, (B, 6))
     p, R, res, it = _solve(exits, robot.attach_local, lengths_arr, x0[:, :3].copy(),
                            rotation_matrices(x0[:, 3:]))
     sols = [(p, R, res)]

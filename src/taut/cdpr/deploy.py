@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike
 from scipy.optimize import differential_evolution, minimize
 
 from .._outcome import check_status, deprecated_alias
-from .._validate import as_array
+from .._validate import MAX_SPEED, as_array, check_range
 from ..errors import InvalidInputError, TautError
 from ._common import renamed_keyword, wrench_vertices
 from ._tol import DEPLOY_DE_TOL, DEPLOY_NM_FATOL, DEPLOY_NM_XATOL, FIXED_COORD_WIDTH
@@ -183,6 +183,10 @@ def evaluate_deployment(robot: CableRobot, points: np.ndarray,
     pm = capacity_margin(robot, points, external_wrench=external_wrench, tipping=True)
     tm = None
     if twists is not None:
+        twists = check_range(twists, "twists", MAX_SPEED, "m/s or rad/s")
+        if twists.ndim not in (1, 2) or twists.shape[-1] != robot.dof or not twists.size:
+            raise InvalidInputError("twists", f"must be (T, {robot.dof}) required twists")
+        twists = twists.reshape(-1, robot.dof)
         ats = available_twist_set(robot, points, limits, "task", moving)
         tm = min(float(ats.margin(t).min()) for t in twists)
     return float(pm.min()), pm, tm

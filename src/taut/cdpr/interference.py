@@ -32,7 +32,8 @@ from ._tol import ANCHOR_LENGTH, BOX_REL, SEGMENT_PARALLEL, TINY
 from .kinematics import as_poses, cable_state
 from ..errors import InvalidInputError
 from .model import CableRobot
-from .._validate import MAX_CDPR_LENGTH_M, as_bounded, as_tolerance, require_instance
+from .._validate import (MAX_CDPR_LENGTH_M, as_array, as_bounded, as_tolerance, check_range,
+                         require_instance)
 
 __all__ = ["segment_distance", "Interference", "cable_interference"]
 
@@ -41,6 +42,15 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
                      ) -> np.ndarray:
     """Closest distance between segments ``[p0, p1]`` and ``[q0, q1]``, broadcast over
     leading axes ((..., 3) each) -> (...). Segments of zero length are points."""
+    p0, p1, q0, q1 = (check_range(as_array(v, k), k, MAX_CDPR_LENGTH_M, "m")
+                      for v, k in ((p0, "p0"), (p1, "p1"), (q0, "q0"), (q1, "q1")))
+    for v, k in ((p0, "p0"), (p1, "p1"), (q0, "q0"), (q1, "q1")):
+        if v.ndim == 0 or v.shape[-1] != 3:
+            raise InvalidInputError(k, "must be points (..., 3)")
+    try:
+        np.broadcast_shapes(p0.shape, p1.shape, q0.shape, q1.shape)
+    except ValueError:
+        raise InvalidInputError("p0", "p0, p1, q0 and q1 must broadcast together") from None
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
     a = np.einsum("...i,...i", d1, d1)
     e = np.einsum("...i,...i", d2, d2)

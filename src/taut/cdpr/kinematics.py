@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array, require_instance
+from .._validate import as_array, as_flag, require_instance
 from .._validate import MAX_CDPR_LENGTH_M, check_range
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ._batching import is_single, unbatch
@@ -34,6 +34,7 @@ def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose",
     :class:`InfeasiblePoseError` when a position lies outside ``robot.bounds``.
     """
     require_instance(robot, CableRobot, "robot")
+    check_bounds = as_flag(check_bounds, "check_bounds")
     arr = check_range(poses, field, MAX_CDPR_LENGTH_M, "m or rad")
     if arr.ndim == 1:
         arr = arr[None, :]
@@ -139,8 +140,12 @@ def cable_state(robot: CableRobot, poses: ArrayLike, *, validated: bool = False
     >>> cable_state(robot, [[0, 0, 1.0], [0.5, 0, 1.2]]).lengths.shape   # a batch
     (2, 8)
     """
+    validated = as_flag(validated, "validated")
     single = not validated and is_single(poses)
     P = np.asarray(poses) if validated else as_poses(robot, poses)
+    if validated and (P.ndim != 2 or P.shape[1] != 6 or P.dtype != np.float64):
+        raise InvalidInputError("validated", "True needs poses already checked as a float64 "
+                                             "(B, 6) array (see as_poses)")
     R = rotation_matrices(P[:, 3:])
     r = np.einsum("bij,mj->bmi", R, robot.attach_local)
     vec = robot.exits_world[None, :, :] - (P[:, None, :3] + r)

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
-from .._validate import as_array
+from .._validate import MAX_BATCH, as_array
 from ..errors import InvalidInputError
 from ._common import renamed_keyword, wrench_vertices
 from ._tol import LIFT_FTOL, LIFT_GTOL, LIFT_RTOL, REFUTE_REL
@@ -313,9 +313,14 @@ def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
     require_instance(robot, CableRobot, "robot")
     as_tolerance(refute_tol, "refute_tol")
     box = workspace_box(workspace, allow_flat=True)
-    sm = np.asarray(samples, dtype=float)
+    if isinstance(samples, (str, bytes)):
+        raise InvalidInputError("samples", "must be two positive integers nx ny")
+    sm = as_array(samples, "samples")
     if sm.shape != (2,) or np.any(sm < 1) or np.any(sm != np.round(sm)):
         raise InvalidInputError("samples", "must be two positive integers nx ny")
+    if float(sm[0]) * float(sm[1]) > MAX_BATCH:
+        raise InvalidInputError("samples", f"{float(sm[0]) * float(sm[1]):g} points exceed "
+                                           f"the accepted range {MAX_BATCH:g} points")
     zt = float(box[1, 2])
     top = np.array([[box[0, 0], box[0, 1], zt], [box[1, 0], box[1, 1], zt]])
     pts, _ = grid_points(top, (int(sm[0]), int(sm[1]), 1))

@@ -23,7 +23,7 @@ from .._validate import MAX_TENSION_N, as_array, as_finite_scalar, check_range
 from ..errors import InvalidModelError
 from .footprint import check_footprint
 from .parts import Base, Cable, Payload, Platform
-from .._validate import require_instance, require_instances
+from .._validate import as_flag, require_instance, require_instances
 
 __all__ = ["Base", "Platform", "Payload", "Cable", "CableRobot", "check_footprint",
            "with_stabilisers", "with_friction"]
@@ -277,6 +277,7 @@ def with_stabilisers(robot: CableRobot, deployed: bool = True) -> CableRobot:
     (or retracted). Deployed stabilisers replace the support polygon by the convex hull of
     wheels and stabiliser feet, so tipping limits can only get looser."""
     require_instance(robot, CableRobot, "robot")
+    deployed = as_flag(deployed, "deployed")
     from dataclasses import replace
     bases = tuple(replace(b, exit_points=dict(b.exit_points),
                           stabilisers_deployed=bool(deployed and b.stabilisers is not None))

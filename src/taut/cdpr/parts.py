@@ -86,6 +86,10 @@ class Base:
 
     def __post_init__(self) -> None:
         f = f"bases[{self.name}]"
+        if not isinstance(self.mobile, (bool, np.bool_)):
+            raise InvalidModelError(f"{f}.mobile", "must be True or False, got "
+                                                   f"{type(self.mobile).__name__}")
+        object.__setattr__(self, "mobile", bool(self.mobile))
         names, pts = _named_points(self.exit_points, f"{f}.exit_points")
         object.__setattr__(self, "exit_names", names)
         object.__setattr__(self, "exit_local", pts)

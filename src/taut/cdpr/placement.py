@@ -10,10 +10,10 @@ from typing import Any, Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array
+from .._validate import MAX_CDPR_LENGTH_M, as_array, as_box, check_range
 from ..errors import InvalidInputError
 from .model import CableRobot
-from .._validate import require_instance
+from .._validate import as_flag, require_instance
 
 __all__ = ["workspace_box", "place_bases", "footprint_overlap"]
 
@@ -25,7 +25,8 @@ def workspace_box(box: ArrayLike, field: str = "workspace", *, allow_flat: bool 
     Raises :class:`InvalidInputError` on NaN/inf, a wrong shape, or a box with no volume
     (some ``max <= min``; with ``allow_flat`` only ``max < min``, so slices such as the
     FASTKIT preset's ``desired_workspace`` pass)."""
-    b = as_array(box, field)
+    allow_flat = as_flag(allow_flat, "allow_flat")
+    b = check_range(box, field, MAX_CDPR_LENGTH_M, "m")
     if b.shape == (6,):                       # CLI order: xmin xmax ymin ymax zmin zmax
         b = b.reshape(3, 2).T
     if b.shape != (2, 3):
@@ -72,7 +73,7 @@ def footprint_overlap(robot: CableRobot, box: np.ndarray) -> float:
     0.0
     """
     require_instance(robot, CableRobot, "robot")
-    box = as_array(box, "box", shape=(2, None))
+    box = as_box(box, "box", allow_flat=True)
     rect = np.array([[box[0, 0], box[0, 1]], [box[1, 0], box[0, 1]],
                      [box[1, 0], box[1, 1]], [box[0, 0], box[1, 1]]])
     worst = 0.0
@@ -84,7 +85,11 @@ def footprint_overlap(robot: CableRobot, box: np.ndarray) -> float:
         for P, Q in ((poly, rect), (rect, poly)):
             e = np.roll(P, -1, axis=0) - P
             nrm = np.column_stack([e[:, 1], -e[:, 0]])
-            nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+            size = np.linalg.norm(nrm, axis=1, keepdims=True)
+            keep = size[:, 0] > 0              # a flat box's zero-length edges: no axis
+            nrm = nrm[keep] / size[keep]
+            if not nrm.size:
+                continue
             a, c = P @ nrm.T, Q @ nrm.T
             depth = min(depth, float(np.min(np.minimum(a.max(0) - c.min(0),
                                                        c.max(0) - a.min(0)))))

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import linprog
 
-from .._validate import as_array
+from .._validate import as_array, as_flag, check_range
 from ..errors import InvalidInputError
 from ._tol import CONTAINS_TOL, SPAN_TOL, ZERO_ROW
 
@@ -223,8 +223,40 @@ class HPolytopeBatch:
         return Hk[first], hk[first]
 
 
+#: Largest |coefficient| :func:`lp_max_step` accepts (tensions, wrenches and joint rates
+#: stay many orders below; HiGHS treats 1e20 as infinite).
+_LP_MAX = 1e15
+
+
+def _lp_bounds(x_bounds: Any, nx: int) -> list[tuple[float | None, float | None]]:
+    """``x_bounds`` as ``nx`` pairs ``(low, high)``, each a number or None (unbounded)."""
+    if isinstance(x_bounds, (str, bytes)) or not hasattr(x_bounds, "__len__"):
+        raise InvalidInputError("x_bounds", f"must be {nx} (low, high) pairs")
+    if len(x_bounds) != nx:
+        raise InvalidInputError("x_bounds", f"must be {nx} (low, high) pairs, got "
+                                            f"{len(x_bounds)}")
+    out: list[tuple[float | None, float | None]] = []
+    for k, pair in enumerate(x_bounds):
+        if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+            raise InvalidInputError(f"x_bounds[{k}]", "must be a (low, high) pair")
+        lo, hi = (_lp_bound(v, f"x_bounds[{k}]") for v in pair)
+        out.append((lo, hi))
+    return out
+
+
+def _lp_bound(value: Any, field: str) -> float | None:
+    """One LP bound: None or +-inf (unbounded) or a number within ``_LP_MAX``."""
+    if value is None:
+        return None
+    arr = as_array(value, field, ndim=0) if not (
+        isinstance(value, (float, np.floating)) and np.isinf(value)) else None
+    if arr is None:
+        return float(value)
+    return float(check_range(arr, field, _LP_MAX, "units"))
+
+
 def lp_max_step(A_eq_x: np.ndarray, step_col: np.ndarray, b_eq: np.ndarray,
-                x_bounds: Sequence[tuple[float, float | None]], *,
+                x_bounds: Sequence[tuple[float | None, float | None]], *,
                 A_ub_x: np.ndarray | None = None, b_ub: np.ndarray | None = None,
                 step_first: bool = False) -> tuple[int, float]:
     """``max s >= 0`` subject to ``A_eq_x x + step_col s = b_eq``, ``x`` in its bounds and
@@ -235,7 +267,21 @@ def lp_max_step(A_eq_x: np.ndarray, step_col: np.ndarray, b_eq: np.ndarray,
     optimal step (NaN unless solved). ``step_first`` puts ``s`` before ``x`` in the
     variable vector (the order only matters for ties between optimal vertices).
     """
-    nx = A_eq_x.shape[1]
+    A_eq_x = check_range(as_array(A_eq_x, "A_eq_x", ndim=2), "A_eq_x", _LP_MAX, "units")
+    ne, nx = A_eq_x.shape
+    step_col = check_range(as_array(step_col, "step_col", shape=(ne,)), "step_col", _LP_MAX,
+                           "units")
+    b_eq = check_range(as_array(b_eq, "b_eq", shape=(ne,)), "b_eq", _LP_MAX, "units")
+    x_bounds = _lp_bounds(x_bounds, nx)
+    step_first = as_flag(step_first, "step_first")
+    if (A_ub_x is None) != (b_ub is None):
+        raise InvalidInputError("A_ub_x" if A_ub_x is None else "b_ub",
+                                "give A_ub_x and b_ub together")
+    if A_ub_x is not None:
+        A_ub_x = check_range(as_array(A_ub_x, "A_ub_x", shape=(None, nx)), "A_ub_x", _LP_MAX,
+                             "units")
+        b_ub = check_range(as_array(b_ub, "b_ub", shape=(A_ub_x.shape[0],)), "b_ub", _LP_MAX,
+                           "units")
     col = step_col.reshape(-1, 1)
     if step_first:
         Aeq = np.hstack([col, A_eq_x])

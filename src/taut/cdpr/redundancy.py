@@ -141,7 +141,7 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     """
     require_instance(robot, CableRobot, "robot")
     as_tolerance(tol, "tol")
-    if objective not in OBJECTIVES:
+    if not isinstance(objective, str) or objective not in OBJECTIVES:
         raise InvalidInputError("objective", "must be one of " + ", ".join(OBJECTIVES))
     limits = fastkit_motion_limits() if limits is None else limits
     P = as_array(pose, "pose")

@@ -144,7 +144,8 @@ def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, 
     acceleration = as_bounded(acceleration, "acceleration", 1e3 * MAX_SPEED, "m/s^2")
     rate = as_bounded(rate, "rate", MAX_RATE_HZ, "Hz")
     dwell = as_bounded(dwell, "dwell", MAX_DURATION_S, "s", positive=False)
-    if profile not in ("quintic", "trapezoidal"):
+    if not isinstance(profile, str) or profile not in ("quintic",
+                                                       "trapezoidal"):
         raise InvalidInputError("profile", f"unknown profile {profile!r}; choose quintic or "
                                            "trapezoidal")
     wp = as_array(waypoints, "waypoints")

@@ -38,6 +38,9 @@ Engine = Literal["auto", "numba", "numpy"]
 _CHECK_EVERY = 50          # control steps between divergence checks
 _MC_RECORD_EVERY = 10      # Monte Carlo keeps every 10th state for the tipping monitor
 
+#: Most integration substeps per control step (1 MHz integration at a 1 kHz controller).
+MAX_SUBSTEPS = 1000
+
 
 @dataclass
 class _Setup:
@@ -71,8 +74,12 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
     if not isinstance(dyn, DynamicsModel):
         raise InvalidInputError("dynamics", "must be a taut.cdpr.DynamicsModel")
     rate = as_bounded(control_rate, "control_rate", MAX_RATE_HZ, "Hz")
-    if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
+    if (isinstance(substeps, bool) or not isinstance(substeps, (int, float, np.number))
+            or not np.isfinite(substeps) or int(substeps) != substeps or substeps < 1):
         raise InvalidInputError("substeps", f"must be a positive integer, got {substeps!r}")
+    if substeps > MAX_SUBSTEPS:
+        raise InvalidInputError("substeps", f"{substeps:g} exceeds the accepted range "
+                                            f"{MAX_SUBSTEPS} substeps per control step")
     dur = reference.duration if duration is None else \
         as_bounded(duration, "duration", MAX_DURATION_S, "s")
     if dur * rate > MAX_BATCH:

@@ -37,6 +37,7 @@ from scipy.optimize import linprog, minimize
 
 from .._outcome import deprecated_alias
 from ..errors import InvalidInputError
+from .._validate import as_choice, as_flag
 from ._batching import is_single, unbatch
 from ._common import batch_outcome, constraints, feas_tol, required_wrench, svd_split
 from ._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_FTOL, SLSQP_REL
@@ -140,11 +141,10 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     >>> one.success, one.status, one.tensions.shape
     (True, 'ok', (8,))
     """
-    if method not in METHODS:
-        raise InvalidInputError("method", f"unknown method {method!r}; choose one of "
-                                          + ", ".join(METHODS))
-    if qp_solver not in ("auto", "enumeration", "scipy"):
-        raise InvalidInputError("qp_solver", "must be auto, enumeration or scipy")
+    as_choice(method, METHODS, "method")
+    as_choice(qp_solver, ("auto", "enumeration", "scipy"), "qp_solver")
+    tipping = as_flag(tipping, "tipping")
+    sliding = as_flag(sliding, "sliding")
     single = is_single(poses)
     P = as_poses(robot, poses)
     st = cable_state(robot, P, validated=True)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array
+from .._validate import MAX_TENSION_N, as_array, check_range
 from ..errors import InvalidInputError
 from ._batching import is_single, unbatch
 from ._common import feas_tol
@@ -79,7 +79,10 @@ def tipping_moments(robot: CableRobot, poses: ArrayLike, tensions: ArrayLike) ->
     """
     single = is_single(poses)
     P = as_poses(robot, poses)
-    t = as_array(tensions, "tensions")
+    t = check_range(tensions, "tensions", MAX_TENSION_N, "N")
+    if t.ndim == 1 and t.shape != (robot.m,):
+        raise InvalidInputError("tensions", f"must have shape ({robot.m},) or "
+                                            f"({P.shape[0]}, {robot.m})")
     t = np.broadcast_to(t, (P.shape[0], robot.m)) if t.ndim == 1 else t
     if t.shape != (P.shape[0], robot.m):
         raise InvalidInputError("tensions", f"must have shape ({P.shape[0]}, {robot.m})")

@@ -211,7 +211,7 @@ def twist_capacities(robot: CableRobot, poses: ArrayLike, limits: MotionLimits |
     >>> cap.positive.shape, bool(cap.positive[0] >= 1.0)   # vx: at least the paper's 1 m/s
     ((6,), True)
     """
-    if method not in ("hrep", "lp"):
+    if not isinstance(method, str) or method not in ("hrep", "lp"):
         raise InvalidInputError("method", "must be 'hrep' or 'lp'")
     single = is_single(poses)
     limits = fastkit_motion_limits() if limits is None else limits

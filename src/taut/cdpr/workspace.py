@@ -9,7 +9,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array
+from .._validate import MAX_BATCH, as_array
 from ..errors import InvalidInputError
 from ._common import renamed_keyword
 from ._tol import BOX_REL, CLOSURE_TOL
@@ -26,9 +26,14 @@ def grid_points(box: ArrayLike, shape: ArrayLike) -> tuple[np.ndarray, tuple[int
     (nx, ny, nz) points per axis (a flat axis gets one point). Returns points (P, 3) in
     C order (x slowest) and the effective shape."""
     b = as_array(box, "box", shape=(2, 3))
-    sh = np.asarray(shape, dtype=float)
+    if isinstance(shape, (str, bytes)):
+        raise InvalidInputError("grid", "must be three positive integers nx ny nz")
+    sh = as_array(shape, "grid")
     if sh.shape != (3,) or np.any(sh < 1) or np.any(sh != np.round(sh)):
         raise InvalidInputError("grid", "must be three positive integers nx ny nz")
+    if float(np.prod(sh)) > MAX_BATCH:
+        raise InvalidInputError("grid", f"{float(np.prod(sh)):g} points exceed the accepted "
+                                        f"range {MAX_BATCH:g} grid points")
     nx, ny, nz = (int(n) if b[1, k] > b[0, k] else 1 for k, n in enumerate(sh))
     eff = (nx, ny, nz)
     axes = [np.linspace(b[0, k], b[1, k], eff[k]) if eff[k] > 1 else

@@ -32,7 +32,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array, as_count, require_instance
+from .._validate import as_array, as_choice, as_count, as_flag, require_instance
 from ..errors import InvalidInputError
 from ._batching import first, is_single, unbatch
 from ._common import (constraints, feas_tol, renamed_keyword, required_wrench, svd_split,
@@ -128,6 +128,8 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = Tr
     >>> aws.contains(-aws.gravity_wrench)               # it can hold its own weight
     True
     """
+    tipping = as_flag(tipping, "tipping")
+    sliding = as_flag(sliding, "sliding")
     single = is_single(poses)
     P = as_poses(robot, poses)
     slide = bool(sliding and robot.has_sliding)
@@ -224,6 +226,8 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     >>> wrench_feasible(robot, [0, 0, 0.6])
     True
     """
+    tipping = as_flag(tipping, "tipping")
+    sliding = as_flag(sliding, "sliding")
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     single = is_single(poses)
@@ -290,8 +294,9 @@ def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
     >>> cap.positive.shape, bool(cap.positive[2] > 0)      # one pose: (n,)
     ((6,), True)
     """
-    if method not in ("hrep", "lp"):
-        raise InvalidInputError("method", "must be 'hrep' or 'lp'")
+    as_choice(method, ("hrep", "lp"), "method")
+    tipping = as_flag(tipping, "tipping")
+    sliding = as_flag(sliding, "sliding")
     n = require_instance(robot, CableRobot, "robot").dof
     labels = AXIS_LABELS[:n]
     single = is_single(poses)
@@ -356,6 +361,8 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     >>> (capacity_margin(robot, [[0, 0, 0.6], [2, 0, 1.8]]) > 0).tolist()
     [True, False]
     """
+    tipping = as_flag(tipping, "tipping")
+    sliding = as_flag(sliding, "sliding")
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     single = is_single(poses)

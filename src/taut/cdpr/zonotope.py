@@ -5,7 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validate import as_array, check_range
 from ..errors import InvalidInputError
+
+#: Largest |generator or center component| accepted (twists and wrenches stay far below).
+_ZONO_MAX = 1e12
 from ._common import subsets as _subsets
 from ._tol import SUBSET_DEGENERACY, TINY
 
@@ -29,7 +33,13 @@ def zonotope_hrep(center: np.ndarray, gens: np.ndarray) -> tuple[np.ndarray, np.
     -------
     H : (B, 2S, d) unit rows, h : (B, 2S)
     """
+    gens = check_range(as_array(gens, "gens", ndim=3), "gens", _ZONO_MAX, "units")
     Bn, d, g = gens.shape
+    center = check_range(as_array(center, "center", shape=(Bn, d)), "center", _ZONO_MAX,
+                         "units")
+    if Bn == 0 or d == 0:
+        raise InvalidInputError("gens", "is empty (shape "
+                                        f"{'x'.join(map(str, gens.shape))})")
     if g < d or np.any(np.linalg.matrix_rank(gens) < d):
         raise InvalidInputError("limits", "the joints that may move do not span every "
                                           "direction (give each cable a speed range with "

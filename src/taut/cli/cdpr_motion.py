@@ -37,8 +37,8 @@ def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, bas
     from ..cdpr import MotionLimits, available_twist_set, twist_capacities
 
     P = pose_vector(pose, rpy)
-    for field, value in (("limits.base", base_speed), ("limits.base", yaw_rate),
-                         ("limits.cable", cable_speed)):
+    for field, value in (("--base-speed", base_speed), ("--yaw-rate", yaw_rate),
+                         ("--cable-speed", cable_speed)):   # name the option, not the model
         if value <= 0:
             raise InvalidInputError(field, f"speed limits must be positive, got {value:g}")
         speeds(value, field)

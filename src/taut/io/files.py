@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from ..errors import ScenarioError
+from ..errors import InvalidInputError, ScenarioError
 from .._validate import as_path, require_instance
 
 __all__ = ["read_text", "read_mapping", "validate_mapping", "write_json"]
@@ -165,4 +165,8 @@ def write_json(obj: Any, path: str | Path) -> None:
     path = as_path(path)
     from .serialize import to_json
 
-    Path(path).write_text(to_json(obj) + "\n", encoding="utf-8")
+    try:
+        text = to_json(obj)
+    except (TypeError, ValueError, RecursionError) as exc:
+        raise InvalidInputError("obj", f"is not plain JSON data ({exc})") from None
+    Path(path).write_text(text + "\n", encoding="utf-8")

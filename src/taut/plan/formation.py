@@ -62,7 +62,7 @@ from . import _tol
 from ._formation_problem import (MIN_DEPTH_FRACTION, CostWeights, _curvature_constraint,
                                  _Decision, _nominal_ik, _problem)
 from .world import Team
-from .._validate import MAX_SHEET_LENGTH, as_bounded, as_count, require_instance
+from .._validate import MAX_SHEET_LENGTH, as_bounded, as_choice, as_count, require_instance
 
 __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
            "offset_crossings"]
@@ -254,6 +254,7 @@ def optimal_formation(team: Team, *, kind: FormationKind = "crossing", height: f
     (0.2, True)
     """
     require_instance(team, Team, "team")
+    as_choice(kind, ("crossing", "compact", "narrow"), "kind")
     as_bounded(height, "height", MAX_SHEET_LENGTH, "m", positive=False)
     as_bounded(diameter, "diameter", MAX_SHEET_LENGTH, "m", positive=False)
     as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)

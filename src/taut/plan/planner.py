@@ -247,10 +247,12 @@ def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_ma
     """Validate :func:`plan`'s options (typed errors naming the field); the budget."""
     if not isinstance(scenario, Scenario):
         raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
-    if method not in ("se2", "roadmap", "algorithm2"):
+    if not isinstance(method, str) or method not in ("se2", "roadmap",
+                                                     "algorithm2"):
         raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
                                           f"{method!r}")
-    if baseline not in (False, True, "se2", "disc"):
+    if (not isinstance(baseline, (bool, np.bool_, str))
+            or baseline not in (False, True, "se2", "disc")):
         raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
     if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
         raise InvalidInputError("sheet_margin", "must be a finite length >= 0")

@@ -38,7 +38,7 @@ from .._outcome import check_status, deprecated_alias
 from . import _tol
 from .formation import Formation, crossing_pairs, offset_crossings
 from .world import Obstacle, Scenario
-from .._validate import require_instance, require_instances
+from .._validate import as_flag, require_instance, require_instances
 
 __all__ = ["Leg", "Route", "find_route"]
 
@@ -380,6 +380,8 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
         require_instances(formation, Formation, "formation", min_count=1)
     else:
         require_instance(formation, Formation, "formation")
+    allow_crossing = as_flag(allow_crossing, "allow_crossing")
+    straight_crossings = as_flag(straight_crossings, "straight_crossings")
     team = scenario.team
     forms = [formation] if isinstance(formation, Formation) else list(formation)
     layers = [_Layer(scenario, f, allow_crossing, straight_crossings) for f in forms]

@@ -32,7 +32,7 @@ from typing import Iterable, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import (MAX_SHEET_LENGTH, as_array, as_positive, check_range,
+from .._validate import (MAX_SHEET_LENGTH, as_array, as_mass, as_positive, check_range,
                          require_nonempty)
 from ..errors import InvalidInputError
 from ._candidates import Stationary, hull_candidates, padded_small_subsets
@@ -81,13 +81,13 @@ def _check_sheet(sheet: Sheet) -> Sheet:
 
 
 def _check_method(method: str) -> Method:
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise InvalidInputError("method", f"must be one of {', '.join(METHODS)}; got {method!r}")
     return method  # type: ignore[return-value]
 
 
 def _check_mass(mass: float | None) -> float | None:
-    return None if mass is None else as_positive(mass, "mass")
+    return None if mass is None else as_mass(mass, "mass")
 
 
 #: Squared sheet side lengths, shrunk by FAST_CHECK_RTOL, per sheet (see _formations).

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import as_array, as_finite_scalar, as_positive
+from .._validate import as_array, as_finite_scalar, as_nonnegative, check_range
 from ..errors import InvalidInputError
 from ._ik_certificate import (IKCertificate, closure_branch_certificate,
                               closure_lp_certificate, depth_certificate, radial_certificate,
@@ -225,8 +225,8 @@ def ik_constraints(sheet: Sheet, object_position: ArrayLike, hold_height: float,
     if weights is None:
         w = _least_squares_weights(V, t.vo, rel)
     else:
-        w = as_array(weights, "weights")
-        if w.shape[-1] != N:
+        w = check_range(weights, "weights", 1e6, "(load shares, in [0, 1] at a solution)")
+        if w.ndim == 0 or w.shape[-1] != N:
             raise InvalidInputError("weights", f"last axis must have length {N}")
         w = np.broadcast_to(w, R.shape[:-1])
     balance = np.einsum("...n,...nk->...k", w, rel)
@@ -394,9 +394,8 @@ def inverse_kinematics(sheet: Sheet, object_position: ArrayLike, hold_height: fl
     mass = _check_mass(mass)
     t = _target(sheet, object_position, hold_height, contact)
     heading = as_finite_scalar(heading, "heading")
-    budget = int(as_positive(budget, "budget")) if budget != 0 else 0
-    branch_boxes = (int(as_positive(branch_boxes, "branch_boxes")) if branch_boxes != 0
-                    else 0)
+    budget = int(as_nonnegative(budget, "budget"))
+    branch_boxes = int(as_nonnegative(branch_boxes, "branch_boxes"))
     ref_n = None
     if reference is not None:
         ref_n = (as_array(reference, "reference", shape=(sheet.n, 2)) - t.p[:2]) / t.scale

@@ -121,7 +121,7 @@ class FKSolver:
         self.sheet = sheet = _check_sheet(sheet)  # type: ignore[arg-type]
         self.hold_height = check_hold_height(hold_height)
         self.method = _check_method(method)
-        if backend not in _BACKENDS:
+        if not isinstance(backend, str) or backend not in _BACKENDS:
             raise InvalidInputError("backend", f"must be one of {', '.join(_BACKENDS)}; "
                                                f"got {backend!r}")
         N = sheet.n

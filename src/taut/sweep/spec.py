@@ -53,7 +53,11 @@ class Parameter:
             arr = getattr(self, attr)
             if arr is None:
                 continue
-            arr = np.array(arr, dtype=float).reshape(-1)
+            try:
+                arr = np.array(arr, dtype=float).reshape(-1)
+            except (TypeError, ValueError):
+                raise SweepError(f"parameters.{self.name}", f"{attr} must be numbers (a list "
+                                 "or array)") from None
             if arr.size == 0:
                 raise SweepError(f"parameters.{self.name}", "is empty")
             if not np.all(np.isfinite(arr)):
