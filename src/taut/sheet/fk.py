@@ -393,6 +393,15 @@ def forward_kinematics_batch(sheet: Sheet, formations: ArrayLike, hold_height: f
     ------
     InfeasibleFormationError
         With ``.step`` set to the first infeasible formation's index.
+
+    Examples
+    --------
+    >>> import taut.sheet as ts
+    >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+    >>> b = ts.forward_kinematics_batch(sheet, [0.9 * sheet.vertices, 0.8 * sheet.vertices], 1.0)
+    >>> low = b.result(1).lowest
+    >>> b.count.tolist(), low.taut, [round(float(c), 4) for c in low.object]
+    ([1, 1], (0, 1, 2, 3), [0.4, 0.4, 0.5757])
     """
     sheet = _check_sheet(sheet)
     method = _check_method(method)
