@@ -83,10 +83,10 @@ KNOWN_HEAVY_GAPS = frozenset({
     ("check_tipping_grid", "duration"), ("evaluate_chunk", "params"),
     ("evaluate_chunk", "start"), ("evaluate_chunk", "stop"), ("generate_suite", "count"),
     ("generate_suite", "seed"), ("monte_carlo", "engine"), ("monte_carlo", "model_errors"),
-    ("monte_carlo", "settle"), ("plan", "search"), ("plan_deployment", "external_wrench"),
+    ("monte_carlo", "settle"), ("plan", "search"),
     ("run_sweep", "limit"), ("run_sweep", "resume"), ("settle", "trace"),
     ("simulate", "backend"), ("simulate", "engine"), ("simulate", "settle"),
-    ("tallest_workspace", "certificate_tol"), ("tallest_workspace", "external_wrench"),
+    ("tallest_workspace", "certificate_tol"), 
     ("tallest_workspace", "tol"),
 })
 #: Heavy pairs where the wrong value is accepted and the full search runs past ``BOUND_S``
@@ -101,6 +101,8 @@ HEAVY_HANGS = frozenset({
     ("plan_moving_deployment", "robot"), ("tallest_workspace", "disturbance"),
     ("tallest_workspace", "stages"), ("tallest_workspace", "warm_start"),
     ("tallest_workspace", "robot"),
+    # refused with a TautError on an idle machine, past the bound on a loaded one
+    ("plan_deployment", "external_wrench"), ("tallest_workspace", "external_wrench"),
 })
 
 
