@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
-                         as_nonnegative, as_positive)
+                         as_positive, require_instances)
 from ..errors import InvalidInputError
 from ._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
 from .cable_fk import rpy_from_matrices
@@ -85,7 +85,10 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
     if dur * rate > MAX_BATCH:
         raise InvalidInputError("duration", f"{dur:g} s at {rate:g} Hz is {dur * rate:.3g} "
                                 f"control steps, more than {MAX_BATCH}")
-    settle_s = as_nonnegative(settle, "settle")
+    settle_s = as_bounded(settle, "settle", MAX_DURATION_S, "s", positive=False)
+    if settle_s * rate > MAX_BATCH:
+        raise InvalidInputError("settle", f"{settle_s:g} s at {rate:g} Hz is "
+                                f"{settle_s * rate:.3g} control steps, more than {MAX_BATCH}")
     dt = 1.0 / rate
     n = max(int(np.ceil(dur * rate - STEP_COUNT_SLACK)), 1)
     k0 = int(round(settle_s * rate))
@@ -167,7 +170,7 @@ def _loop(setup: _Setup, controller: Controller,
 
 def _engine(engine: str, controller: Controller) -> str:
     """Resolve ``engine`` to "numba" or "numpy"."""
-    if engine not in ("auto", "numba", "numpy"):
+    if not isinstance(engine, str) or engine not in ("auto", "numba", "numpy"):
         raise InvalidInputError("engine", f"unknown engine {engine!r}; choose auto, numba or "
                                           "numpy")
     compiled = type(controller) in (VelocityController, TorqueController)
@@ -331,7 +334,7 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
         Arrays (B,) of worst tracking error, tension extremes, slack time, over-tension,
         minimum tipping margin and per-run success/status.
     """
-    errs = list(model_errors)
+    errs = list(require_instances(model_errors, ModelErrors, "model_errors"))
     if not errs:
         raise InvalidInputError("model_errors", "needs at least one ModelErrors")
     eng = _engine(engine, controller)

@@ -10,6 +10,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._validate import MAX_CDPR_LENGTH_M, as_bounded
 from ..errors import InvalidInputError
 from ._common import renamed_keyword, wrench_vertices
 from ._tol import TALLEST_CERTIFICATE_TOL
@@ -135,10 +136,8 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
     box = workspace_box(workspace)
     if not (isinstance(stages, (int, np.integer)) and 1 <= stages <= 50):
         raise InvalidInputError("stages", "must be an integer from 1 to 50")
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidInputError("tol", "must be a positive number of metres")
-    if not (np.isfinite(certificate_tol) and certificate_tol > 0):
-        raise InvalidInputError("certificate_tol", "must be a positive number of metres")
+    tol = as_bounded(tol, "tol", MAX_CDPR_LENGTH_M, "m")
+    certificate_tol = as_bounded(certificate_tol, "certificate_tol", MAX_CDPR_LENGTH_M, "m")
     field = "disturbance" if disturbance is not None else "external_wrench"
     ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     D = None if ext is None else wrench_vertices(robot, ext, field)

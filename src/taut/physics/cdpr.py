@@ -18,7 +18,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._outcome import check_status
-from .._validate import as_array, as_positive
+from .._validate import MAX_DURATION_S, as_array, as_bounded, as_positive
 from ..cdpr import (CableRobot, TensionMethod, distribute_tensions, rotation_matrices,
                     tipping_moments)
 from ..cdpr.kinematics import as_poses
@@ -264,6 +264,7 @@ def check_tipping_grid(robot: CableRobot, poses: Any, *,
     check asks whether taut's tipping verdict for tensions chosen *without* the tipping
     constraints agrees with the simulated bases; tensions that already avoid tipping would
     leave nothing to check."""
+    duration = as_bounded(duration, "duration", MAX_DURATION_S, "s")
     P = as_poses(robot, poses)
     dist = distribute_tensions(robot, P, method, tipping=tipping)
     B, nb = P.shape[0], len(robot.bases)

@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 
 from .._outcome import check_status
-from .._validate import as_array, as_positive
+from .._validate import as_array, as_flag, as_positive
 from ..errors import InvalidInputError
 from ..sheet import Equilibrium, Sheet, check_formation, forward_kinematics
 from ..sheet.model import check_hold_height
@@ -194,6 +194,7 @@ def settle(sheet: Sheet, formation: object, hold_height: float, *,
     >>> bool(r.converged), bool(0 < r.position[2] < 800)
     (True, True)
     """
+    trace = as_flag(trace, "trace")
     R, z, div, radius = _check_inputs(sheet, formation, hold_height, mesh, ball)
     p0 = None if start is None else as_array(start, "start", shape=(3,))
     max_t = as_positive(max_time, "max_time")
@@ -280,6 +281,7 @@ def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
     -------
     EquilibriaCheck
     """
+    corner_tendons = as_flag(corner_tendons, "corner_tendons")
     R, z, div, radius = _check_inputs(sheet, formation, hold_height, mesh, ball)
     tol = _tol.HOLD_FRACTION if hold_tolerance is None else as_positive(
         hold_tolerance, "hold_tolerance")

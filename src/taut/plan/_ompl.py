@@ -278,7 +278,7 @@ def _solve_prm(ob: Any, planner: Any, pdef: Any, budget: _Budget) -> None:
 def engine(search: str) -> Callable[..., SearchOutcome] | None:
     """The search function of ``plan(..., search=...)`` (None: taut's own RRT-Connect);
     raises InvalidInputError for an unknown name or when OMPL is not installed."""
-    if search not in SEARCHES:
+    if not isinstance(search, str) or search not in SEARCHES:
         raise InvalidInputError("search", f"must be one of {', '.join(map(repr, SEARCHES))}, "
                                           f"got {search!r}")
     if search == "rrtconnect":

@@ -126,4 +126,6 @@ def generate_scenario(seed: int, n_robots: int | None = None) -> Scenario:
 
 def generate_suite(count: int = 50, seed: int = 2024) -> list[Scenario]:
     """``count`` scenarios, robot counts cycling through 3..8, seeds ``seed + i``."""
+    count = as_count(count, "count", minimum=0, maximum=100_000)
+    seed = as_count(seed, "seed", minimum=0, maximum=2**63 - 1 - count)
     return [generate_scenario(seed + i, 3 + i % 6) for i in range(count)]

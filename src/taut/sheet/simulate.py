@@ -67,7 +67,7 @@ Backend = Literal["auto", "numba", "numpy"]
 def _compiled(backend: object) -> bool:
     """Whether ``backend`` selects the compiled branch follower (as ``FKSolver``'s
     ``backend``: ``"numba"`` without numba installed is an error)."""
-    if backend not in ("auto", "numba", "numpy"):
+    if not isinstance(backend, str) or backend not in ("auto", "numba", "numpy"):
         raise InvalidInputError("backend", f"must be one of auto, numba, numpy; got "
                                            f"{backend!r}")
     if backend == "numba" and not HAVE_NUMBA:

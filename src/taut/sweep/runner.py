@@ -25,7 +25,7 @@ from .points import chunk_bounds, expand, point_seeds
 from .spec import SweepSpec
 from .store import Store
 from .tasks import TASKS, Columns
-from .._validate import require_instance
+from .._validate import as_array, as_count, as_flag, require_instance
 from .._validate import as_path
 
 __all__ = ["SweepResult", "run_sweep", "evaluate_chunk", "chunk_size_of"]
@@ -87,10 +87,18 @@ def evaluate_chunk(spec: SweepSpec, start: int, stop: int,
     expanded from the spec.
     """
     require_instance(spec, SweepSpec, "spec")
+    start = as_count(start, "start", minimum=0, maximum=max(spec.size - 1, 0))
+    stop = as_count(stop, "stop", minimum=start + 1, maximum=spec.size)
+    n = stop - start
+    if params is not None:
+        require_instance(params, dict, "params")
+        for name in ("point", *spec.names):
+            if name not in params:
+                raise SweepError("params", f"has no column {name!r}")
+            as_array(params[name], f"params[{name!r}]", shape=(n,))
     task = TASKS[spec.task]
     ctx = _context(spec)
     cols = dict(params) if params is not None else expand(spec, start, stop)
-    n = stop - start
     defaults = task.defaults(ctx)
     full = {name: np.asarray(cols[name], float) if name in cols
             else np.full(n, defaults[name], dtype=float) for name in task.parameters}
@@ -182,6 +190,9 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     """
     require_instance(spec, SweepSpec, "spec")
     out = as_path(out, "out")
+    resume = as_flag(resume, "resume")
+    if limit is not None:
+        limit = as_count(limit, "limit", minimum=1)
     t0 = time.perf_counter()
     total = spec.size if limit is None else min(int(limit), spec.size)
     if total < 1:
