@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import jit
-from ._small_kernel import (INFEASIBLE, _candidates, _classify_row, _frame, _write_row,
+from ._small_kernel import (INFEASIBLE, _candidates, _frame, classify_survivors,
                             feasible, similar_fit, solve_formation)
 
 __all__ = ["solve_formations_ws", "solve_packed", "pack"]
@@ -40,7 +40,6 @@ def _one(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out, Rn, P, G, bvec, 
     """``_small_kernel.solve_formation`` on preallocated work arrays; returns the number
     of rows written to ``out`` (or ``INFEASIBLE``). ``taut`` needs no reset: only rows of
     surviving candidates are read, and ``_candidates`` writes those in full."""
-    N = R.shape[0]
     if not feasible(R, lim2):
         return INFEASIBLE
     C = table.shape[0]
@@ -50,24 +49,9 @@ def _one(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out, Rn, P, G, bvec, 
     if found == 0:
         return 0
     m = _sorted_survivors(key, C, order)
-    k = 0
-    last = -1
-    for r in range(m):
-        c = order[r]
-        head = key[c] // (2 * C)
-        if head == last:
-            continue
-        last = head
-        tsize = 0
-        for j in range(N):
-            if taut[c, j]:
-                tsize += 1
-        status = _classify_row(Rn, P, table, sizes, c, sol, taut[c], tsize, ang)
-        if status < 0:
-            continue
-        _write_row(out, k, status, c, sol, taut[c], tsize, table, sizes, Vn, scale, cx, cy,
-                   vcx, vcy, hold)
-        k += 1
+    k, _stable, _pending = classify_survivors(order, 0, m, key, C, Rn, P, table, sizes, sol,
+                                              taut, ang, out, Vn, scale, cx, cy, vcx, vcy,
+                                              hold)
     return k
 
 

@@ -88,17 +88,23 @@ def _lagrange(G, bvec, members, s, K, rhs, work):
 
 
 @jit
-def _frame(R, Vn, scale, Rn, P, G, bvec):
-    """Normalised robots ``Rn``, lifted points ``P`` (N, 5), Gram matrix ``G`` and ``b``
-    (``_kernel.Frame.build``); returns the formation centre (cx, cy)."""
+def centroid(R):
+    """Mean ``(x, y)`` of the points ``R`` (N, 2)."""
     N = R.shape[0]
     cx = 0.0
     cy = 0.0
     for i in range(N):
         cx += R[i, 0]
         cy += R[i, 1]
-    cx /= N
-    cy /= N
+    return cx / N, cy / N
+
+
+@jit
+def _frame(R, Vn, scale, Rn, P, G, bvec):
+    """Normalised robots ``Rn``, lifted points ``P`` (N, 5), Gram matrix ``G`` and ``b``
+    (``_kernel.Frame.build``); returns the formation centre (cx, cy)."""
+    N = R.shape[0]
+    cx, cy = centroid(R)
     for i in range(N):
         Rn[i, 0] = (R[i, 0] - cx) / scale
         Rn[i, 1] = (R[i, 1] - cy) / scale
@@ -269,12 +275,22 @@ def solve_formation(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out):
     if found == 0:
         return 0, 0, 0
     order = np.argsort(key)
-    ang = np.empty(N)
+    return classify_survivors(order, C - found, C, key, C, Rn, P, table, sizes, sol, taut,
+                              np.empty(N), out, Vn, scale, cx, cy, vcx, vcy, hold)
+
+
+@jit
+def classify_survivors(order, r0, r1, key, C, Rn, P, table, sizes, sol, taut, ang, out, Vn,
+                       scale, cx, cy, vcx, vcy, hold):
+    """Classify the surviving candidates ``order[r0:r1]`` (sorted by ``key``; one per
+    distinct stationary point, ``key // (2 C)``) and write their rows into ``out``.
+    Returns ``(rows, stable_rows, pending_rows)``."""
+    N = Rn.shape[0]
     k = 0
     stable = 0
     pending = 0
     last = -1
-    for r in range(C - found, C):
+    for r in range(r0, r1):
         c = order[r]
         head = key[c] // (2 * C)
         if head == last:

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ._jit import jit
+from ._small_kernel import centroid
 from ._small_linalg import _lu_solve, _reduced_min_eig
 from ._tol import CURVATURE_TOL, MAX_SOLUTION, TAUT_TOL, WEIGHT_TOL
 
@@ -39,13 +40,7 @@ def solve_support(R, Xv, vcx, vcy, size, z, support, k, out):
     vertices centred at ``(vcx, vcy)`` and divided by ``size``; ``z`` the hold height.
     Returns True when the support gives a stable state there (module docstring)."""
     N = R.shape[0]
-    cx = 0.0
-    cy = 0.0
-    for i in range(N):
-        cx += R[i, 0]
-        cy += R[i, 1]
-    cx /= N
-    cy /= N
+    cx, cy = centroid(R)
     P = np.empty((N, 5))
     for i in range(N):
         rx = (R[i, 0] - cx) / size
