@@ -26,11 +26,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import shapely
 
 from ._rrt import SearchOutcome, rrt_connect, shortcut, valid_headings
 from ._se2_motion import Piece
-from ._se2_space import PoseChecker
+from ._se2_space import PoseChecker, morph_valid
 from .formation import Formation
 from .world import Scenario
 
@@ -96,24 +95,6 @@ def _bounds(scenario: Scenario) -> np.ndarray:
     return np.array([fs.min(axis=0), fs.max(axis=0)])
 
 
-def _transition_ok(scenario: Scenario, ca: PoseChecker, cb: PoseChecker,
-                   state: np.ndarray) -> bool:
-    """Is the in-place change from ``ca``'s formation to ``cb``'s at ``state`` valid?"""
-    a, b = ca.robots(state)[0], cb.robots(state)[0]
-    move = float(np.linalg.norm(b - a, axis=1).max())
-    k = max(1, int(np.ceil(move / ca.resolution)))
-    s = np.arange(0, k + 1) / k
-    r = a[None] + s[:, None, None] * (b - a)[None]
-    p = r.reshape(-1, 2)
-    if not shapely.intersects_xy(ca.robot_region, p[:, 0], p[:, 1]).all():
-        return False
-    hulls = shapely.convex_hull(shapely.multipoints(r))
-    if not shapely.covers(ca.hull_region, hulls).all():
-        return False
-    strict = ca if ca.formation.max_height <= cb.formation.max_height else cb
-    return strict.blocked is None or not shapely.intersects(strict.blocked, hulls).any()
-
-
 def _reform_states(scenario: Scenario, ca: PoseChecker, cb: PoseChecker,
                    rng: np.random.Generator, count: int) -> np.ndarray:
     lo, hi = _bounds(scenario)
@@ -123,7 +104,7 @@ def _reform_states(scenario: Scenario, ca: PoseChecker, cb: PoseChecker,
         q = q[ca.valid(q)]
         if len(q):
             q = q[cb.valid(q)]
-        found.extend(s for s in q if _transition_ok(scenario, ca, cb, s))
+        found.extend(s for s in q if morph_valid(ca, cb, s))
         if len(found) >= count:
             break
     return np.asarray(found[:count]).reshape(-1, 3)

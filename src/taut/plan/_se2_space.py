@@ -8,17 +8,19 @@ turned by ``psi`` (rad). It is *valid* when
 2. the robots' convex hull (the sheet's projection when every cable is taut) lies in the
    free space (walls are tall) and meets only obstacles the formation can hold the object
    above: ``height <= f.max_height`` (eq. 2: object height minus the height safety). With
-   crossing disabled it meets no obstacle at all.
+   crossing disabled it meets no obstacle at all;
 
-An obstacle passing under the sheet between two robots is then automatically narrower than
-the gap it passes through: it would otherwise violate rule 1 on the way in.
+each with ``STATE_CLEARANCE`` to spare. An obstacle passing under the sheet between two
+robots is then automatically narrower than the gap it passes through: it would otherwise
+violate rule 1 on the way in.
 
-Motions between two states are checked at states ``MOTION_RESOLUTION`` of robot motion
-apart, against the rules tightened by half a resolution plus ``INFLATION``: every point of
-the continuous motion is within half a resolution of a checked state (robot positions and
-hence hull points move at most that far), so the continuous motion keeps the rules with
-``INFLATION`` to spare. This is the per-interval proof the verifier relies on for rigid
-motions.
+The rules are evaluated by compiled code (:mod:`taut.plan._se2_kernel`) as a
+*clearance*: how far the robots may move before a rule breaks. Motions between two
+states (and in-place formation changes) are proved valid by conservative advancement on
+that clearance: every pose of the continuous motion keeps the rules with
+``MOTION_MARGIN`` to spare. This is the per-interval proof the verifier relies on for
+rigid motions. Shapely geometry is kept only for the samplers (free parts of heading
+slices, passages under the sheet).
 """
 
 from __future__ import annotations
@@ -26,18 +28,38 @@ from __future__ import annotations
 import numpy as np
 import shapely
 import shapely.affinity
+from shapely.geometry.polygon import orient
 from shapely.ops import unary_union
 
 from . import _tol
-from shapely.geometry.polygon import orient
-
+from ._se2_kernel import OBST_COLS, morph_clear, motion_clear, poses_clearance
 from .formation import Formation
 from .world import Scenario
 
-__all__ = ["PoseChecker", "SLICES"]
+__all__ = ["PoseChecker", "SLICES", "morph_valid"]
 
 #: Heading slices of the free-space sampler.
 SLICES = 72
+
+
+def _kernel_world(scenario: Scenario, blocked: list[bool]) -> tuple[np.ndarray, np.ndarray,
+                                                                     np.ndarray]:
+    """Walls (M, 2), obstacle rows (``OBST_COLS``) and polygon vertices for the kernel."""
+    world = scenario.world
+    walls = np.ascontiguousarray(world.free_space, dtype=float)
+    rows, verts = [], []
+    count = 0
+    for o, bl in zip(world.obstacles, blocked):
+        if o.polygon is None:
+            rows.append([*o.mec_center, o.mec_radius, float(bl), 0.0, 0.0, 0.0])
+        else:
+            v = np.asarray(o.polygon, dtype=float)
+            rows.append([*o.mec_center, o.mec_radius, float(bl), 1.0, count, len(v)])
+            verts.append(v)
+            count += len(v)
+    obst = np.array(rows, dtype=float).reshape(-1, OBST_COLS)
+    vv = np.concatenate(verts) if verts else np.zeros((0, 2))
+    return walls, obst, np.ascontiguousarray(vv)
 
 
 class PoseChecker:
@@ -49,36 +71,32 @@ class PoseChecker:
     formation : Formation
     allow_crossing : bool
         False: no obstacle may meet the robots' hull (the SE(2) bypass baseline).
-    resolution : float
-        Largest robot displacement between checked states of a motion, m.
     """
 
-    def __init__(self, scenario: Scenario, formation: Formation, *, allow_crossing: bool,
-                 resolution: float = _tol.MOTION_RESOLUTION) -> None:
+    def __init__(self, scenario: Scenario, formation: Formation, *,
+                 allow_crossing: bool) -> None:
         world, team = scenario.world, scenario.team
         self.formation = formation
-        self.resolution = float(resolution)
-        pad = self.pad = 0.5 * self.resolution + _tol.INFLATION
+        self.allow_crossing = bool(allow_crossing)
+        blocked = [not allow_crossing or o.height > formation.max_height + _tol.GEOMETRY_TOL
+                   for o in world.obstacles]
+        self._walls, self._obst, self._verts = _kernel_world(scenario, blocked)
+        self._local = np.ascontiguousarray(formation.robots, dtype=float)
+        self.clearance_rule = float(team.clearance)
+        self.radius = float(np.linalg.norm(formation.robots, axis=1).max())
+        self.checks = 0
+        # Shapely geometry of the samplers only (validity is decided by the kernel).
+        pad = self.pad = _tol.STATE_CLEARANCE
         c = team.clearance + pad
         robots_free = world.geometry.buffer(-c, quad_segs=16)
         grown = [o.geometry.buffer(c, quad_segs=16) for o in world.obstacles]
         if grown:
             robots_free = robots_free.difference(unary_union(grown))
         self.robot_region = robots_free
-        self.hull_region = world.geometry.buffer(-pad, quad_segs=16)
-        blocked = [o.geometry.buffer(pad, quad_segs=16) for o in world.obstacles
-                   if not allow_crossing or o.height > formation.max_height + _tol.GEOMETRY_TOL]
-        self.blocked = unary_union(blocked) if blocked else None
-        for g in (self.robot_region, self.hull_region, self.blocked):
-            if g is not None:
-                shapely.prepare(g)
-        self.radius = float(np.linalg.norm(formation.robots, axis=1).max())
-        self.checks = 0
-        self._near_sets(scenario, allow_crossing)
+        shapely.prepare(self.robot_region)
+        self._blocked_geoms = [o.geometry for o, bl in zip(world.obstacles, blocked) if bl]
+        self._reflex = _reflex_vertices(scenario)
         self.passages = self._passages(scenario, c) if allow_crossing else []
-        self._blocked_geoms = [o.geometry for o in world.obstacles
-                               if not allow_crossing
-                               or o.height > formation.max_height + _tol.GEOMETRY_TOL]
         self._slices: dict[int, object] = {}
         hull = orient(shapely.convex_hull(shapely.multipoints(formation.robots)), 1.0)
         self.hull_idx = np.array([int(np.argmin(np.linalg.norm(formation.robots - q, axis=1)))
@@ -105,10 +123,10 @@ class PoseChecker:
             v = np.asarray(shapely.convex_hull(g).exterior.coords)[:-1]
             cuts.append(shapely.convex_hull(shapely.multipoints(
                 (v[:, None] - hull[None]).reshape(-1, 2))))
-        for v in self.near_c[len(self.near_c) - self._n_reflex:]:
+        for v in self._reflex:
             cuts.append(shapely.Polygon(v - hull))
         if cuts and not region.is_empty:
-            region = region.difference(unary_union(cuts).buffer(self.pad + _tol.INFLATION))
+            region = region.difference(unary_union(cuts).buffer(self.pad))
         shapely.prepare(region)
         self._slices[k] = region
         return region
@@ -161,73 +179,54 @@ class PoseChecker:
         return np.array([centre[0] - (cs * p[0] - sn * p[1]),
                          centre[1] - (sn * p[0] + cs * p[1]), psi])
 
-    def _near_sets(self, scenario: Scenario, allow_crossing: bool) -> None:
-        """Points near which the hull test can fail: blocked obstacles (centre, radius)
-        and reflex vertices of the walls (a convex world never cuts a hull whose robots
-        are inside it)."""
-        world, f = scenario.world, self.formation
-        blocked = [o for o in world.obstacles
-                   if not allow_crossing or o.height > f.max_height + _tol.GEOMETRY_TOL]
-        ring = orient(world.geometry, 1.0).exterior
-        p = np.asarray(ring.coords)[:-1]
-        a, b = p - np.roll(p, 1, axis=0), np.roll(p, -1, axis=0) - p
-        reflex = p[a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0] < 0]
-        self.near_c = np.concatenate([np.array([o.mec_center for o in blocked]).reshape(-1, 2),
-                                      reflex])
-        self.near_r = np.concatenate([[o.mec_radius for o in blocked], np.zeros(len(reflex))])
-        self.near_r = self.near_r + self.radius + 2 * self.resolution
-        self._near_r2 = self.near_r ** 2
-        self._n_reflex = len(reflex)
-
     def robots(self, states: np.ndarray) -> np.ndarray:
         """Robot positions ``(K, N, 2)`` of states ``(K, 3)``."""
         s = np.asarray(states, dtype=float).reshape(-1, 3)
         return self.formation.placed(s[:, :2], s[:, 2])
 
-    def valid(self, states: np.ndarray) -> np.ndarray:
-        """Bool ``(K,)``: which states are valid. The hull test runs only for states whose
-        object is near a blocked obstacle or a reflex wall vertex (elsewhere the hull,
-        within ``radius`` of the object, cannot meet either)."""
-        r = self.robots(states)
-        K, N = r.shape[:2]
-        self.checks += K
-        p = r.reshape(-1, 2)                     # point-in-region without point objects
-        ok = shapely.intersects_xy(self.robot_region, p[:, 0], p[:, 1])
-        ok = ok.reshape(K, N).all(axis=1)
-        if not ok.any():
-            return ok
-        idx = np.flatnonzero(ok)
-        if len(self.near_r):
-            s = np.asarray(states, dtype=float).reshape(-1, 3)[idx, :2]
-            d2 = ((s[:, None] - self.near_c[None]) ** 2).sum(axis=-1)
-            idx = idx[(d2 <= self._near_r2[None]).any(axis=1)]
-        else:
-            idx = idx[:0]
-        if not len(idx):
-            return ok
-        hulls = shapely.convex_hull(shapely.multipoints(r[idx]))
-        good = shapely.covers(self.hull_region, hulls)
-        if self.blocked is not None:
-            good &= ~shapely.intersects(self.blocked, hulls)
-        ok[idx] = good
-        return ok
+    def clearance(self, states: np.ndarray) -> np.ndarray:
+        """Float ``(K,)``: how far (m) every robot may move from each state before a rule
+        breaks (negative: broken); :mod:`taut.plan._se2_kernel`."""
+        s = np.ascontiguousarray(np.asarray(states, dtype=float).reshape(-1, 3))
+        out = np.empty(len(s))
+        poses_clearance(self._local, self.radius, self._walls, self._obst, self._verts,
+                        self.clearance_rule, s, out)
+        self.checks += len(s)
+        return out
 
-    def steps(self, a: np.ndarray, b: np.ndarray) -> int:
-        """Number of intervals that keep every robot within ``resolution`` per interval on
-        the straight SE(2) motion from ``a`` to ``b``."""
-        move = float(np.hypot(b[0] - a[0], b[1] - a[1]) + abs(b[2] - a[2]) * self.radius)
-        return max(1, int(np.ceil(move / self.resolution)))
+    def valid(self, states: np.ndarray) -> np.ndarray:
+        """Bool ``(K,)``: which states keep every rule with ``STATE_CLEARANCE`` to
+        spare."""
+        return self.clearance(states) >= _tol.STATE_CLEARANCE
 
     def motion_valid(self, a: np.ndarray, b: np.ndarray) -> bool:
         """Is the straight SE(2) motion from ``a`` to ``b`` (position and heading linear in
-        a common parameter) valid? Checked from both ends inward, coarse to fine."""
-        k = self.steps(a, b)
-        s = np.arange(1, k) / k
-        if not len(s):
-            return True
-        pts = a[None, :] + s[:, None] * (b - a)[None, :]
-        for stride in (16, 4, 1):                       # coarse to fine: fail early
-            if not self.valid(pts[stride - 1::stride] if stride > 1 else pts).all():
-                return False
-        return True
+        a common parameter) valid at every pose, with ``MOTION_MARGIN`` to spare?"""
+        n = motion_clear(self._local, self.radius, self._walls, self._obst, self._verts,
+                         self.clearance_rule, np.asarray(a, dtype=float),
+                         np.asarray(b, dtype=float), _tol.MOTION_MARGIN, _tol.MIN_ADVANCE)
+        self.checks += abs(n)
+        return n > 0
 
+
+def _reflex_vertices(scenario: Scenario) -> np.ndarray:
+    """Reflex vertices of the walls (a convex world never cuts a hull whose robots are
+    inside it)."""
+    ring = orient(scenario.world.geometry, 1.0).exterior
+    p = np.asarray(ring.coords)[:-1]
+    a, b = p - np.roll(p, 1, axis=0), np.roll(p, -1, axis=0) - p
+    return p[a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0] < 0]
+
+
+def morph_valid(ca: PoseChecker, cb: PoseChecker, state: np.ndarray) -> bool:
+    """Is the in-place change from ``ca``'s formation to ``cb``'s at ``state`` valid (every
+    robot moving straight to its new place; robots clear of walls and obstacles, the hull
+    in the free space and over obstacles low enough for both formations), with
+    ``MOTION_MARGIN`` to spare at every instant?"""
+    strict = ca if ca.formation.max_height <= cb.formation.max_height else cb
+    a, b = ca.robots(state)[0], cb.robots(state)[0]
+    n = morph_clear(np.ascontiguousarray(a), np.ascontiguousarray(b), float(state[0]),
+                    float(state[1]), max(ca.radius, cb.radius), strict._walls, strict._obst,
+                    strict._verts, strict.clearance_rule, _tol.MOTION_MARGIN,
+                    _tol.MIN_ADVANCE)
+    return n > 0

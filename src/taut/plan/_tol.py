@@ -24,12 +24,17 @@ SHEET_MARGIN = 0.01
 POSITION_ACCURACY = 0.005
 #: Default largest object step between verification samples, m ("a few mm").
 MAX_OBJECT_STEP = 0.005
-#: Largest robot displacement between two states checked by the SE(2) search, m.
-MOTION_RESOLUTION = 0.01
-#: Extra clearance the SE(2) search keeps beyond the rules, m, on top of half the motion
-#: resolution: a robot between two checked states is within half a resolution of one of
-#: them, so the continuous motion keeps the rules with ``INFLATION`` to spare.
-INFLATION = 1e-3
+#: Clearance to spare at every pose of a motion the SE(2) search accepts, m: the motion
+#: check (conservative advancement, :mod:`taut.plan._se2_kernel`) proves every pose of the
+#: continuous motion keeps the rules by at least this much; far below the robots'
+#: position accuracy, above round-off of the distances.
+MOTION_MARGIN = 1e-3
+#: Least robot motion per step of the motion check, m: a pose with less than
+#: ``MOTION_MARGIN + MIN_ADVANCE`` of clearance fails the motion, so a check never takes
+#: more than its length over this many steps.
+MIN_ADVANCE = 1e-3
+#: Clearance a state of the SE(2) search keeps, m (a motion through it can advance).
+STATE_CLEARANCE = MOTION_MARGIN + MIN_ADVANCE
 #: Largest robot displacement between the samples of a returned plan, m.
 SAMPLE_STEP = 0.02
 #: Largest robot displacement between samples during a formation change, m (the model is
