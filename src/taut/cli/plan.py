@@ -48,10 +48,14 @@ def plan_command(
                                        help="Robot pairs stay this far inside their sheet "
                                             "distance, m."),
     seed: int = typer.Option(0, "--seed", help="Seed of the SE(2) search."),
-    search: str = typer.Option("rrtconnect", "--search",
-                               help="Who searches SE(2): rrtconnect (taut's own, "
-                                    "deterministic), ompl-rrtconnect, ompl-rrtstar or "
-                                    "ompl-prm (OMPL, extra plan-ompl)."),
+    search: str = typer.Option("auto", "--search",
+                               help="Who searches SE(2): auto (the lattice, then "
+                                    "rrtconnect), lattice (A* over every formation, "
+                                    "deterministic), rrtconnect (taut's own, seeded), "
+                                    "ompl-rrtconnect, ompl-rrtstar or ompl-prm (OMPL, extra "
+                                    "plan-ompl)."),
+    spacing: float = typer.Option(0.05, "--spacing", help="Lattice spacing of the lattice "
+                                  "search, m."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
@@ -69,6 +73,8 @@ def plan_command(
     as_count(seed, "--seed", minimum=0)
     as_count(iterations, "--iterations", minimum=1, maximum=MAX_ITERATIONS)
     _check_search(search)
+    if not 0.005 <= spacing <= 1.0:
+        raise InvalidInputError("--spacing", f"must be in [0.005, 1] m, got {spacing:g}")
     if baseline and disc_baseline:
         raise InvalidInputError("--baseline", "give at most one of --baseline and "
                                 "--disc-baseline")
@@ -77,7 +83,7 @@ def plan_command(
         result = plan(sc, baseline="disc" if disc_baseline else baseline,
                       method="algorithm2" if algorithm2 else "se2", time_budget=budget,
                       iterations=iterations, sheet_margin=sheet_margin, seed=seed,
-                      search=search)  # type: ignore[arg-type]  # checked above
+                      search=search, spacing=spacing)  # type: ignore[arg-type]  # checked
     doc = plan_to_dict(result)
     if out is not None:
         out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")

@@ -69,10 +69,13 @@ PRM_CHUNK = 100
 #: it, while OMPL keeps growing the roadmap), s.
 PRM_QUERY_TIME = 0.2
 
-Search = Literal["rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"]
+Search = Literal["auto", "lattice", "rrtconnect", "ompl-rrtconnect", "ompl-rrtstar",
+                 "ompl-prm"]
 
-#: Every value of ``plan(..., search=...)``; the first is taut's own RRT-Connect.
-SEARCHES: tuple[str, ...] = ("rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm")
+#: Every value of ``plan(..., search=...)``: ``"auto"`` (the lattice, then taut's own
+#: RRT-Connect), the lattice alone, taut's own RRT-Connect, and the OMPL planners.
+SEARCHES: tuple[str, ...] = ("auto", "lattice", "rrtconnect", "ompl-rrtconnect",
+                             "ompl-rrtstar", "ompl-prm")
 #: The searches run by OMPL and the OMPL planner class name of each.
 OMPL_SEARCHES = {"ompl-rrtconnect": "RRTConnect", "ompl-rrtstar": "RRTstar", "ompl-prm": "PRM"}
 
@@ -276,12 +279,13 @@ def _solve_prm(ob: Any, planner: Any, pdef: Any, budget: _Budget) -> None:
 
 
 def engine(search: str) -> Callable[..., SearchOutcome] | None:
-    """The search function of ``plan(..., search=...)`` (None: taut's own RRT-Connect);
-    raises InvalidInputError for an unknown name or when OMPL is not installed."""
+    """The sampling search of ``plan(..., search=...)`` (None: taut's own RRT-Connect, also
+    the one ``"auto"`` and ``"lattice"`` name); raises InvalidInputError for an unknown
+    name or when OMPL is not installed."""
     if not isinstance(search, str) or search not in SEARCHES:
         raise InvalidInputError("search", f"must be one of {', '.join(map(repr, SEARCHES))}, "
                                           f"got {search!r}")
-    if search == "rrtconnect":
+    if search in ("auto", "lattice", "rrtconnect"):
         return None
     _modules()
 

@@ -64,6 +64,8 @@ class SearchBudget:
     total : int or None
         Samples of the whole search (every run together; default ``TOTAL_RUNS`` times
         ``iterations``): bounds the work deterministically.
+    spacing : float
+        Spacing of the lattice search, m (:mod:`taut.plan._lattice`).
     """
 
     iterations: int = 3000
@@ -71,6 +73,7 @@ class SearchBudget:
     seed: int = 0
     reform_samples: int = 24
     total: int | None = None
+    spacing: float = 0.05
 
     @property
     def total_samples(self) -> int:

@@ -14,6 +14,7 @@ motion; the object's planned states there come from the quasi-static simulation
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,7 @@ from . import _tol
 from .formation import Formation
 from .world import Scenario
 
-__all__ = ["Piece", "SampledMotion", "sample_pieces"]
+__all__ = ["Piece", "SampledMotion", "sample_pieces", "ChangeProfile", "change_profile"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,31 +89,73 @@ class _Samples:
         team = scenario.team
         c, h = self.c[-1], self.h[-1]
         a, b = self.r[-1], g.placed(c, np.asarray(h))
-        dist = float(np.linalg.norm(b - a, axis=1).max())
-        if dist <= 0.0:
+        change = _simulate_change(scenario, a, b, self.o[-1], np.array([*c, g.object_height]))
+        if isinstance(change, str):
+            return change
+        robots, obj, dist = change
+        k = len(robots) - 1
+        if k <= 0:
             return None
-        k = max(2, int(np.ceil(dist / _tol.REFORM_STEP)))
-        s = np.arange(0, k + 1) / k
-        robots = a[None] + s[:, None, None] * (b - a)[None]
-        try:
-            sim = simulate(team.sheet, robots, team.hold_height, start=self.o[-1])
-        except TautError as exc:
-            return f"formation change has no rest state ({exc.problem})"
-        bad = [e for e in sim.events if e.kind in ("jump", "lost")]
-        if bad:
-            return (f"the object {bad[0].kind}s during a formation change "
-                    f"(drop {bad[0].drop:.3g} m)")
-        end = np.array([*c, g.object_height])
-        if np.linalg.norm(sim.object[-1] - end) > _tol.OBJECT_RTOL * team.sheet.size:
-            return "a formation change does not end in the new formation's rest state"
-        self.t.extend(self.t[-1] + s[1:] * dist / team.speed)
+        self.t.extend(self.t[-1] + np.arange(1, k + 1) / k * dist / team.speed)
         self.c.extend([c] * k)
         self.h.extend([h] * k)
         self.r.extend(robots[1:])
-        obj = sim.object[1:].copy()
-        obj[-1] = end
-        self.o.extend(obj)
+        self.o.extend(obj[1:])
         return None
+
+
+def _simulate_change(scenario: Scenario, a: np.ndarray, b: np.ndarray, start: np.ndarray,
+                     end: np.ndarray) -> str | tuple[np.ndarray, np.ndarray, float]:
+    """Robots moving straight from ``a`` to ``b`` (N, 2), sampled every ``REFORM_STEP``,
+    and the object followed from ``start`` by the quasi-static simulation; it must end at
+    ``end``. Returns (robots (K+1, N, 2), object (K+1, 3), largest robot displacement)
+    or why the change is not usable."""
+    team = scenario.team
+    dist = float(np.linalg.norm(b - a, axis=1).max())
+    if dist <= 0.0:
+        return a[None], np.asarray(start, float)[None], 0.0
+    k = max(2, int(np.ceil(dist / _tol.REFORM_STEP)))
+    s = np.arange(0, k + 1) / k
+    robots = a[None] + s[:, None, None] * (b - a)[None]
+    try:
+        sim = simulate(team.sheet, robots, team.hold_height, start=start)
+    except TautError as exc:
+        return f"formation change has no rest state ({exc.problem})"
+    bad = [e for e in sim.events if e.kind in ("jump", "lost")]
+    if bad:
+        return (f"the object {bad[0].kind}s during a formation change "
+                f"(drop {bad[0].drop:.3g} m)")
+    if np.linalg.norm(sim.object[-1] - end) > _tol.OBJECT_RTOL * team.sheet.size:
+        return "a formation change does not end in the new formation's rest state"
+    obj = sim.object.copy()
+    obj[-1] = end
+    return robots, obj, dist
+
+
+@dataclass(frozen=True, eq=False)
+class ChangeProfile:
+    """The quasi-static simulation of an in-place change between two formations (the
+    model is invariant under planar rigid motions, so it is the same wherever the change
+    happens): ``message`` None when usable; ``lowest`` the lowest object height on the
+    way, m; ``duration`` s."""
+
+    message: str | None
+    lowest: float
+    duration: float
+
+
+@functools.lru_cache(maxsize=256)
+def change_profile(scenario: Scenario, f: Formation, g: Formation) -> ChangeProfile:
+    """:class:`ChangeProfile` of the change from ``f`` to ``g`` (memoised)."""
+    zero = np.zeros(2)
+    change = _simulate_change(scenario, f.placed(zero, np.asarray(0.0)),
+                              g.placed(zero, np.asarray(0.0)),
+                              np.array([0.0, 0.0, f.object_height]),
+                              np.array([0.0, 0.0, g.object_height]))
+    if isinstance(change, str):
+        return ChangeProfile(change, -np.inf, np.inf)
+    _, obj, dist = change
+    return ChangeProfile(None, float(obj[:, 2].min()), dist / scenario.team.speed)
 
 
 def sample_pieces(scenario: Scenario, pieces: list[Piece]) -> SampledMotion:

@@ -33,7 +33,9 @@ from .._validate import as_count
 from ..errors import InvalidInputError
 from . import _tol
 from ._ompl import Search, engine
-from ._se2 import SearchBudget, search_se2
+from ._lattice import MAX_NODES, lattice_search
+from ._se2 import SE2Search, SearchBudget, search_se2
+from ._se2_space import PoseChecker
 from ._se2_motion import Piece, sample_pieces
 from .certificate import find_certificate, narrowest_cut
 from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
@@ -185,23 +187,53 @@ def _finish_se2(scenario: Scenario, pieces: list[Piece], planner: str, sheet_mar
                       sheet_margin=sheet_margin, scenario=scenario)
 
 
+def _lattice(scenario: Scenario, forms: list[Formation], allow_crossing: bool,
+             budget: SearchBudget, planner: str, sheet_margin: float
+             ) -> tuple[PlanResult | None, str]:
+    """The lattice search over every formation (:mod:`taut.plan._lattice`): its verified
+    plan, or None and what it found."""
+    checkers = [PoseChecker(scenario, f, allow_crossing=allow_crossing) for f in forms]
+    lat = lattice_search(scenario, forms, checkers, spacing=budget.spacing,
+                         expansions=MAX_NODES, rng=np.random.default_rng(budget.seed))
+    where = (f"a lattice of {lat.spacing:.3g} m and {lat.headings} headings over "
+             f"{len(forms)} formation(s) with any number of changes")
+    refused = ("; changes refused by the quasi-static model: "
+               + "; ".join(lat.refused_changes)) if lat.refused_changes else ""
+    if lat.pieces is None:
+        return None, f"no path on {where}{refused}"
+    r = _finish_se2(scenario, lat.pieces, planner, sheet_margin)
+    if r.success:
+        return replace(r, search="lattice"), ""
+    return None, f"the path found on {where} failed verification: {r.message}"
+
+
 def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
          budget: SearchBudget, planner: str, library: Library,
-         search: Search = "rrtconnect") -> PlanResult:
+         search: Search = "auto") -> PlanResult:
     """One SE(2) search (crossing planner or its bypass baseline) and its best plan."""
     compact, others, notes = library
     forms = [compact, *others]
+    lattice_note = ""
+    if search in ("auto", "lattice"):
+        found_lattice, lattice_note = _lattice(scenario, forms, allow_crossing, budget,
+                                               planner, sheet_margin)
+        if found_lattice is not None:
+            return found_lattice
     results: list[PlanResult] = []
 
     def accept(pieces: list[Piece]) -> bool:
         results.append(_finish_se2(scenario, pieces, planner, sheet_margin))
         return results[-1].success
 
-    found = search_se2(scenario, forms, allow_crossing=allow_crossing, budget=budget,
-                       accept=accept, engine=engine(search))
+    if search == "lattice":
+        found = SE2Search()
+    else:
+        found = search_se2(scenario, forms, allow_crossing=allow_crossing, budget=budget,
+                           accept=accept, engine=engine(search))
     good = [r for r in results if r.success]
     if good:
-        return replace(min(good, key=lambda r: r.duration), search=search)
+        who = "rrtconnect" if search == "auto" else search
+        return replace(min(good, key=lambda r: r.duration), search=who)
     cert = find_certificate(scenario)
     if cert is not None:
         return failure(scenario, cert.message, planner, "refuted", cert)
@@ -210,16 +242,21 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
     if results and not found.timed_out and len(results) == len(found.notes):
         return failure(scenario, f"every candidate failed verification: {tried}", planner,
                        "unverified")
-    cap = (f"the time cap of {budget.time_budget:g} s" if found.timed_out
-           else f"{budget.iterations} samples per run, {found.iterations} of "
-                f"{budget.total_samples} in all")
+    if search == "lattice":
+        head = "not found on the lattice"
+    else:
+        cap = (f"the time cap of {budget.time_budget:g} s" if found.timed_out
+               else f"{budget.iterations} samples per run, {found.iterations} of "
+                    f"{budget.total_samples} in all")
+        head = f"not found within the budget ({cap}; seed {budget.seed})"
     searched = ("searched " + ", ".join(f"{f.kind} (object at {f.object_height:.3g} m)"
                                         for f in forms)
-                + f" alone and {found.pairs} formation pair(s) with one change, "
+                + (f" alone and {found.pairs} formation pair(s) with one change, "
+                   if search != "lattice" else ", ")
                 + ("crossing low obstacles" if allow_crossing else "bypassing only"))
-    return failure(scenario, f"not found within the budget ({cap}; seed {budget.seed}): "
-                   + "; ".join(x for x in (searched, tried, _diagnosis(scenario, forms,
-                                                                       allow_crossing)) if x),
+    return failure(scenario, f"{head}: " + "; ".join(
+        x for x in (searched, lattice_note, tried,
+                    _diagnosis(scenario, forms, allow_crossing)) if x),
                    planner, "budget_exhausted")
 
 
@@ -266,7 +303,8 @@ def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_ma
 def plan(scenario: Scenario, *, method: Method = "se2",
          baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
          sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float | None = None,
-         iterations: int = 3000, seed: int = 0, search: Search = "rrtconnect") -> PlanResult:
+         iterations: int = 3000, seed: int = 0, search: Search = "auto",
+         spacing: float = 0.05) -> PlanResult:
     """Plan the transport of the object from ``scenario.start`` to ``scenario.goal``.
 
     Parameters
@@ -291,11 +329,19 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     seed : int
         Seed of the SE(2) search: plans are reproducible for a given seed and
         ``iterations`` (unless the optional time cap stops a search).
-    search : {"rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"}
-        Who searches SE(2) (``method="se2"`` and ``baseline="se2"``): taut's own seeded
-        RRT-Connect (default), or OMPL's RRT-Connect / RRT* / PRM on the same validity
-        checker, formations, bounds and verification (optional extra ``plan-ompl``;
-        seeding in :mod:`taut.plan._ompl`).
+    search : {"auto", "lattice", "rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"}
+        Who searches SE(2) (``method="se2"`` and ``baseline="se2"``). ``"lattice"``: A*
+        over a lattice of poses of every formation at once, with any number of formation
+        changes (:mod:`taut.plan._lattice`; deterministic, the fastest lattice path,
+        resolution-complete at ``spacing``); ``"rrtconnect"``: taut's own seeded
+        RRT-Connect per formation and formation pair (narrow passages below the lattice's
+        resolution); ``"auto"`` (default): the lattice, then RRT-Connect where it finds
+        nothing. ``"ompl-*"``: OMPL's RRT-Connect / RRT* / PRM in place of taut's
+        RRT-Connect, on the same validity checker, formations, bounds and verification
+        (optional extra ``plan-ompl``; seeding in :mod:`taut.plan._ompl`).
+    spacing : float
+        Lattice spacing, m (the headings are spaced so that a heading step moves the
+        farthest robot about as far).
 
     Returns
     -------
@@ -319,8 +365,9 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     if time_budget is not None:
         as_bounded(time_budget, "time_budget", MAX_DURATION_S, "s")
     as_count(iterations, "iterations", minimum=1, maximum=10_000_000)
-    budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
-                              iterations, seed)
+    budget = replace(_checked_options(scenario, method, baseline, sheet_margin, time_budget,
+                                      iterations, seed),
+                     spacing=as_bounded(spacing, "spacing", MAX_SHEET_LENGTH, "m"))
     engine(search)                      # validates the name and that OMPL is installed
     margin = float(sheet_margin)
     cached = _library(scenario, margin)
@@ -353,7 +400,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
 
 @functools.lru_cache(maxsize=32)
 def _bypass(scenario: Scenario, sheet_margin: float, budget: SearchBudget,
-            search: Search = "rrtconnect") -> PlanResult:
+            search: Search = "auto") -> PlanResult:
     """The SE(2) bypass search (the baseline, and the crossing planner's last fallback),
     memoised: it is deterministic for a given scenario, margin and sample budget, so the
     fallback and the baseline are one search, run once."""
