@@ -36,11 +36,25 @@ class Robustness:
     tear_probability : float
         Fraction of trials in which some robot pair was beyond its sheet distance.
     drop_probability : float
-        Fraction of trials in which, at some checked sample, the lowest rest state of the
-        perturbed formation was below the height safety over an obstacle beneath the
-        sheet or over the ground (forward kinematics at the tightest samples).
+        Fraction of trials in which the object's rest state ended in the quasi-static
+        replay (a jump to another state, or lost).
     worst_extension : float
         Largest (robot distance - sheet distance) seen, m (negative: never taut).
+    contact_probability : float
+        Fraction of trials in which the object touched an obstacle beneath the sheet or
+        the ground.
+    unsafe_probability : float
+        Fraction of trials in which the object came closer than the height safety to
+        them somewhere (the planner's rule; not by itself a failure).
+    collision_probability : float
+        Fraction of trials in which a robot's footprint touched a wall or an obstacle.
+    failure_probability : float
+        Fraction of trials with a tear, a drop, a contact or a collision.
+    worst_height_margin : float
+        Least object height above the obstacle beneath (or the ground) over the replays
+        that were not torn, m.
+    worst_clearance : float
+        Least robot-centre distance to a wall or obstacle over all trials, m.
     """
 
     sigma: float
@@ -49,6 +63,12 @@ class Robustness:
     tear_probability: float
     drop_probability: float
     worst_extension: float
+    contact_probability: float = 0.0
+    unsafe_probability: float = 0.0
+    collision_probability: float = 0.0
+    failure_probability: float = 0.0
+    worst_height_margin: float = float("nan")
+    worst_clearance: float = float("nan")
 
 
 @dataclass(frozen=True, eq=False)

@@ -59,10 +59,9 @@ def _run_suite(ctx: Any, cols: Columns, seeds: np.ndarray) -> Columns:
 
 @dataclass(frozen=True, eq=False)
 class _PlanContext:
-    team: Any
+    scenario: Any
     robots: np.ndarray       # (T, N, 2) m
     object: np.ndarray       # (T, 3) m
-    limits: np.ndarray       # (N, N) sheet distances, m
 
 
 def _prepare_robustness(spec: Any) -> _PlanContext:
@@ -74,35 +73,23 @@ def _prepare_robustness(spec: Any) -> _PlanContext:
     if not res.success:
         _, _, message = _status(res)
         raise SweepError("base", f"the base scenario has no plan to perturb ({message})")
-    return _PlanContext(sc.team, np.asarray(res.robots, float), np.asarray(res.object, float),
-                        sc.team.sheet.side_lengths())
+    return _PlanContext(sc, np.asarray(res.robots, float), np.asarray(res.object, float))
 
 
 def _run_robustness(ctx: _PlanContext, cols: Columns, seeds: np.ndarray) -> Columns:
-    from ...sheet import simulate
+    from ...plan.robustness import replay
 
     b = len(seeds)
     out: Columns = {"torn": np.zeros(b, dtype=bool), "max_extension": np.full(b, np.nan),
-                    "jumped": np.zeros(b, dtype=bool), "max_deviation": np.full(b, np.nan)}
-    iu, ju = np.triu_indices(ctx.robots.shape[1], 1)
+                    "jumped": np.zeros(b, dtype=bool), "max_deviation": np.full(b, np.nan),
+                    "contact": np.zeros(b, dtype=bool), "collision": np.zeros(b, dtype=bool)}
     for k in range(b):
         rng = np.random.default_rng(int(seeds[k]))
         noisy = ctx.robots + rng.normal(0.0, cols["sigma"][k], size=ctx.robots.shape)
-        dist = np.linalg.norm(noisy[:, iu] - noisy[:, ju], axis=-1)
-        ext = float(np.max(dist - ctx.limits[iu, ju]))
-        out["max_extension"][k] = ext
-        if ext > 0:
-            out["torn"][k] = True
-            continue
-        try:
-            sim = simulate(ctx.team.sheet, noisy, ctx.team.hold_height, start=ctx.object[0])
-        except TautError:          # e.g. a formation the sheet cannot span within rounding
-            out["torn"][k] = True
-            continue
-        events = getattr(sim, "events", ())
-        out["jumped"][k] = any(getattr(e, "kind", "") in ("jump", "lost") for e in events)
-        out["max_deviation"][k] = float(np.max(np.linalg.norm(
-            np.asarray(sim.object) - ctx.object, axis=1)))
+        t = replay(ctx.scenario, noisy, ctx.object)
+        out["torn"][k], out["max_extension"][k] = t.torn, t.extension
+        out["jumped"][k], out["max_deviation"][k] = t.dropped, t.deviation
+        out["contact"][k], out["collision"][k] = t.contact, t.collision
     return out
 
 
@@ -131,7 +118,9 @@ register(Task(
     outputs={"torn": "some robot pair exceeded its sheet distance",
              "max_extension": "largest pair distance beyond its sheet distance, m (< 0: slack)",
              "jumped": "the object left its branch (jump or lost) in the simulation",
-             "max_deviation": "largest distance of the object from its planned position, m"},
+             "max_deviation": "largest distance of the object from its planned position, m",
+             "contact": "the object touched an obstacle beneath the sheet or the ground",
+             "collision": "a robot's footprint touched a wall or an obstacle"},
     defaults=lambda ctx: {"sigma": 0.005, "trial": 0.0},
     default_chunk=25,
     needs_base="plan scenario",

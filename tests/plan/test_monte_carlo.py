@@ -1,0 +1,54 @@
+"""Monte Carlo of a plan under robot position error: the replay through the quasi-static
+simulation and what it counts."""
+
+import numpy as np
+import pytest
+
+from taut.io import load_plan_scenario
+from taut.plan import plan
+from taut.plan.robustness import replay
+
+from .test_plan import EXAMPLES
+
+
+@pytest.fixture(scope="module")
+def paper():
+    sc = load_plan_scenario(EXAMPLES / "paper_corridor.yaml")
+    return sc, plan(sc)
+
+
+def test_exact_replay_matches_the_verification(paper):
+    sc, r = paper
+    t = replay(sc, r.robots, r.object)
+    assert not t.failed and not t.unsafe
+    assert t.deviation < 1e-6 * sc.team.sheet.size
+    assert t.height_margin == pytest.approx(min(r.verification.min_height_margin,
+                                                r.object[:, 2].min()), abs=1e-9)
+    assert t.clearance == pytest.approx(r.verification.min_clearance, abs=1e-9)
+    assert t.extension == pytest.approx(-r.verification.min_sheet_slack, abs=1e-12)
+
+
+def test_a_robot_pushed_into_a_wall_is_a_collision_and_a_pair_pulled_apart_a_tear(paper):
+    sc, r = paper
+    bad = r.robots.copy()
+    bad[5, 0, 1] = 1.0 - 0.5 * sc.team.robot_radius         # half inside the wall y = 1
+    assert replay(sc, bad, r.object).collision
+    far = r.robots.copy()
+    far[7, 0] += 10.0
+    t = replay(sc, far, r.object)
+    assert t.torn and t.failed and t.extension > 9.0
+
+
+def test_probabilities_follow_the_margins(paper):
+    sc, r = paper
+    small = r.robustness(0.005, 10, seed=2)       # the default 5 mm position accuracy
+    assert small.tear_probability == 0.0 and small.worst_extension < 0
+    assert small.failure_probability == 0.0 and small.collision_probability == 0.0
+    # The plan holds the object exactly the height safety above the obstacles, so noise
+    # makes it unsafe (below the safety) in most trials without any contact.
+    assert small.unsafe_probability > 0.5 and small.contact_probability == 0.0
+    assert 0 < small.worst_height_margin < sc.team.height_safety
+    big = r.robustness(0.2, 10, seed=2)
+    assert big.tear_probability > 0.5 and big.failure_probability >= big.tear_probability
+    # 4 cm at every sample squeezes the compact formation until the object is lost.
+    assert r.robustness(0.04, 5, seed=2).drop_probability > 0
