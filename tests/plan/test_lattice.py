@@ -157,3 +157,20 @@ def test_two_formation_changes_in_an_l_corridor():
     rigid = np.abs(np.diff(np.linalg.norm(r.robots[:, 0] - r.robots[:, 1], axis=1))) < 1e-9
     changes = np.flatnonzero(np.diff(np.concatenate([[1], (~rigid).astype(int)])) == 1)
     assert len(changes) >= 2
+
+
+def test_change_rules_block_obstacles_the_lowest_object_does_not_clear(small):
+    sc, forms, checkers = small
+    cost, obst, refused = _lattice._changes(sc, forms, checkers)
+    assert not refused and np.all(np.isfinite(cost[~np.eye(2, dtype=bool)]))
+    low = min(f.object_height for f in forms)
+    post = sc.world.obstacle("post")
+    # The compact formation's object (0.05 m) cannot clear the 0.1 m post: blocked during
+    # either change; flags are exactly 0 or 1.
+    assert low - sc.team.height_safety < post.height
+    assert obst[0, 1][0, 3] == 1.0 and obst[1, 0][0, 3] == 1.0
+    assert set(np.unique(obst[..., 3])) <= {0.0, 1.0}
+    # Without crossing every obstacle is blocked.
+    bypass = [PoseChecker(sc, f, allow_crossing=False) for f in forms]
+    _, obst_b, _ = _lattice._changes(sc, forms, bypass)
+    assert np.all(obst_b[0, 1][:, 3] == 1.0)

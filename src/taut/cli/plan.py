@@ -66,18 +66,8 @@ def plan_command(
     out = output_path(out, "--out", JSON_SUFFIXES)
     plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
-    if budget is not None and not 0 < budget <= MAX_BUDGET_S:
-        raise InvalidInputError("--budget", f"must be in (0, {MAX_BUDGET_S:g}] s, got {budget:g}")
-    if not 0 <= sheet_margin <= 1.0:
-        raise InvalidInputError("--sheet-margin", f"must be in [0, 1] m, got {sheet_margin:g}")
-    as_count(seed, "--seed", minimum=0)
-    as_count(iterations, "--iterations", minimum=1, maximum=MAX_ITERATIONS)
-    _check_search(search)
-    if not 0.005 <= spacing <= 1.0:
-        raise InvalidInputError("--spacing", f"must be in [0.005, 1] m, got {spacing:g}")
-    if baseline and disc_baseline:
-        raise InvalidInputError("--baseline", "give at most one of --baseline and "
-                                "--disc-baseline")
+    _check_options(budget, sheet_margin, seed, iterations, search, spacing,
+                   baseline and disc_baseline)
     sc = load_plan_scenario(scenario)
     with working("plan"):
         result = plan(sc, baseline="disc" if disc_baseline else baseline,
@@ -107,6 +97,23 @@ def plan_command(
                 typer.echo(f"taut: {name}: {path} not written: there is no plan to draw",
                            err=True)
     return 0 if result.success else 1
+
+
+def _check_options(budget: float | None, sheet_margin: float, seed: int, iterations: int,
+                   search: str, spacing: float, both_baselines: bool) -> None:
+    """Every option's range, before any work (one line naming the option)."""
+    if budget is not None and not 0 < budget <= MAX_BUDGET_S:
+        raise InvalidInputError("--budget", f"must be in (0, {MAX_BUDGET_S:g}] s, got {budget:g}")
+    if not 0 <= sheet_margin <= 1.0:
+        raise InvalidInputError("--sheet-margin", f"must be in [0, 1] m, got {sheet_margin:g}")
+    as_count(seed, "--seed", minimum=0)
+    as_count(iterations, "--iterations", minimum=1, maximum=MAX_ITERATIONS)
+    _check_search(search)
+    if not 0.005 <= spacing <= 1.0:
+        raise InvalidInputError("--spacing", f"must be in [0.005, 1] m, got {spacing:g}")
+    if both_baselines:
+        raise InvalidInputError("--baseline", "give at most one of --baseline and "
+                                "--disc-baseline")
 
 
 def _check_search(search: str) -> None:

@@ -124,7 +124,9 @@ def _changes(scenario: Scenario, forms: list[Formation], checkers: list[PoseChec
              ) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Cost (L, L) of every allowed change (inf: refused by the quasi-static model) and
     its obstacle rows: an obstacle may be under the hull during a change only when the
-    lowest object on the way clears it by the height safety (and crossing is allowed)."""
+    lowest object on the way clears it by the height safety plus ``MAX_OBJECT_STEP`` (the
+    verifier samples a change until the object moves at most that much between samples,
+    and allows for it between them), and crossing is allowed."""
     L = len(forms)
     cost = np.full((L, L), np.inf)
     obst = np.stack([np.stack([c._obst for c in checkers])] * L)
@@ -142,9 +144,10 @@ def _changes(scenario: Scenario, forms: list[Formation], checkers: list[PoseChec
                 continue
             cost[a, b] = max(prof.duration, _tol.MIN_EDGE_COST)
             if len(obst[a, b]):
-                tall = np.array([o.height > prof.lowest - safety + _tol.GEOMETRY_TOL
+                low = prof.lowest - _tol.MAX_OBJECT_STEP
+                tall = np.array([o.height > low - safety + _tol.GEOMETRY_TOL
                                  for o in scenario.world.obstacles])
-                obst[a, b][:, 3] = (tall | ~checkers[a].allow_crossing).astype(float)
+                obst[a, b][:, 3] = (tall | (not checkers[a].allow_crossing)).astype(float)
     return cost, obst, refused
 
 

@@ -70,6 +70,81 @@ def _clear(node, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts, 
 
 
 @jit
+def _push(heap, g, parent, q, node, cost, x, y, goal_xy, speed):
+    """Relax node ``q`` reached from ``node`` at ``cost`` (its pose at ``(x, y)``)."""
+    g[q], parent[q] = cost, node
+    dist = math.sqrt((x - goal_xy[0]) ** 2 + (y - goal_xy[1]) ** 2)
+    heapq.heappush(heap, (cost + dist / speed, q))
+
+
+@jit
+def _rigid_moves(node, c0, heap, g, parent, done, clear, cells, nbr, nk, geo, locals_,
+                 radii, walls, obsts, verts, rule, motion, goal_xy, work):
+    """Relax the 26 lattice neighbours of ``node`` in its layer (module docstring)."""
+    C = cells.shape[0]
+    dpsi = geo[1]
+    speed, omega, margin, min_step, need = motion[0], motion[1], motion[2], motion[3], motion[4]
+    robots, order, scratch, a, b = work[0], work[1], work[2], work[3], work[4]
+    k = node % nk
+    cell = (node // nk) % C
+    layer = node // (nk * C)
+    x, y, psi = cells[cell, 0], cells[cell, 1], -math.pi + k * dpsi
+    for m in range(9):
+        c2 = cell if m == 8 else nbr[cell, m]
+        if c2 < 0:
+            continue
+        move = math.sqrt((cells[c2, 0] - x) ** 2 + (cells[c2, 1] - y) ** 2)
+        for dk in range(-1, 2):
+            if m == 8 and dk == 0:
+                continue
+            q = (layer * C + c2) * nk + (k + dk) % nk
+            if done[q]:
+                continue
+            cq = _clear(q, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts,
+                        rule, robots, order, scratch)
+            if cq < need:
+                continue
+            if c0 + cq - move - radii[layer] * dpsi * abs(dk) < 2.0 * margin:
+                a[0], a[1], a[2] = x, y, psi
+                b[0], b[1], b[2] = cells[c2, 0], cells[c2, 1], psi + dk * dpsi
+                if motion_clear(locals_[layer], radii[layer], walls, obsts[layer], verts,
+                                rule, a, b, margin, min_step) <= 0:
+                    continue
+            cost = g[node] + max(move / speed, dpsi * abs(dk) / omega)
+            if cost < g[q]:
+                _push(heap, g, parent, q, node, cost, cells[c2, 0], cells[c2, 1], goal_xy,
+                      speed)
+
+
+@jit
+def _changes(node, heap, g, parent, done, clear, cells, nk, geo, locals_, radii, walls,
+             obsts, verts, rule, motion, change_cost, change_obst, goal_xy, work):
+    """Relax the same pose of every other layer that ``node``'s layer may change to."""
+    C = cells.shape[0]
+    margin, min_step, need = motion[2], motion[3], motion[4]
+    robots, order, scratch, other = work[0], work[1], work[2], work[5]
+    k = node % nk
+    cell = (node // nk) % C
+    layer = node // (nk * C)
+    x, y, psi = cells[cell, 0], cells[cell, 1], -math.pi + k * geo[1]
+    for m in range(locals_.shape[0]):
+        if m == layer or not change_cost[layer, m] < np.inf:
+            continue
+        q = (m * C + cell) * nk + k
+        cost = g[node] + change_cost[layer, m]
+        if done[q] or not cost < g[q]:
+            continue
+        if _clear(q, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts, rule,
+                  robots, order, scratch) < need:
+            continue
+        _place(locals_[layer], x, y, psi, robots)
+        _place(locals_[m], x, y, psi, other)
+        if morph_clear(robots, other, x, y, max(radii[layer], radii[m]), walls,
+                       change_obst[layer, m], verts, rule, margin, min_step) > 0:
+            _push(heap, g, parent, q, node, cost, x, y, goal_xy, motion[0])
+
+
+@jit
 def lattice_astar(cells, nbr, nk, geo, locals_, radii, walls, obsts, verts, rule, motion,
                   change_cost, change_obst, starts, goal_nodes, goal_cost, goal_xy,
                   max_expansions):
@@ -87,18 +162,12 @@ def lattice_astar(cells, nbr, nk, geo, locals_, radii, walls, obsts, verts, rule
     L, N = locals_.shape[0], locals_.shape[1]
     C = cells.shape[0]
     total = L * C * nk
-    dpsi = geo[1]
-    speed, omega, margin, min_step, need = motion[0], motion[1], motion[2], motion[3], motion[4]
     g = np.full(total, np.inf)
     parent = np.full(total, -1, np.int64)
     clear = np.full(total, np.nan, np.float32)
     done = np.zeros(total, np.bool_)
-    robots = np.empty((N, 2))
-    other = np.empty((N, 2))
-    order = np.empty(N, np.int64)
-    scratch = np.empty((N + 1, 2))
-    a = np.empty(3)
-    b = np.empty(3)
+    work = (np.empty((N, 2)), np.empty(N, np.int64), np.empty((N + 1, 2)), np.empty(3),
+            np.empty(3), np.empty((N, 2)))
     heap = [(0.0, np.int64(0))]
     heap.pop()
     for s in starts:
@@ -115,65 +184,16 @@ def lattice_astar(cells, nbr, nk, geo, locals_, radii, walls, obsts, verts, rule
         expanded += 1
         if expanded > max_expansions:
             break
-        k = node % nk
-        cell = (node // nk) % C
-        layer = node // (nk * C)
-        base = layer * C
-        x, y, psi = cells[cell, 0], cells[cell, 1], -math.pi + k * dpsi
-        c0 = _clear(node, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts,
-                    rule, robots, order, scratch)
         gi = np.searchsorted(goal_nodes, node)
         if gi < len(goal_nodes) and goal_nodes[gi] == node:
             if g[node] + goal_cost[gi] < best_cost:
                 best_cost, best_goal = g[node] + goal_cost[gi], node
-        for m in range(9):
-            c2 = cell if m == 8 else nbr[cell, m]
-            if c2 < 0:
-                continue
-            move = math.sqrt((cells[c2, 0] - x) ** 2 + (cells[c2, 1] - y) ** 2)
-            for dk in range(-1, 2):
-                if m == 8 and dk == 0:
-                    continue
-                q = (base + c2) * nk + (k + dk) % nk
-                if done[q]:
-                    continue
-                cq = _clear(q, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts,
-                            rule, robots, order, scratch)
-                if cq < need:
-                    continue
-                disp = move + radii[layer] * dpsi * abs(dk)
-                if c0 + cq - disp < 2.0 * margin:
-                    a[0], a[1], a[2] = x, y, psi
-                    b[0], b[1], b[2] = cells[c2, 0], cells[c2, 1], psi + dk * dpsi
-                    if motion_clear(locals_[layer], radii[layer], walls, obsts[layer], verts,
-                                    rule, a, b, margin, min_step) <= 0:
-                        continue
-                cost = g[node] + max(move / speed, dpsi * abs(dk) / omega)
-                if cost < g[q]:
-                    g[q], parent[q] = cost, node
-                    dist = math.sqrt((cells[c2, 0] - goal_xy[0]) ** 2
-                                     + (cells[c2, 1] - goal_xy[1]) ** 2)
-                    heapq.heappush(heap, (cost + dist / speed, q))
-        for m in range(L):
-            if m == layer or not change_cost[layer, m] < np.inf:
-                continue
-            q = (m * C + cell) * nk + k
-            if done[q]:
-                continue
-            cost = g[node] + change_cost[layer, m]
-            if not cost < g[q]:
-                continue
-            if _clear(q, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts, rule,
-                      robots, order, scratch) < need:
-                continue
-            _place(locals_[layer], x, y, psi, robots)
-            _place(locals_[m], x, y, psi, other)
-            if morph_clear(robots, other, x, y, max(radii[layer], radii[m]), walls,
-                           change_obst[layer, m], verts, rule, margin, min_step) <= 0:
-                continue
-            g[q], parent[q] = cost, node
-            dist = math.sqrt((x - goal_xy[0]) ** 2 + (y - goal_xy[1]) ** 2)
-            heapq.heappush(heap, (cost + dist / speed, q))
+        c0 = _clear(node, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts,
+                    rule, work[0], work[1], work[2])
+        _rigid_moves(node, c0, heap, g, parent, done, clear, cells, nbr, nk, geo, locals_,
+                     radii, walls, obsts, verts, rule, motion, goal_xy, work)
+        _changes(node, heap, g, parent, done, clear, cells, nk, geo, locals_, radii, walls,
+                 obsts, verts, rule, motion, change_cost, change_obst, goal_xy, work)
     if best_goal < 0:
         return np.zeros(0, np.int64), np.inf, expanded
     path = [best_goal]
