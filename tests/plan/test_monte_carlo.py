@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from taut.io import load_plan_scenario
-from taut.plan import plan
+from taut.plan import _tol, plan
 from taut.plan.robustness import replay
 
 from .test_plan import EXAMPLES
@@ -24,7 +24,10 @@ def test_exact_replay_matches_the_verification(paper):
     assert t.deviation < 1e-6 * sc.team.sheet.size
     assert t.height_margin == pytest.approx(min(r.verification.min_height_margin,
                                                 r.object[:, 2].min()), abs=1e-9)
-    assert t.clearance == pytest.approx(r.verification.min_clearance, abs=1e-9)
+    # The replay measures at the samples; the verification proves the least clearance of
+    # the continuous motion (a lower bound), within the sampling's robot motion of it.
+    assert (r.verification.min_clearance - 1e-7 <= t.clearance
+            <= r.verification.min_clearance + _tol.SAMPLE_STEP)
     assert t.extension == pytest.approx(-r.verification.min_sheet_slack, abs=1e-12)
 
 

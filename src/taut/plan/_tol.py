@@ -83,3 +83,44 @@ INSCRIBED_CIRCLE_RTOL = 1e-3
 #: is at least this much below the compact formation's, m: one barely narrower opens no
 #: passage the compact one cannot pass and only adds a formation to search with.
 NARROWER_BY = 0.01
+#: Most bisections of one sample interval when proving the geometric rules between samples
+#: (:mod:`taut.plan._verify_geometry`), a count: a piece is proved when its ends' slacks
+#: (m, the tolerance ``GEOMETRY_TOL`` included) add up to its robot travel, so an interval
+#: of ``SAMPLE_STEP`` still unproved after 16 halvings (pieces of 0.3 um) comes within
+#: 0.3 um of breaking a rule even with the tolerance: it is refused as unproved.
+PROOF_DEPTH = 16
+#: Most poses that proof inserts in all (and that the search for the least clearance
+#: measures), a count: bounds its time to about two seconds for 8 robots and 4 obstacles
+#: (~40 us a pose). A plan keeping 1 mm of slack needs about 20 poses per 2 cm interval
+#: where it keeps so little; one needing more keeps micrometres over a long stretch.
+MAX_PROOF_POSES = 50_000
+#: Squeezed formations (:mod:`taut.plan._squeeze`): the object rests at least this much
+#: above the ground safety height ``team.height_safety``, m, so that the robots' position
+#: error (``POSITION_ACCURACY``) does not lower it under the safety height at once.
+SQUEEZE_HEIGHT_MARGIN = 5e-3
+#: A slack cable of a squeezed formation is at least this much shorter than the sheet
+#: between its vertex and the contact point, m: far below the robots' position accuracy
+#: (the design is still checked by forward kinematics), above round-off, so the taut set the
+#: optimiser designs is the one forward kinematics finds.
+SQUEEZE_SLACK = 1e-3
+#: Forward-difference step of the squeezed-formation program's Jacobian (normalised units:
+#: times the sheet size): about the square root of float64's epsilon times the O(1)
+#: normalised coordinates.
+SQUEEZE_FD_STEP = 1e-7
+#: A linear system of the squeezed-formation program (the rest state of a taut set, in
+#: normalised units with O(1) entries) with a smaller determinant is taken as singular.
+SQUEEZE_SINGULAR = 1e-12
+#: Margin by which a cut of the squeezed-formation program removes an unwanted stable rest
+#: state (a weight or curvature this far below zero, or a slack cable this far over its
+#: length, in normalised units): far above the FK solver's tolerances (~1e-9).
+SQUEEZE_CUT_MARGIN = 1e-3
+#: Minimising the width of a squeezed formation stops when it is within this of the lower
+#: bound ``2 * inset`` (any polygon holding a disc of radius ``inset`` is at least that
+#: wide), m: on the seed-2024 suite the last 3 cm cost several times the search's time, and
+#: the team is then narrower than its robots' footprints plus two clearances (~0.5 m).
+SQUEEZE_WIDTH_TOL = 3e-2
+#: Accuracy of the least robot clearance a verification reports, m: it is a lower bound
+#: within this of the continuous motion's least clearance, so it does not depend on how
+#: finely the motion is sampled (far below the robots' position accuracy; a few
+#: bisections of a turning interval reach it).
+CLEARANCE_ACCURACY = 1e-7

@@ -19,7 +19,18 @@ Checked (vectorised over samples):
    is taut);
 4. every robot centre is inside the free space and at least ``robot_radius +
    lateral_safety`` from walls and obstacles, and the robots' hull stays in the free space
-   (walls are tall).
+   (walls are tall). Checks 3 (obstacles beneath the hull) and 4 are proved for the
+   continuous motion between samples too (:mod:`taut.plan._verify_geometry`): each rule is
+   a slack, m, that moves no faster than the robots, and every robot's travel between two
+   samples is bounded (rigid intervals: centroid step plus radius times turn; formation
+   changes: the longest straight robot step), so an interval whose end slacks add up to
+   its travel cannot break a rule; others are bisected (rigidly or linearly) until proved,
+   until an inserted pose breaks a rule, or until a depth limit (then unproved: refused).
+   Between samples the object is taken at its lowest height on the interval (carried
+   rigidly; on a formation change, the lowest model sample less ``max_object_step``), and
+   the model samples of formation changes keep the height safety above the ground. The
+   reported least clearance is the continuous motion's (exact robot paths, to
+   ``_tol.CLEARANCE_ACCURACY``), not the samples'.
 
 :func:`resample_motion` refines a sampled motion (rigidly on rigid intervals) so that the
 checks can be re-run at any multiple of a plan's sampling.
@@ -37,6 +48,7 @@ from .._outcome import check_status, deprecated_alias
 from ..errors import InvalidInputError, TautError
 from ..sheet import check_formations, forward_kinematics, simulate
 from . import _tol
+from ._verify_geometry import Shapes, prove_between, shapes_of
 from .world import Scenario
 from .._validate import MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance, require_nonempty
 
@@ -63,9 +75,12 @@ class Verification:
         Taut cables per sample (0-based).
     min_height_margin : float
         Least (object height - obstacle height) over samples with an obstacle beneath, m
-        (inf when none).
+        (inf when none); samples inserted by the proof between samples count, with the
+        interval's lowest object height.
     min_clearance : float
-        Least robot-centre distance to a wall or obstacle, m.
+        Least robot-centre distance to a wall or obstacle over the continuous motion, m:
+        a lower bound within ``_tol.CLEARANCE_ACCURACY`` of it (so it does not depend on
+        how finely the motion is sampled).
     min_sheet_slack : float
         Least (sheet distance - robot distance) over samples and robot pairs, m.
     max_object_step : float
@@ -116,7 +131,8 @@ def _follow_rigid(obj: np.ndarray, robots: np.ndarray, t: int) -> np.ndarray:
 def _simulate_run(scenario: Scenario, robots: np.ndarray, start: np.ndarray,
                   max_step: float, depth: int = 8):
     """Simulate a non-rigid run, refining intervals where the object moves more than
-    ``max_step``. Returns (object at the run's samples, taut sets, largest step, message)."""
+    ``max_step``. Returns (object at the run's samples, taut sets, largest step, message,
+    lowest object height per interval over the model samples)."""
     team = scenario.team
     s = np.arange(len(robots), dtype=float)          # sample parameter of each fine state
     for _ in range(depth + 1):
@@ -128,27 +144,31 @@ def _simulate_run(scenario: Scenario, robots: np.ndarray, start: np.ndarray,
         if bad:
             e = bad[0]
             return None, None, np.inf, (f"object {e.kind}s during a formation change "
-                                        f"(drop {e.drop:.3g} m)")
+                                        f"(drop {e.drop:.3g} m)"), None
         step = np.linalg.norm(np.diff(sim.object, axis=0), axis=1)
         big = np.flatnonzero(step > max_step)
         if not len(big):
             keep = np.flatnonzero(np.abs(s - np.round(s)) == 0)
-            return sim.object[keep], [sim.taut[k] for k in keep], float(step.max(initial=0)), None
+            z = sim.object[:, 2]
+            low = np.minimum(np.minimum.reduceat(z, keep[:-1]), z[keep[1:]])
+            return (sim.object[keep], [sim.taut[k] for k in keep], float(step.max(initial=0)),
+                    None, low)
         s = np.sort(np.concatenate([s, (s[big] + s[big + 1]) / 2]))
     return None, None, float(step.max()), (f"the object moves {step.max():.3g} m between "
                                            "samples however finely a formation change is "
-                                           "sampled (a jump)")
+                                           "sampled (a jump)"), None
 
 
 def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
                   max_step: float):
-    """Rest state along the motion (module docstring, check 2)."""
+    """Rest state along the motion (module docstring, check 2): (object, taut sets,
+    largest object step, message or None, lowest object height per interval, m)."""
     team = scenario.team
     size = team.sheet.size
     T = len(robots)
     fk0 = forward_kinematics(team.sheet, robots[0], team.hold_height)
     if not fk0.stable:
-        return None, (), 0.0, "no stable rest state at the first sample"
+        return None, (), 0.0, "no stable rest state at the first sample", None
     lowest = fk0.lowest
     assert lowest is not None                     # fk0.stable is not empty
     guess = planned[0] if np.all(np.isfinite(planned[0])) else lowest.object
@@ -157,20 +177,22 @@ def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
     taut: list[tuple[int, ...]] = [()] * T
     obj[0], taut[0] = e0.object, e0.taut
     rigid = _rigid_mask(robots, _tol.RIGID_RTOL * size * 10)
+    low = np.full(T - 1, np.nan)
     worst = 0.0
     t = 0
     while t < T - 1:
         if rigid[t]:
             obj[t + 1], taut[t + 1] = _follow_rigid(obj[t], robots, t), taut[t]
+            low[t] = obj[t, 2]                    # carried rigidly: the height is constant
             t += 1
             continue
         u = t
         while u < T - 1 and not rigid[u]:
             u += 1
-        o, ts, step, why = _simulate_run(scenario, robots[t:u + 1], obj[t], max_step)
+        o, ts, step, why, z = _simulate_run(scenario, robots[t:u + 1], obj[t], max_step)
         if why is not None:
-            return obj, tuple(taut), step, why
-        obj[t:u + 1], taut[t:u + 1] = o, ts
+            return obj, tuple(taut), step, why, low
+        obj[t:u + 1], taut[t:u + 1], low[t:u] = o, ts, z
         worst = max(worst, step)
         t = u
     err = np.linalg.norm(obj - planned, axis=1)
@@ -179,23 +201,23 @@ def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
     if off.any():
         k = int(np.argmax(off))
         return obj, tuple(taut), worst, (f"object left the planned branch at sample {k} "
-                                         f"(off by {err[k]:.3g} m)")
-    return obj, tuple(taut), worst, None
+                                         f"(off by {err[k]:.3g} m)"), low
+    return obj, tuple(taut), worst, None, low
 
 
-def _geometry(scenario: Scenario, robots: np.ndarray, obj: np.ndarray
-              ) -> tuple[float, float, str | None]:
-    """Checks 3-4: (height margin, clearance, message or None)."""
+def _geometry(scenario: Scenario, robots: np.ndarray, obj: np.ndarray,
+              shapes: Shapes | None = None) -> tuple[float, float, str | None]:
+    """Checks 3-4 at the samples: (height margin, clearance, message or None); ``shapes``:
+    the samples' points and hulls (:func:`~taut.plan._verify_geometry.shapes_of`)."""
     team, world = scenario.team, scenario.world
     T, N = robots.shape[:2]
     if np.nanmin(obj[:, 2]) < team.height_safety - TOLERANCE:
         return -np.inf, -np.inf, "object closer to the ground than the height safety"
-    pts = shapely.points(robots.reshape(-1, 2))
+    pts, hulls = shapes if shapes is not None else shapes_of(robots)
     inside = shapely.contains(world.geometry, pts)
     if not inside.all():
         k = int(np.argmin(inside))
         return -np.inf, -np.inf, f"robot {k % N + 1} leaves the free space at sample {k // N}"
-    hulls = shapely.convex_hull(shapely.multipoints(robots))
     out = ~shapely.covers(world.geometry.buffer(TOLERANCE), hulls)
     if out.any():
         return -np.inf, -np.inf, (f"the sheet crosses a wall at sample "
@@ -281,14 +303,21 @@ def verify_motion(scenario: Scenario, robots: ArrayLike, planned_object: ArrayLi
     if gap < 2 * team.robot_radius - TOLERANCE:
         return fail(f"robots overlap (centres {gap:.3g} m apart)", slack=slack)
     try:
-        obj, taut, step, why = _model_states(scenario, robots, planned, max_object_step)
+        obj, taut, step, why, low = _model_states(scenario, robots, planned,
+                                                  max_object_step)
     except TautError as exc:
         return fail(f"simulation failed: {exc}", slack=slack)
     if why is not None:
         return fail(why, obj, taut, slack)
-    margin, clear, why = _geometry(scenario, robots, obj)
+    shapes = shapes_of(robots)
+    margin, clear, why = _geometry(scenario, robots, obj, shapes)
     if why is not None:
         return fail(why, obj, taut, slack)
+    rigid = _rigid_mask(robots, _tol.RIGID_RTOL * team.sheet.size * 10)   # as _model_states
+    margin2, clear2, why = prove_between(scenario, robots, low, rigid, max_object_step, shapes)
+    if why is not None:
+        return fail(why, obj, taut, slack)
+    margin, clear = min(margin, margin2), min(clear, clear2)
     return Verification(True, "ok", f"verified at {T} samples", obj, tuple(taut), margin,
                         clear, slack, step)
 
