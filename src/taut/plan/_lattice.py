@@ -238,13 +238,17 @@ def _pieces(forms: list[Formation], checkers: list[PoseChecker],
 
 def _rigid(checker: PoseChecker, f: Formation, run: list[np.ndarray],
            rng: np.random.Generator) -> Piece:
-    """A rigid piece through ``run`` (headings unwrapped), straight runs merged, then
-    shortcut."""
+    """A rigid piece through ``run`` (headings unwrapped), runs of equal lattice moves
+    merged into one straight motion while they turn by at most pi/2 in all (the shortcut
+    needs edges that turn by less than pi), then shortcut."""
     w = np.array(run)
     for k in range(1, len(w)):
         w[k, 2] = w[k - 1, 2] + float(np.angle(np.exp(1j * (w[k, 2] - w[k - 1, 2]))))
     if len(w) > 2:
-        step = np.diff(w, axis=0)
-        turn = np.flatnonzero(np.abs(step[1:] - step[:-1]).max(axis=1) > _tol.GEOMETRY_TOL)
-        w = shortcut(checker, w[np.concatenate([[0], turn + 1, [len(w) - 1]])], rng)
+        keep = [0]
+        for k in range(1, len(w) - 1):
+            bend = np.abs((w[k + 1] - w[k]) - (w[k] - w[k - 1])).max() > _tol.GEOMETRY_TOL
+            if bend or abs(w[k + 1, 2] - w[keep[-1], 2]) > np.pi / 2:
+                keep.append(k)
+        w = shortcut(checker, w[keep + [len(w) - 1]], rng)
     return Piece(f, w)

@@ -197,7 +197,8 @@ def _unwrap(path: np.ndarray) -> np.ndarray:
 
 def shortcut(checker: PoseChecker, path: np.ndarray, rng: np.random.Generator,
              rounds: int = 60, passes: int = 3) -> np.ndarray:
-    """Shorten ``path`` by replacing sub-paths with straight SE(2) motions where valid:
+    """Shorten ``path`` (every edge turning by at most pi) by replacing sub-paths with
+    straight SE(2) motions where valid (and turning by at most pi):
     a greedy pass from the start, then ``rounds`` random pairs; repeated ``passes`` times
     on the path with its edge midpoints added (so corners can be cut partway)."""
     p = _shortcut_once(checker, path, rng, rounds)
@@ -216,7 +217,7 @@ def _shortcut_once(checker: PoseChecker, path: np.ndarray, rng: np.random.Genera
     i = 0
     while i < len(p) - 1:                               # greedy: farthest visible vertex
         j = len(p) - 1
-        while j > i + 1 and not checker.motion_valid(p[i], p[j]):
+        while j > i + 1 and not _straight(checker, p[i], p[j]):
             j -= 1
         out.append(p[j])
         i = j
@@ -227,6 +228,13 @@ def _shortcut_once(checker: PoseChecker, path: np.ndarray, rng: np.random.Genera
         i, j = sorted(rng.choice(len(p), 2, replace=False))
         if j - i < 2:
             continue
-        if checker.motion_valid(p[i], p[j]):
+        if _straight(checker, p[i], p[j]):
             p = np.concatenate([p[:i + 1], p[j:]])
     return _unwrap(p)
+
+
+def _straight(checker: PoseChecker, a: np.ndarray, b: np.ndarray) -> bool:
+    """Can the straight motion from ``a`` to ``b`` replace the path between them? It must
+    be valid and turn by at most pi (paths are unwrapped edge by edge, which would turn a
+    larger turn the other way)."""
+    return abs(float(b[2] - a[2])) <= np.pi and checker.motion_valid(a, b)
