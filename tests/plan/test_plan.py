@@ -137,8 +137,10 @@ def test_must_bypass_tall_obstacle():
 
 
 def test_must_fail_with_reason_blocked_by_tall_obstacle():
-    # Gaps of 0.85 m beside the obstacle: a robot fits (no certificate), the team does not.
-    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.15)])
+    # Gaps of 0.55 m beside the obstacle: a robot fits (no certificate), the team does not.
+    # (With gaps of 0.85 m it does: the hull may reach the obstacle and the wall, only the
+    # robot centres keep the clearance.)
+    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
     r = plan(sc, iterations=200, time_budget=600)
     assert not r.success and r.status == "budget_exhausted" and r.certificate is None
     assert "'wall-ish' (0.9 m tall) cannot be crossed" in r.message
@@ -330,7 +332,7 @@ def test_cli_plan_json_and_figures(tmp_path, capsys):
 
 def test_failed_plan_json():
     from taut.cli.plan import plan_to_dict
-    r = plan(corridor([Obstacle("big", 0.9, center=[3.0, 0.0], radius=0.15)]), iterations=100)
+    r = plan(corridor([Obstacle("big", 0.9, center=[3.0, 0.0], radius=0.45)]), iterations=100)
     d = json.loads(json.dumps(plan_to_dict(r)))
     assert d["success"] is False and d["reason"] and d["times"] == [] and d["robots"] == []
     assert d["status"] == "budget_exhausted" and d["message"] == d["reason"]

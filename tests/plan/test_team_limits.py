@@ -94,7 +94,7 @@ def test_result_does_not_depend_on_the_time_cap():
 
 def test_exhausted_budget_names_the_samples():
     from taut.plan import Obstacle
-    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.15)])
+    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
     r = plan(sc, iterations=40)
     assert not r.success and r.status == "budget_exhausted"
     assert "40 samples per run" in r.message and "in all" in r.message
@@ -111,21 +111,25 @@ def test_iterations_must_be_positive():
 
 
 def test_budget_exhaustion_diagnoses_a_passage_too_narrow():
-    # Gaps of 0.85 m beside a tall cylinder in a 2 m corridor (perpendicular line: (2 -
-    # 0.3) / 2); the triangle team's narrowest formation is wider than that plus the
-    # clearance, so the message says so, without claiming impossibility.
+    # Gaps of 0.55 m beside a tall cylinder in a 2 m corridor (perpendicular line: (2 -
+    # 0.9) / 2): a robot with its clearance (0.4 m) fits, so nothing is proved, but the
+    # triangle team's narrowest formation (the squeezed one included) is wider than that
+    # less the clearance, so the message says so, without claiming impossibility.
     import re
     from taut.plan import Obstacle
-    from taut.plan.planner import _library, _min_width
-    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.15)])
+    from taut.plan.library import _library, _min_width, _with_squeezed
+    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
     r = plan(sc, iterations=40)
     assert r.status == "budget_exhausted" and r.certificate is None
+    assert r.sheet_margin == 0.01                      # a failure carries the margin used
     m = re.search(r"obstacle 'wall-ish' .*? the widest passage is ([0-9.]+) m, less than "
                   r"the ([0-9.]+) m", r.message)
     assert m, r.message
     passage, need = float(m.group(1)), float(m.group(2))
-    assert passage <= 0.85 + 1e-3 and passage > 0.5     # the perpendicular line is a bound
+    assert passage <= 0.55 + 1e-3 and passage > 0.4     # the perpendicular line is a bound
     compact, others, _ = _library(sc, r.sheet_margin)
-    narrowest = min(_min_width(f) for f in (compact, *others))
+    forms = _with_squeezed(sc, [compact, *others], True, r.sheet_margin)
+    assert forms[-1].kind == "squeezed"
+    narrowest = min(_min_width(f) for f in forms)
     assert need == pytest.approx(narrowest + 2 * sc.team.clearance, abs=1e-3)
     assert "not ruled out" in r.message

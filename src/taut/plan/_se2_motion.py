@@ -123,8 +123,9 @@ def _simulate_change(scenario: Scenario, a: np.ndarray, b: np.ndarray, start: np
         return f"formation change has no rest state ({exc.problem})"
     bad = [e for e in sim.events if e.kind in ("jump", "lost")]
     if bad:
-        return (f"the object {bad[0].kind}s during a formation change "
-                f"(drop {bad[0].drop:.3g} m)")
+        return ("the object jumps during a formation change (drop "
+                f"{bad[0].drop:.3g} m)" if bad[0].kind == "jump" else
+                "the object is lost (reaches the ground) during a formation change")
     if np.linalg.norm(sim.object[-1] - end) > _tol.OBJECT_RTOL * team.sheet.size:
         return "a formation change does not end in the new formation's rest state"
     obj = sim.object.copy()

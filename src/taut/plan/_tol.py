@@ -124,3 +124,7 @@ SQUEEZE_WIDTH_TOL = 3e-2
 #: finely the motion is sampled (far below the robots' position accuracy; a few
 #: bisections of a turning interval reach it).
 CLEARANCE_ACCURACY = 1e-7
+#: Room a squeezed formation leaves in the passage it is designed for, m (its width is
+#: the passage less two clearances and this): the lattice and the sampling search need
+#: some room to find a way through, and robots some room for their position error.
+SQUEEZE_ROOM = 0.06

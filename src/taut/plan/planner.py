@@ -3,22 +3,25 @@
 Methods (one private module each):
 
 ``"se2"`` (default)
-    The team is a rigid body in SE(2) per formation of a small library (the compact one
-    and, per obstacle-height class, the optimal crossing formation of eqs. 11-15); a
-    seeded RRT-Connect searches each, then pairs with one formation change
-    (:mod:`taut.plan._se2`). Low obstacles pass under the sheet between any two robots at
-    any heading. When no SE(2) candidate verifies, the disc-model roadmap plan and the
-    SE(2) bypass baseline are tried too, so the planner succeeds wherever either baseline
-    does. Failures carry a certificate (status ``refuted``) or say the budget ran out
-    (``budget_exhausted``).
+    The team is a rigid body in SE(2) per formation of a small library
+    (:mod:`taut.plan.library`: the compact one, the narrow one, per obstacle-height class
+    the optimal crossing formation of eqs. 11-15, and a squeezed one where passages are
+    too narrow for all of them). The lattice search (:mod:`taut.plan._lattice`) searches
+    every formation at once with any number of in-place formation changes; where it finds
+    nothing, a seeded RRT-Connect searches each formation and pairs with one change
+    (:mod:`taut.plan._se2`), or OMPL does (``search=``). Low obstacles pass under the sheet
+    between any two robots at any heading. When no SE(2) candidate verifies, the
+    disc-model roadmap plan and the SE(2) bypass baseline are tried too, so the planner
+    succeeds wherever either baseline does. Failures carry a certificate (status
+    ``refuted``) or say the budget ran out (``budget_exhausted``).
 ``"roadmap"``
     The disc-model roadmap of :func:`~taut.plan.route.find_route` with Algorithm 2 and
     straight offset crossings (the planner of issue 4).
 ``"algorithm2"``
     The same roadmap with the paper's Algorithm 2 only (paper-faithful mode).
 
-Baselines (``baseline=``): ``"se2"`` (or True) the SE(2) search with crossing disabled and
-the compact formation only (same search, same budget); ``"disc"`` the disc-model bypass.
+Baselines (``baseline=``): ``"se2"`` (or True) the same SE(2) search with crossing
+disabled (same library, searches and budget); ``"disc"`` the disc-model bypass.
 """
 
 from __future__ import annotations
@@ -37,92 +40,19 @@ from ._lattice import MAX_NODES, lattice_search
 from ._se2 import SE2Search, SearchBudget, search_se2
 from ._se2_space import PoseChecker
 from ._se2_motion import Piece, sample_pieces
-from .certificate import find_certificate, narrowest_cut
-from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
-from .result import PlanResult, _summary, attempt, compact_formation, failure, relabel
+from .certificate import find_certificate
+from .formation import Formation
+from .library import (Library, _diagnosis, _library, _with_squeezed,
+                      formation_library)
+from .result import PlanResult, _summary, attempt, failure, relabel
 from .route import crossable
 from .verify import verify_motion
 from .world import Scenario
 from .._validate import MAX_DURATION_S, MAX_SHEET_LENGTH, as_bounded, require_instance
 
-__all__ = ["plan", "formation_library"]
-
-#: Most obstacle-height classes for which a crossing formation is optimised.
-MAX_CLASSES = 4
+__all__ = ["plan", "formation_library"]   # formation_library: re-exported from .library
 
 Method = Literal["se2", "roadmap", "algorithm2"]
-
-
-def _height_classes(scenario: Scenario) -> list[float]:
-    heights = sorted({o.height for o in scenario.world.obstacles})
-    if len(heights) > MAX_CLASSES:
-        idx = np.unique(np.linspace(0, len(heights) - 1, MAX_CLASSES).round().astype(int))
-        heights = [heights[i] for i in idx]
-    return heights
-
-
-def _why_not_crossable(scenario: Scenario, h: float, ids: str) -> str:
-    team = scenario.team
-    if h + team.height_safety >= (1 - MIN_DEPTH_FRACTION) * team.hold_height:
-        why = (f"the object hangs below the hands ({team.hold_height:.3g} m), so it "
-               f"cannot clear {h:.3g} m plus the height safety")
-    else:
-        why = ("no stable all-taut formation lifts the object that high with room "
-               "between the robots")
-    return f"obstacle {ids} ({h:.3g} m tall) cannot be crossed: {why}"
-
-
-def formation_library(scenario: Scenario, sheet_margin: float = 0.0
-                      ) -> tuple[Formation, list[Formation], list[str]]:
-    """The compact formation; the others (the narrow one when it differs, and the crossing
-    formations, one per obstacle-height class, eqs. 11-15, preferring one that fits the
-    widest passage); and why some height classes have none."""
-    require_instance(scenario, Scenario, "scenario")
-    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
-    world, team = scenario.world, scenario.team
-    compact = compact_formation(scenario, sheet_margin)
-    crossing, notes = [], []
-    # A triangle's narrowest stable formation is its compact one.
-    narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
-                                                        width=world.width,
-                                                        sheet_margin=sheet_margin)
-    if narrow is not None and _min_width(narrow) < _min_width(compact) - _tol.NARROWER_BY:
-        crossing.append(narrow)
-    for h in _height_classes(scenario):
-        group = [o for o in world.obstacles if o.height <= h]
-        diameter = max(o.diameter for o in group)
-        f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
-                              width=world.width, max_reach=0.49 * world.width,
-                              sheet_margin=sheet_margin)
-        if f is None:
-            f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
-                                  width=world.width, sheet_margin=sheet_margin)
-        if f is None:
-            notes.append(_why_not_crossable(
-                scenario, h, ", ".join(repr(o.id) for o in group if o.height == h)))
-            continue
-        crossing.append(f)
-    return compact, crossing, notes
-
-
-Library = tuple[Formation, list[Formation], list[str]]
-
-
-@functools.lru_cache(maxsize=32)
-def _library(scenario: Scenario, sheet_margin: float
-             ) -> tuple[Formation, tuple[Formation, ...], tuple[str, ...]]:
-    """:func:`formation_library`, memoised per scenario object (the optimisations of
-    eqs. 11-15 dominate a plan's time; baselines and re-plans reuse them)."""
-    compact, others, notes = formation_library(scenario, sheet_margin)
-    return compact, tuple(others), tuple(notes)
-
-
-def _min_width(f: Formation) -> float:
-    """Least width of the robots' hull over all directions, m."""
-    a = np.linspace(0, np.pi, 180, endpoint=False)
-    proj = f.robots @ np.stack([-np.sin(a), np.cos(a)])
-    return float(np.ptp(proj, axis=0).min())
-
 
 def _roadmap(scenario: Scenario, straight: bool, sheet_margin: float, planner: str,
              library: Library) -> PlanResult:
@@ -219,6 +149,14 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
                                                planner, sheet_margin)
         if found_lattice is not None:
             return found_lattice
+    more = _with_squeezed(scenario, forms, allow_crossing, sheet_margin)
+    if len(more) > len(forms):
+        forms = more
+        if search in ("auto", "lattice"):
+            found_lattice, lattice_note = _lattice(scenario, forms, allow_crossing, budget,
+                                                   planner, sheet_margin)
+            if found_lattice is not None:
+                return found_lattice
     results: list[PlanResult] = []
 
     def accept(pieces: list[Piece]) -> bool:
@@ -258,25 +196,6 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
         x for x in (searched, lattice_note, tried,
                     _diagnosis(scenario, forms, allow_crossing)) if x),
                    planner, "budget_exhausted")
-
-
-def _diagnosis(scenario: Scenario, forms: list[Formation], allow_crossing: bool) -> str:
-    """Why the search likely failed (not a proof): the narrowest passage beside obstacles
-    no formation of the library can cross, against what the narrowest formation needs."""
-    top = max(f.max_height for f in forms) if allow_crossing else -np.inf
-    blockers = [o for o in scenario.world.obstacles if o.height > top + _tol.GEOMETRY_TOL]
-    cut = narrowest_cut(scenario, blockers)
-    if cut is None:
-        return ""
-    narrowest = min(forms, key=_min_width)
-    need = _min_width(narrowest) + 2 * scenario.team.clearance
-    if cut[0] >= need:
-        return ""
-    return (f"diagnosis: on the narrowest line through obstacle {cut[1]!r} (which no "
-            f"formation of the library can cross) the widest passage is {cut[0]:.3g} m, "
-            f"less than the {need:.3g} m the narrowest formation found needs (its width "
-            f"{_min_width(narrowest):.3g} m plus twice the clearance); a narrower formation "
-            "outside the library is not ruled out")
 
 
 def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
@@ -370,6 +289,13 @@ def plan(scenario: Scenario, *, method: Method = "se2",
                      spacing=as_bounded(spacing, "spacing", MAX_SHEET_LENGTH, "m"))
     engine(search)                      # validates the name and that OMPL is installed
     margin = float(sheet_margin)
+    r = _dispatch(scenario, method, baseline, straight_crossings, margin, budget, search)
+    return r if r.success else replace(r, sheet_margin=margin)
+
+
+def _dispatch(scenario: Scenario, method: str, baseline: object, straight_crossings: bool,
+              margin: float, budget: SearchBudget, search: Search) -> PlanResult:
+    """:func:`plan` after its options are checked."""
     cached = _library(scenario, margin)
     lib: Library = (cached[0], list(cached[1]), list(cached[2]))
     if baseline == "disc":

@@ -143,8 +143,10 @@ def _simulate_run(scenario: Scenario, robots: np.ndarray, start: np.ndarray,
         bad = [e for e in sim.events if e.kind in ("jump", "lost")]
         if bad:
             e = bad[0]
-            return None, None, np.inf, (f"object {e.kind}s during a formation change "
-                                        f"(drop {e.drop:.3g} m)"), None
+            why = (f"object jumps during a formation change (drop {e.drop:.3g} m)"
+                   if e.kind == "jump" else "object is lost (reaches the ground) during a "
+                                            "formation change")
+            return None, None, np.inf, why, None
         step = np.linalg.norm(np.diff(sim.object, axis=0), axis=1)
         big = np.flatnonzero(step > max_step)
         if not len(big):

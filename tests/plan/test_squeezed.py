@@ -1,0 +1,131 @@
+"""Squeezed formations (taut.plan._squeeze): narrower than the narrowest all-taut formation,
+checked independently of the optimiser with forward kinematics and shapely."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+
+import numpy as np
+import pytest
+from shapely.geometry import MultiPoint, Point
+
+from taut.errors import InvalidInputError
+from taut.plan import formation_library, generate_scenario
+from taut.plan._squeeze import squeezed_formation
+from taut.sheet import forward_kinematics
+
+SHEET_MARGIN = 0.01
+#: Suite (50, 2024) scenarios that pass beside an obstacle too tall to cross: index -> the
+#: width (m) the passage needs, below the narrow all-taut formation's (0.858, 0.846, 0.776).
+NEEDED = {3: 0.69, 20: 0.73, 39: 0.59}
+
+
+@functools.lru_cache(maxsize=None)
+def _scenario(index):
+    """``generate_suite(50, 2024)[index]``, without generating the other 49."""
+    return generate_scenario(2024 + index, 3 + index % 6)
+
+
+def _team(index):
+    return _scenario(index).team
+
+
+@functools.lru_cache(maxsize=None)
+def _narrow(index):
+    _, others, _ = formation_library(_scenario(index), SHEET_MARGIN)
+    return next(f for f in others if f.kind == "narrow")
+
+
+@functools.lru_cache(maxsize=None)
+def _squeezed(index, width=None):
+    return squeezed_formation(_team(index), sheet_margin=SHEET_MARGIN, width=width,
+                              start=_narrow(index))
+
+
+def _check(team, f, inset):
+    """Every requirement, from forward kinematics and shapely alone; returns the inset and
+    height margins (m)."""
+    assert f.kind == "squeezed" and not f.robots.flags.writeable
+    stable = forward_kinematics(team.sheet, f.robots, team.hold_height).stable
+    assert len(stable) == 1, [e.taut for e in stable]
+    e = stable[0]
+    np.testing.assert_allclose(e.object, [0.0, 0.0, f.object_height], rtol=0, atol=1e-6)
+    assert e.height >= team.height_safety
+    hull = MultiPoint([tuple(p) for p in f.robots[list(e.taut)]]).convex_hull
+    centre = Point(*e.object[:2])
+    assert hull.geom_type == "Polygon" and hull.contains(centre)
+    assert hull.exterior.distance(centre) >= inset - 1e-9
+    iu, ju = np.triu_indices(team.n, 1)
+    dist = np.linalg.norm(f.robots[iu] - f.robots[ju], axis=1)
+    sheet = np.linalg.norm(team.sheet.vertices[iu] - team.sheet.vertices[ju], axis=1)
+    assert np.all(dist >= 2 * team.robot_radius - 1e-9)
+    assert np.all(dist <= sheet - SHEET_MARGIN + 1e-9)
+    weights = np.zeros(team.n)
+    weights[list(e.taut)] = e.weights
+    np.testing.assert_allclose(f.weights, weights, atol=1e-9)
+    assert f.cost == pytest.approx(np.ptp(f.robots[:, 1]), abs=1e-12)
+    assert f.reach == pytest.approx(np.linalg.norm(f.robots, axis=1).max() + team.clearance,
+                                    abs=1e-9)
+    return hull.exterior.distance(centre) - inset, e.height - team.height_safety
+
+
+def test_scenarios_are_the_suite_s():
+    team = _team(39)
+    assert team.n == 6 and np.ptp(_narrow(39).robots[:, 1]) == pytest.approx(0.776, abs=1e-3)
+
+
+@pytest.mark.parametrize("index", sorted(NEEDED))
+def test_squeezed_fits_the_passage(index):
+    """``width=`` stops at the first formation as narrow as the passage needs."""
+    f = _squeezed(index, NEEDED[index])
+    assert f is not None and f.cost <= NEEDED[index] + 1e-9
+    assert np.ptp(_narrow(index).robots[:, 1]) > NEEDED[index]
+    _check(_team(index), f, _team(index).robot_radius)
+
+
+@pytest.mark.parametrize("index", [pytest.param(3, marks=pytest.mark.slow), 20,
+                                   pytest.param(39, marks=pytest.mark.slow)])
+def test_narrowest_squeezed_holds_the_object(index):
+    team = _team(index)
+    f = _squeezed(index)
+    assert f is not None
+    assert f.cost < NEEDED[index] - 0.1 < np.ptp(_narrow(index).robots[:, 1])
+    assert f.cost <= _squeezed(index, NEEDED[index]).cost
+    assert len(np.flatnonzero(f.weights)) < team.n          # some cables are slack
+    _check(team, f, team.robot_radius)
+
+
+def test_width_target_gives_a_more_robust_formation():
+    team = _team(20)
+    robust = min(_check(team, _squeezed(20, NEEDED[20]), team.robot_radius))
+    narrowest = min(_check(team, _squeezed(20), team.robot_radius))
+    assert robust > narrowest + 0.01                        # margins of centimetres
+
+
+def test_default_start_and_determinism():
+    team = _team(20)
+    a = squeezed_formation(team, sheet_margin=SHEET_MARGIN, width=NEEDED[20])
+    b = squeezed_formation(team, sheet_margin=SHEET_MARGIN, width=NEEDED[20])
+    assert a is not None and b is not None and a.cost <= NEEDED[20] + 1e-9
+    np.testing.assert_array_equal(a.robots, b.robots)
+    _check(team, a, team.robot_radius)
+
+
+def test_larger_inset_is_kept():
+    f = squeezed_formation(_team(20), sheet_margin=SHEET_MARGIN, inset=0.15, width=0.6,
+                           start=_narrow(20))
+    assert f is not None
+    _check(_team(20), f, 0.15)
+
+
+def test_impossible_requirements_give_none():
+    team = _team(20)
+    assert squeezed_formation(team, inset=team.sheet.size) is None      # > half the sheet
+    high = dataclasses.replace(team, height_safety=team.hold_height)    # no height left
+    assert squeezed_formation(high) is None
+
+
+def test_start_must_match_the_team():
+    with pytest.raises(InvalidInputError):
+        squeezed_formation(_team(20), start=_narrow(3))                 # six robots, not five
