@@ -135,3 +135,31 @@ def test_sweep_figure(tmp_path):
     finally:
         plt.Figure.savefig = real
     _check(captured["fig"])
+
+
+@pytest.mark.parametrize("method", ["se2", "algorithm2"])
+def test_plan_figure_shows_sides_only_for_algorithm2_crossings(tmp_path, method):
+    from taut.io import load_plan_scenario
+    from taut.plan import plan
+    from taut.viz.plan import plot_plan
+    sc = load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml")
+    r = plan(sc, method=method)
+    assert r.success
+    captured = {}
+    real = plt.Figure.savefig
+    plt.Figure.savefig = lambda self, *a, **k: captured.setdefault("fig", self)
+    try:
+        plot_plan(sc, r, tmp_path / "p.png")
+    finally:
+        plt.Figure.savefig = real
+    fig = captured["fig"]
+    third = fig.axes[2].get_title()
+    if method == "algorithm2":
+        assert "entering/exiting" in third
+    else:                                 # no Algorithm 2 crossing: the clearance panel
+        assert "clearance" in third
+        rule = [ln.get_ydata()[0] for ln in fig.axes[2].get_lines()[1:]]
+        assert sc.team.clearance in rule and sc.team.robot_radius in rule
+    distances = fig.axes[3]
+    assert "sheet limit" in [t.get_text() for t in distances.get_legend().get_texts()]
+    _check(fig, min_panels=4)

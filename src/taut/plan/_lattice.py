@@ -11,7 +11,9 @@ quasi-static model (:func:`~taut.plan._se2_motion.change_profile`: no jump, the 
 in the new formation's rest state; the model is invariant under planar rigid motions, so
 one simulation per ordered pair of formations decides it everywhere). Moves cost their
 duration, so the path found is the fastest lattice path, with any number of formation
-changes.
+changes; time spent in a squeezed formation counts ``SQUEEZED_WEIGHT`` times (the
+all-taut formations of the paper share the load between every robot, so they are
+preferred wherever they fit).
 
 The search is *resolution-complete*: when the lattice holds no path, no path exists whose
 every pose keeps the rules with about a spacing of robot motion to spare (such a path has
@@ -208,7 +210,8 @@ def lattice_search(scenario: Scenario, formations: list[Formation],
         np.stack([c._local for c in checkers]), np.array([c.radius for c in checkers]),
         checkers[0]._walls, np.stack([c._obst for c in checkers]), checkers[0]._verts,
         checkers[0].clearance_rule, motion, cost, change_obst, starts, goals, goal_cost,
-        np.asarray(scenario.goal, dtype=float), int(expansions))
+        np.asarray(scenario.goal, dtype=float), int(expansions),
+        np.array([_tol.SQUEEZED_WEIGHT if f.kind == "squeezed" else 1.0 for f in formations]))
     pieces = None
     if len(path):
         poses = [(int(n // (nk * C)), np.array([*grid.cells[(n // nk) % C],

@@ -20,9 +20,10 @@ Moves from a node:
   it costs the change's duration;
 * to the goal, from the nodes the caller joined to it.
 
-The heuristic, the straight-line distance to the goal over the speed, never exceeds the
-time left (every move takes at least its distance over the speed), so the first time the
-goal is taken from the queue its path is the fastest lattice path. The number of nodes
+Rigid moves of a layer may be weighted (``weight`` >= 1: the caller's preference for some
+formations). The heuristic, the straight-line distance to the goal over the speed, never
+exceeds the cost left (every move takes at least its distance over the speed), so the
+first time the goal is taken from the queue its path is the cheapest lattice path. The number of nodes
 expanded is the search's deterministic budget.
 """
 
@@ -79,7 +80,7 @@ def _push(heap, g, parent, q, node, cost, x, y, goal_xy, speed):
 
 @jit
 def _rigid_moves(node, c0, heap, g, parent, done, clear, cells, nbr, nk, geo, locals_,
-                 radii, walls, obsts, verts, rule, motion, goal_xy, work):
+                 radii, walls, obsts, verts, rule, motion, goal_xy, work, weight):
     """Relax the 26 lattice neighbours of ``node`` in its layer (module docstring)."""
     C = cells.shape[0]
     dpsi = geo[1]
@@ -110,7 +111,7 @@ def _rigid_moves(node, c0, heap, g, parent, done, clear, cells, nbr, nk, geo, lo
                 if motion_clear(locals_[layer], radii[layer], walls, obsts[layer], verts,
                                 rule, a, b, margin, min_step) <= 0:
                     continue
-            cost = g[node] + max(move / speed, dpsi * abs(dk) / omega)
+            cost = g[node] + max(move / speed, dpsi * abs(dk) / omega) * weight[layer]
             if cost < g[q]:
                 _push(heap, g, parent, q, node, cost, cells[c2, 0], cells[c2, 1], goal_xy,
                       speed)
@@ -147,7 +148,7 @@ def _changes(node, heap, g, parent, done, clear, cells, nk, geo, locals_, radii,
 @jit
 def lattice_astar(cells, nbr, nk, geo, locals_, radii, walls, obsts, verts, rule, motion,
                   change_cost, change_obst, starts, goal_nodes, goal_cost, goal_xy,
-                  max_expansions):
+                  max_expansions, weight):
     """A* from the ``starts`` node ids to the goal (module docstring).
 
     ``cells`` (C, 2) cell positions; ``nbr`` (C, 8) neighbour cells in ``OFFSETS`` order
@@ -191,7 +192,7 @@ def lattice_astar(cells, nbr, nk, geo, locals_, radii, walls, obsts, verts, rule
         c0 = _clear(node, clear, cells, nk, C, geo, locals_, radii, walls, obsts, verts,
                     rule, work[0], work[1], work[2])
         _rigid_moves(node, c0, heap, g, parent, done, clear, cells, nbr, nk, geo, locals_,
-                     radii, walls, obsts, verts, rule, motion, goal_xy, work)
+                     radii, walls, obsts, verts, rule, motion, goal_xy, work, weight)
         _changes(node, heap, g, parent, done, clear, cells, nk, geo, locals_, radii, walls,
                  obsts, verts, rule, motion, change_cost, change_obst, goal_xy, work)
     if best_goal < 0:

@@ -104,6 +104,19 @@ class _Samples:
         return None
 
 
+def _closest_pass(a: np.ndarray, b: np.ndarray) -> tuple[float, int, int]:
+    """Least distance between two robots moving straight from ``a`` to ``b`` (N, 2) at
+    the same time, m, and which pair: each pair's relative position is linear in time."""
+    iu, ju = np.triu_indices(len(a), 1)
+    d0, d1 = a[iu] - a[ju], b[iu] - b[ju]
+    e = d1 - d0
+    ee = (e * e).sum(axis=1)
+    t = np.clip(-(d0 * e).sum(axis=1) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+    gap = np.linalg.norm(d0 + t[:, None] * e, axis=1)
+    k = int(np.argmin(gap))
+    return float(gap[k]), int(iu[k]), int(ju[k])
+
+
 def _simulate_change(scenario: Scenario, a: np.ndarray, b: np.ndarray, start: np.ndarray,
                      end: np.ndarray) -> str | tuple[np.ndarray, np.ndarray, float]:
     """Robots moving straight from ``a`` to ``b`` (N, 2), sampled every ``REFORM_STEP``,
@@ -114,6 +127,10 @@ def _simulate_change(scenario: Scenario, a: np.ndarray, b: np.ndarray, start: np
     dist = float(np.linalg.norm(b - a, axis=1).max())
     if dist <= 0.0:
         return a[None], np.asarray(start, float)[None], 0.0
+    gap, i, j = _closest_pass(a, b)
+    if gap < 2 * team.robot_radius:
+        return (f"robots {i + 1} and {j + 1} would pass {gap:.3g} m apart during a formation "
+                f"change (footprints overlap)")
     k = max(2, int(np.ceil(dist / _tol.REFORM_STEP)))
     s = np.arange(0, k + 1) / k
     robots = a[None] + s[:, None, None] * (b - a)[None]

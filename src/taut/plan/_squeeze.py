@@ -42,13 +42,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize
-from scipy.spatial import ConvexHull, QhullError
 
 from .._validate import MAX_SHEET_LENGTH, as_bounded, require_instance
 from ..errors import InvalidInputError, TautError
 from ..sheet import Equilibrium, FKSolver, formation_metrics
 from . import _tol
 from ._formation_problem import MIN_DEPTH_FRACTION
+from ._squeeze_robust import convex_hull, hull_inset, tolerates
 from .formation import Formation, optimal_formation
 from .world import Team
 
@@ -244,24 +244,6 @@ class _Candidate:
     state: Equilibrium
 
 
-def _hull(P: np.ndarray) -> np.ndarray | None:
-    """Vertices of the convex hull of ``P`` (k, 2), counter-clockwise; None without area."""
-    try:
-        return P[ConvexHull(P).vertices]
-    except (QhullError, ValueError):       # fewer than three points, or all on a line
-        return None
-
-
-def _hull_inset(P: np.ndarray, q: np.ndarray) -> float:
-    """Distance of ``q`` inside the convex hull of ``P`` (< 0 outside; -inf for no area)."""
-    hull = _hull(P)
-    if hull is None:
-        return -np.inf
-    E = np.roll(hull, -1, axis=0) - hull
-    Q = q - hull
-    return float(np.min((E[:, 0] * Q[:, 1] - E[:, 1] * Q[:, 0]) / np.linalg.norm(E, axis=1)))
-
-
 def _accept(solver: FKSolver, lim: _Limits, R: np.ndarray) -> _Candidate | None:
     """Robots ``R`` (N, 2, m) as a candidate if forward kinematics alone confirms every
     requirement (one stable state, its height and inset, the pair distances)."""
@@ -278,8 +260,8 @@ def _accept(solver: FKSolver, lim: _Limits, R: np.ndarray) -> _Candidate | None:
         return None
     e = stable[0]
     up = e.height - m["z_min"]
-    inside = _hull_inset(R[list(e.taut)], e.object[:2]) - m["inset"]
-    if up < 0 or inside < 0:
+    inside = hull_inset(R[list(e.taut)], e.object[:2]) - m["inset"]
+    if up < 0 or inside < 0 or not tolerates(solver, R, e, m["z_min"] - _tol.SQUEEZE_HEIGHT_MARGIN):
         return None
     return _Candidate(float(np.ptp(R[:, 1])), min(up, inside), R, e)
 
@@ -343,7 +325,7 @@ def _start_robots(team: Team, sheet_margin: float, start: Formation | None) -> n
 def _turned(R: np.ndarray) -> np.ndarray:
     """``R`` (N, 2) turned so that its narrowest direction is y (the least width of a convex
     polygon is across one of its edges)."""
-    hull = _hull(R)
+    hull = convex_hull(R)
     if hull is None:
         return R
     E = np.roll(hull, -1, axis=0) - hull

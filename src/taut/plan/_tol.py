@@ -128,3 +128,11 @@ CLEARANCE_ACCURACY = 1e-7
 #: the passage less two clearances and this): the lattice and the sampling search need
 #: some room to find a way through, and robots some room for their position error.
 SQUEEZE_ROOM = 0.06
+#: Farthest the object of a squeezed formation may move when every robot is off by up to
+#: ``POSITION_ACCURACY``, m (:mod:`taut.plan._squeeze_robust`: about the 90th percentile of
+#: what the all-taut formations of the seed-2024 suite move).
+SQUEEZE_MAX_SHIFT = 0.05
+#: Weight of the time spent in a squeezed formation in the lattice search's cost (1: none):
+#: the paper's all-taut formations share the load between every robot, so the search keeps
+#: them wherever they fit and squeezes only where a passage needs it.
+SQUEEZED_WEIGHT = 1.5

@@ -31,13 +31,14 @@ class Robustness:
         Position error, m (radius of the disc, or the standard deviation per axis).
     noise : {"disc", "gaussian"}
         Every robot displaced uniformly within a disc of radius ``sigma``, or by a normal
-        error of standard deviation ``sigma`` per axis, independently per sample.
+        error of standard deviation ``sigma`` per axis, drawn independently per robot
+        every ``correlation`` seconds and linear in time in between.
     trials : int
     tear_probability : float
         Fraction of trials in which some robot pair was beyond its sheet distance.
     drop_probability : float
         Fraction of trials in which the object's rest state ended in the quasi-static
-        replay (a jump to another state, or lost).
+        replay and it fell by more than 5 mm (``MAX_OBJECT_STEP``) or reached the ground.
     worst_extension : float
         Largest (robot distance - sheet distance) seen, m (negative: never taut).
     contact_probability : float
@@ -150,8 +151,10 @@ class PlanResult:
                               transform=lambda self, m: None if self.success else m)
 
     def robustness(self, sigma: float = _tol.POSITION_ACCURACY, trials: int = 200, *,
-                   noise: str = "disc", seed: int = 0) -> Robustness:
-        """Probability of failure under robot position error (seeded Monte Carlo).
+                   noise: str = "disc", seed: int = 0, correlation: float = 1.0
+                   ) -> Robustness:
+        """Probability of failure under robot position error (seeded Monte Carlo through
+        the quasi-static simulation, :mod:`taut.plan.robustness`).
 
         Parameters
         ----------
@@ -161,6 +164,9 @@ class PlanResult:
         noise : {"disc", "gaussian"}
             See :class:`Robustness`.
         seed : int
+        correlation : float
+            Each robot's error is drawn every ``correlation`` seconds and interpolated
+            linearly in between, s.
 
         Returns
         -------
@@ -169,7 +175,8 @@ class PlanResult:
         from .robustness import monte_carlo
         if not self.success or self.scenario is None:
             raise PlanningError("plan", "robustness needs a successful plan")
-        return monte_carlo(self.scenario, self, sigma, trials, noise=noise, seed=seed)
+        return monte_carlo(self.scenario, self, sigma, trials, noise=noise, seed=seed,
+                           correlation=correlation)
 
 
 def failure(scenario: Scenario, message: str, planner: str, status: str = "no_route",

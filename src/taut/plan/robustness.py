@@ -1,12 +1,19 @@
 """Seeded Monte Carlo of a plan under robot position error (issue 14, item 4).
 
-Each trial displaces every robot at every sample independently (uniformly within a disc of
-radius ``sigma``, or normally with standard deviation ``sigma`` per axis) and replays the
-perturbed motion through the quasi-static simulation (:func:`taut.sheet.simulate`,
-following the object's rest state from the plan's first state). A trial records
+Each trial displaces every robot by a position error that varies along the plan: drawn
+independently per robot every ``correlation`` seconds (uniformly within a disc of radius
+``sigma``, or normally with standard deviation ``sigma`` per axis) and interpolated
+linearly in time between those instants (a disc error stays in its disc). Localisation
+errors of mobile robots drift rather than jump from sample to sample; an error drawn anew
+at every sample would shake the team by up to ``2 sigma`` between samples and make the
+quasi-static replay see spurious events. The perturbed motion is replayed through the
+quasi-static simulation (:func:`taut.sheet.simulate`, following the object's rest state
+from the plan's first state). A trial records
 
 * a *tear*: some robot pair beyond its sheet distance (then nothing else is replayed);
-* a *drop*: the object's rest state ends (a jump to another state, or lost);
+* a *drop*: the object's rest state ends and it falls by more than ``MAX_OBJECT_STEP``
+  (5 mm; the simulation also reports branch ends where the object settles a few
+  micrometres away, which are not drops) or reaches the ground;
 * a *contact*: the object at or below the top of an obstacle beneath the sheet (its
   footprint meets the robots' hull) or the ground;
 * an *unsafe* sample: the object less than the height safety above them (the rule the
@@ -93,7 +100,8 @@ def replay(scenario: Scenario, robots: np.ndarray, planned_object: np.ndarray) -
         sim = simulate(team.sheet, robots, team.hold_height, start=planned_object[0])
     except TautError:             # no rest state at the first sample: counted as a drop
         return Trial(False, True, False, False, collision, ext, np.nan, clear, np.nan)
-    dropped = any(e.kind in ("jump", "lost") for e in sim.events)
+    dropped = any(e.kind == "lost" or (e.kind == "jump" and e.drop > _tol.MAX_OBJECT_STEP)
+                  for e in sim.events)
     obj = np.asarray(sim.object)
     margin = float(np.nanmin(obj[:, 2] - _beneath(scenario, robots)))
     dev = float(np.nanmax(np.linalg.norm(obj - planned_object, axis=1)))
@@ -110,8 +118,21 @@ def _noise(rng: np.random.Generator, shape: tuple[int, ...], sigma: float, kind:
     return np.stack([r * np.cos(a), r * np.sin(a)], axis=-1)
 
 
+def position_error(rng: np.random.Generator, times: np.ndarray, n: int, sigma: float,
+                   kind: str, correlation: float) -> np.ndarray:
+    """Errors (T, n, 2), m: drawn every ``correlation`` s, linear in time in between."""
+    knots = np.arange(0.0, float(times[-1]) + correlation, correlation)
+    e = _noise(rng, (len(knots), n), sigma, kind)
+    k = np.clip(np.searchsorted(knots, times, side="right") - 1, 0, len(knots) - 2)
+    if len(knots) < 2:
+        return np.broadcast_to(e[0], (len(times), n, 2)).copy()
+    f = ((times - knots[k]) / correlation)[:, None, None]
+    return e[k] * (1 - f) + e[k + 1] * f
+
+
 def monte_carlo(scenario: Scenario, result: "PlanResult", sigma: float, trials: int, *,
-                noise: str = "disc", seed: int = 0) -> "Robustness":
+                noise: str = "disc", seed: int = 0, correlation: float = 1.0
+                ) -> "Robustness":
     """Failure probabilities of ``result`` under robot position error ``sigma`` (m).
 
     Returns
@@ -125,9 +146,12 @@ def monte_carlo(scenario: Scenario, result: "PlanResult", sigma: float, trials: 
         raise InvalidInputError("trials", "must be at least 1")
     if noise not in ("disc", "gaussian"):
         raise InvalidInputError("noise", "must be 'disc' or 'gaussian'")
+    if not (np.isfinite(correlation) and correlation > 0):
+        raise InvalidInputError("correlation", "must be a positive time in s")
     rng = np.random.default_rng(seed)
-    R = np.asarray(result.robots)
-    out = [replay(scenario, R + _noise(rng, R.shape[:2], sigma, noise),
+    R, times = np.asarray(result.robots), np.asarray(result.times)
+    out = [replay(scenario, R + position_error(rng, times, R.shape[1], sigma, noise,
+                                               float(correlation)),
                   np.asarray(result.object)) for _ in range(int(trials))]
 
     def p(flag: str) -> float:

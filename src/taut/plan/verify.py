@@ -118,9 +118,17 @@ def _rigid_fit(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, fl
 
 
 def _rigid_mask(robots: np.ndarray, tol: float) -> np.ndarray:
-    """Bool (T-1,): sample pairs related by a rigid motion."""
-    d = np.linalg.norm(robots[:, :, None] - robots[:, None, :], axis=-1)
-    return np.abs(np.diff(d, axis=0)).max(axis=(1, 2)) <= tol
+    """Bool (T-1,): sample pairs related by a rigid motion of the plane (a rotation and a
+    translation: the best such fit, Kabsch without reflection, leaves every robot within
+    ``tol``; equal pair distances alone would also admit a mirror image)."""
+    a, b = robots[:-1], robots[1:]
+    ca, cb = a.mean(axis=1, keepdims=True), b.mean(axis=1, keepdims=True)
+    h = np.einsum("tni,tnj->tij", a - ca, b - cb)
+    ang = np.arctan2(h[:, 0, 1] - h[:, 1, 0], h[:, 0, 0] + h[:, 1, 1])
+    c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]
+    x, y = (a - ca)[..., 0], (a - ca)[..., 1]
+    fit = np.stack([c * x - s * y, s * x + c * y], axis=-1) + cb
+    return np.abs(fit - b).max(axis=(1, 2)) <= tol
 
 
 def _follow_rigid(obj: np.ndarray, robots: np.ndarray, t: int) -> np.ndarray:
@@ -244,6 +252,21 @@ def _geometry(scenario: Scenario, robots: np.ndarray, obj: np.ndarray,
     return margin, float(clear.min()), None
 
 
+def _least_gap(robots: np.ndarray, rigid: np.ndarray) -> float:
+    """Least distance between two robot centres over the continuous motion, m: rigid
+    intervals (``rigid``, (T-1,)) keep every distance; on the others robots move straight,
+    so a pair's relative position is linear in time and its least distance has a closed
+    form."""
+    iu, ju = np.triu_indices(robots.shape[1], 1)
+    d = robots[:, iu] - robots[:, ju]                    # (T, P, 2)
+    if len(d) < 2:
+        return float(np.linalg.norm(d, axis=2).min())
+    a, e = d[:-1], np.where(rigid[:, None, None], 0.0, d[1:] - d[:-1])
+    ee = (e * e).sum(axis=2)
+    t = np.clip(-(a * e).sum(axis=2) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+    return float(np.linalg.norm(a + t[..., None] * e, axis=2).min())
+
+
 def _sheet_slack(scenario: Scenario, robots: np.ndarray) -> tuple[float, int, int, int]:
     """Least (sheet distance - robot distance), m, and where (sample, i, j)."""
     V = scenario.team.sheet.vertices
@@ -300,8 +323,7 @@ def verify_motion(scenario: Scenario, robots: ArrayLike, planned_object: ArrayLi
     if slack < sheet_margin - TOLERANCE:
         return fail(f"robots {i + 1} and {j + 1} only {slack:.3g} m inside their sheet "
                     f"distance at sample {ts} (sheet margin {sheet_margin:.3g} m)", slack=slack)
-    iu, ju = np.triu_indices(N, 1)
-    gap = np.linalg.norm(robots[:, iu] - robots[:, ju], axis=2).min()
+    gap = _least_gap(robots, _rigid_mask(robots, _tol.RIGID_RTOL * team.sheet.size * 10))
     if gap < 2 * team.robot_radius - TOLERANCE:
         return fail(f"robots overlap (centres {gap:.3g} m apart)", slack=slack)
     try:

@@ -1,7 +1,7 @@
 """Figures of transport plans, after the planning paper's Figs. 8-10: top view with robot
 footprints, sheet outlines and the object's path, object height over time against the
-obstacles beneath it, entering/exiting side angles during Algorithm 2 crossings, robot
-pair distances against their sheet limits; and an animated GIF."""
+obstacles beneath it, entering/exiting side angles during Algorithm 2 crossings (or the
+robots' clearance), robot pair distances against their sheet limits; and an animated GIF."""
 
 from __future__ import annotations
 
@@ -73,9 +73,8 @@ def _top_view(ax, scenario: Scenario, r: PlanResult) -> None:
 
 
 def _sides(ax, r: PlanResult) -> None:
-    """Entering/exiting side angles during Algorithm 2 crossings (empty otherwise)."""
-    alg2 = [c for c in r.crossings if c.kind == "algorithm2"]
-    for c in alg2:
+    """Entering/exiting side angles during Algorithm 2 crossings."""
+    for c in (c for c in r.crossings if c.kind == "algorithm2"):
         sel = (r.times >= c.times[0]) & (r.times <= c.times[4])
         ent = np.degrees(np.angle(np.exp(1j * (r.heading[sel] + c.entering - c.direction))))
         ext = np.degrees(np.angle(np.exp(1j * (r.heading[sel] + c.exiting - c.direction
@@ -85,11 +84,28 @@ def _sides(ax, r: PlanResult) -> None:
     ax.set_xlabel("time [s]")
     ax.set_ylabel("angle to travel axis [deg]")
     ax.set_title("entering/exiting sides (Algorithm 2 crossings)")
-    if alg2:
-        ax.legend(fontsize=7)
-    else:
-        ax.text(0.5, 0.5, "no Algorithm 2 crossing in this plan", ha="center",
-                va="center", transform=ax.transAxes, fontsize=9, color="0.4")
+    ax.legend(fontsize=7)
+
+
+def _clearances(ax, scenario: Scenario, r: PlanResult) -> None:
+    """Least robot-centre distance to a wall or an obstacle over time against the rule
+    (robot radius + lateral safety) and the robot radius (footprint contact)."""
+    world, team = scenario.world, scenario.team
+    pts = shapely.points(r.robots.reshape(-1, 2))
+    d = shapely.distance(world.geometry.exterior, pts)
+    for o in world.obstacles:
+        d = np.minimum(d, shapely.distance(o.geometry, pts))
+    least = d.reshape(r.robots.shape[:2]).min(axis=1)
+    ax.plot(r.times, least, label="least robot clearance")
+    ax.axhline(team.clearance, color="k", ls="--", lw=0.8,
+               label=f"rule: radius + lateral safety ({team.clearance:.2f} m)")
+    ax.axhline(team.robot_radius, color="tab:red", ls=":", lw=0.8,
+               label=f"footprint contact ({team.robot_radius:.2f} m)")
+    ax.set_ylim(0.0, max(float(least.max()), team.clearance) * 1.1)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("distance to walls and obstacles [m]")
+    ax.set_title("robot clearance (least over robots)")
+    ax.legend(fontsize=7)
 
 
 def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
@@ -118,7 +134,8 @@ def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
 def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
     """Four-panel summary figure of a successful plan (PNG/PDF by extension): top view
     with robot footprints, sheet outlines and the object's path; object height against
-    the obstacles beneath the sheet; entering/exiting sides of Algorithm 2 crossings;
+    the obstacles beneath the sheet; entering/exiting sides of Algorithm 2 crossings
+    (plans with such crossings) or else the robots' clearance against its rule;
     pairwise robot distances against their sheet limits."""
     r = result
     fig, axs = plt.subplots(2, 2, figsize=(12, 8))
@@ -134,7 +151,10 @@ def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
     ax.set_ylabel("height [m]")
     ax.legend(fontsize=7)
     ax.set_title("object height vs obstacles beneath")
-    _sides(axs[1, 0], r)
+    if any(c.kind == "algorithm2" for c in r.crossings):
+        _sides(axs[1, 0], r)
+    else:
+        _clearances(axs[1, 0], scenario, r)
     _distances(axs[1, 1], scenario, r)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

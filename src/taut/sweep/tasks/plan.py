@@ -3,10 +3,12 @@ plan under robot position noise.
 
 ``plan_robustness`` plans the base scenario once per worker process (the planner is
 deterministic), then for each point adds seeded normal noise of standard deviation
-``sigma`` (m, per robot coordinate, independent at every sample of the plan, modelling
-position tracking error) and replays the noisy formations: ``torn`` when some robot pair
-stands farther apart than its sheet vertices (the sheet would tear or a robot slip), else
-the quasi-static simulation runs and ``jumped`` says whether the object left its branch.
+``sigma`` (m, per robot coordinate, drawn every second of the plan and linear in time in
+between, modelling drifting position error; :func:`taut.plan.robustness.position_error`)
+and replays the noisy formations (:func:`taut.plan.robustness.replay`): ``torn`` when some
+robot pair stands farther apart than its sheet vertices (the sheet would tear or a robot
+slip), else the quasi-static simulation runs and ``jumped`` says whether the object
+dropped.
 """
 
 from __future__ import annotations
@@ -60,6 +62,7 @@ def _run_suite(ctx: Any, cols: Columns, seeds: np.ndarray) -> Columns:
 @dataclass(frozen=True, eq=False)
 class _PlanContext:
     scenario: Any
+    times: np.ndarray        # (T,) s
     robots: np.ndarray       # (T, N, 2) m
     object: np.ndarray       # (T, 3) m
 
@@ -73,11 +76,12 @@ def _prepare_robustness(spec: Any) -> _PlanContext:
     if not res.success:
         _, _, message = _status(res)
         raise SweepError("base", f"the base scenario has no plan to perturb ({message})")
-    return _PlanContext(sc, np.asarray(res.robots, float), np.asarray(res.object, float))
+    return _PlanContext(sc, np.asarray(res.times, float), np.asarray(res.robots, float),
+                        np.asarray(res.object, float))
 
 
 def _run_robustness(ctx: _PlanContext, cols: Columns, seeds: np.ndarray) -> Columns:
-    from ...plan.robustness import replay
+    from ...plan.robustness import position_error, replay
 
     b = len(seeds)
     out: Columns = {"torn": np.zeros(b, dtype=bool), "max_extension": np.full(b, np.nan),
@@ -85,7 +89,8 @@ def _run_robustness(ctx: _PlanContext, cols: Columns, seeds: np.ndarray) -> Colu
                     "contact": np.zeros(b, dtype=bool), "collision": np.zeros(b, dtype=bool)}
     for k in range(b):
         rng = np.random.default_rng(int(seeds[k]))
-        noisy = ctx.robots + rng.normal(0.0, cols["sigma"][k], size=ctx.robots.shape)
+        noisy = ctx.robots + position_error(rng, ctx.times, ctx.robots.shape[1],
+                                            float(cols["sigma"][k]), "gaussian", 1.0)
         t = replay(ctx.scenario, noisy, ctx.object)
         out["torn"][k], out["max_extension"][k] = t.torn, t.extension
         out["jumped"][k], out["max_deviation"][k] = t.dropped, t.deviation
@@ -113,11 +118,13 @@ register(Task(
 register(Task(
     name="plan_robustness",
     summary="one plan replayed under seeded robot position noise",
-    parameters={"sigma": "standard deviation of the position noise per coordinate, m",
+    parameters={"sigma": "standard deviation of the position noise per coordinate (drawn "
+                         "every second, linear in time in between), m",
                 "trial": "trial number (only distinguishes points; seeds derive from it)"},
     outputs={"torn": "some robot pair exceeded its sheet distance",
              "max_extension": "largest pair distance beyond its sheet distance, m (< 0: slack)",
-             "jumped": "the object left its branch (jump or lost) in the simulation",
+             "jumped": "the object dropped: its rest state ended and it fell more than 5 mm, "
+                       "or it was lost, in the simulation",
              "max_deviation": "largest distance of the object from its planned position, m",
              "contact": "the object touched an obstacle beneath the sheet or the ground",
              "collision": "a robot's footprint touched a wall or an obstacle"},
