@@ -44,6 +44,18 @@ def _check(fig, *, min_panels: int = 1):
     plt.close(fig)
 
 
+def _drawn(draw):
+    """The figure ``draw()`` saves (saving is intercepted)."""
+    captured = {}
+    real = plt.Figure.savefig
+    plt.Figure.savefig = lambda self, *a, **k: captured.setdefault("fig", self)
+    try:
+        draw()
+    finally:
+        plt.Figure.savefig = real
+    return captured["fig"]
+
+
 def test_fk_figure():
     from taut.io.sheet_scenario import load_sheet_scenario
     from taut.sheet import forward_kinematics
@@ -65,14 +77,7 @@ def test_plan_top_view_has_metres_on_both_axes(tmp_path):
     r = plan_baseline(sc)
     if not r.success:
         pytest.skip("baseline found no plan on this scenario")
-    captured = {}
-    real = plt.Figure.savefig
-    plt.Figure.savefig = lambda self, *a, **k: captured.setdefault("fig", self)
-    try:
-        plot_plan(sc, r, tmp_path / "p.png")
-    finally:
-        plt.Figure.savefig = real
-    fig = captured["fig"]
+    fig = _drawn(lambda: plot_plan(sc, r, tmp_path / "p.png"))
     top = fig.axes[0]
     assert top.get_xlabel() == "x [m]" and top.get_ylabel() == "y [m]"
     _check(fig, min_panels=3)
@@ -145,14 +150,7 @@ def test_plan_figure_shows_sides_only_for_algorithm2_crossings(tmp_path, method)
     sc = load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml")
     r = plan(sc, method=method)
     assert r.success
-    captured = {}
-    real = plt.Figure.savefig
-    plt.Figure.savefig = lambda self, *a, **k: captured.setdefault("fig", self)
-    try:
-        plot_plan(sc, r, tmp_path / "p.png")
-    finally:
-        plt.Figure.savefig = real
-    fig = captured["fig"]
+    fig = _drawn(lambda: plot_plan(sc, r, tmp_path / "p.png"))
     third = fig.axes[2].get_title()
     if method == "algorithm2":
         assert "entering/exiting" in third
