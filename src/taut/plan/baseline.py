@@ -2,11 +2,11 @@
 
 * :func:`plan_baseline` (``"disc"``): the formation is a disc covering every heading, routed
   on the visibility roadmap, never crossing (the baseline of issue 4);
-* ``plan(scenario, baseline="se2")``: the SE(2) search with crossing disabled (same search,
-  budget and compact formation as the crossing planner).
+* ``plan(scenario, baseline="se2")``: the SE(2) search with crossing disabled (the crossing
+  planner's own searches, formation library and budget).
 
-Both use the most compact stable all-taut formation (the most room to pass beside
-obstacles) and the same timing and verification as the crossing planner.
+The disc baseline uses the most compact stable all-taut formation (the most room to pass
+beside obstacles); both use the same timing and verification as the crossing planner.
 """
 
 from __future__ import annotations
