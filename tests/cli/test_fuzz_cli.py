@@ -165,6 +165,8 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
         cases += [("plan", ["plan", str(PLAN), opt, o]) for o in outs]
     cases += [("plan", ["plan", str(PLAN), "--search", v])
               for v in ["", "ompl", "RRTConnect", "ompl-rrt", "prm", "1"]]
+    for opt in ("--spacing", "--robustness", "--trials"):
+        cases += [("plan", ["plan", str(PLAN), opt, v]) for v in BAD_NUMBERS]
     # cdpr
     models = ["nosuch"] + files
     pose = ["--pose", "0", "0", "1"]

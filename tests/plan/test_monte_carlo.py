@@ -55,3 +55,19 @@ def test_probabilities_follow_the_margins(paper):
     assert big.tear_probability > 0.5 and big.failure_probability >= big.tear_probability
     # 4 cm at every sample squeezes the compact formation until the object is lost.
     assert r.robustness(0.04, 5, seed=2).drop_probability > 0
+
+
+def test_cli_reports_margins_and_robustness(capsys):
+    import json
+
+    from .test_plan import _app
+    yaml = str(EXAMPLES / "paper_corridor.yaml")
+    rc = _app()(args=["plan", yaml, "--robustness", "0.005", "--trials", "3", "--json"],
+                standalone_mode=False)
+    doc = json.loads(capsys.readouterr().out)
+    assert rc == 0 and doc["success"] and doc["sheet_margin"] == 0.01
+    assert doc["margins"]["sheet_slack"] >= 0.01 - 1e-9
+    assert doc["margins"]["clearance"] >= 0.2 - 1e-9           # robot radius + lateral
+    rob = doc["robustness"]
+    assert rob["trials"] == 3 and rob["sigma"] == 0.005 and rob["tear_probability"] == 0.0
+    assert rob["worst_extension"] < 0

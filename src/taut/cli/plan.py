@@ -9,7 +9,7 @@ import typer
 
 from .._validate import as_count
 from ..errors import InvalidInputError
-from ..io.serialize import plan_to_dict, to_json
+from ..io.serialize import plan_to_dict, robustness_to_dict, to_json
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
 
@@ -19,6 +19,8 @@ __all__ = ["register", "plan_to_dict", "plan_command"]
 MAX_BUDGET_S = 3600.0
 #: Largest iteration budget the command accepts (a few minutes of search per run).
 MAX_ITERATIONS = 200_000
+#: Most Monte Carlo trials of --robustness (each replays the whole plan).
+MAX_TRIALS = 100_000
 
 
 def plan_command(
@@ -56,6 +58,11 @@ def plan_command(
                                     "plan-ompl)."),
     spacing: float = typer.Option(0.05, "--spacing", help="Lattice spacing of the lattice "
                                   "search, m."),
+    robustness: Optional[float] = typer.Option(None, "--robustness", help="Also replay the "
+                                               "plan under this robot position error, m "
+                                               "(seeded Monte Carlo): failure "
+                                               "probabilities."),
+    trials: int = typer.Option(100, "--trials", help="Trials of --robustness."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
@@ -68,6 +75,9 @@ def plan_command(
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
     _check_options(budget, sheet_margin, seed, iterations, search, spacing,
                    baseline and disc_baseline)
+    if robustness is not None and not 0 <= robustness <= 1.0:
+        raise InvalidInputError("--robustness", f"must be in [0, 1] m, got {robustness:g}")
+    as_count(trials, "--trials", minimum=1, maximum=MAX_TRIALS)
     sc = load_plan_scenario(scenario)
     with working("plan"):
         result = plan(sc, baseline="disc" if disc_baseline else baseline,
@@ -75,6 +85,11 @@ def plan_command(
                       iterations=iterations, sheet_margin=sheet_margin, seed=seed,
                       search=search, spacing=spacing)  # type: ignore[arg-type]  # checked
     doc = plan_to_dict(result)
+    rob = None
+    if robustness is not None and result.success:
+        with working("robustness"):
+            rob = result.robustness(robustness, trials, seed=seed)
+        doc["robustness"] = robustness_to_dict(rob)
     if out is not None:
         out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")
     if result.success and (plot is not None or animate is not None):
@@ -83,12 +98,27 @@ def plan_command(
             plot_plan(sc, result, plot)
         if animate is not None:
             animate_plan(sc, result, animate)
+    _report(result, rob, doc, as_json, plot, animate)
+    return 0 if result.success else 1
+
+
+def _report(result, rob, doc: dict, as_json: bool, plot: Optional[Path],
+            animate: Optional[Path]) -> None:
+    """The plan's JSON, or its summary (and the robustness line); why figures were not
+    written."""
     if as_json:
         typer.echo(to_json(doc))
     elif result.success:
         typer.echo(f"plan: {len(result.times)} samples, {result.duration:.2f} s, path "
                    f"{result.path_length:.3f} m, crossed [{', '.join(result.crossed)}], "
                    f"object at {result.object[:, 2].max():.3f} m")
+        if rob is not None:
+            typer.echo(f"robustness ({rob.trials} trials, {rob.sigma * 1e3:g} mm): failure "
+                       f"{rob.failure_probability:.3f} (tear {rob.tear_probability:.3f}, "
+                       f"drop {rob.drop_probability:.3f}, contact "
+                       f"{rob.contact_probability:.3f}, collision "
+                       f"{rob.collision_probability:.3f}); below the height safety "
+                       f"{rob.unsafe_probability:.3f}")
     else:
         typer.echo(f"no plan ({result.status}): {result.message}")
     if not result.success:
@@ -96,7 +126,6 @@ def plan_command(
             if path is not None:
                 typer.echo(f"taut: {name}: {path} not written: there is no plan to draw",
                            err=True)
-    return 0 if result.success else 1
 
 
 def _check_options(budget: float | None, sheet_margin: float, seed: int, iterations: int,

@@ -23,7 +23,7 @@ if TYPE_CHECKING:                                  # imported lazily: keep `taut
     from ..cdpr.tension import TensionResult
     from ..cdpr.twist import TwistCapacities
     from ..cdpr.workspace import WorkspaceResult
-    from ..plan.result import PlanResult
+    from ..plan.result import PlanResult, Robustness
     from ..sheet.ik import IKResult
     from ..sheet.results import Equilibrium, FKResult
     from ..sheet.simulate import SimulationResult
@@ -32,7 +32,7 @@ __all__ = ["to_json", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dic
            "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",
            "wrench_set_to_dict", "workspace_to_dict", "twist_set_to_dict",
            "deployment_to_dict", "equilibria_check_to_dict", "control_result_to_dict",
-           "monte_carlo_to_dict"]
+           "monte_carlo_to_dict", "robustness_to_dict"]
 
 _MISSING = object()
 
@@ -177,7 +177,36 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
         "path_length": finite_or_none(r.path_length),
         "duration": finite_or_none(r.duration),
         "search": getattr(r, "search", None),
+        "sheet_margin": finite_or_none(getattr(r, "sheet_margin", None)),
+        "formations": [f.kind for f in getattr(r, "formations", ())],
+        "margins": _plan_margins(r),
     }
+
+
+def _plan_margins(r: PlanResult) -> dict[str, Any] | None:
+    """The worst margins of a verified plan (m): object height above what is beneath it,
+    robot-centre clearance, sheet slack of the tightest pair; null without a plan."""
+    v = getattr(r, "verification", None)
+    if v is None or not r.success:
+        return None
+    return {"height": finite_or_none(v.min_height_margin),
+            "clearance": finite_or_none(v.min_clearance),
+            "sheet_slack": finite_or_none(v.min_sheet_slack),
+            "max_object_step": finite_or_none(v.max_object_step)}
+
+
+def robustness_to_dict(rob: Robustness) -> dict[str, Any]:
+    """JSON form of a plan's Monte Carlo under robot position error (lengths m)."""
+    return {"sigma": rob.sigma, "noise": rob.noise, "trials": rob.trials,
+            "tear_probability": rob.tear_probability,
+            "drop_probability": rob.drop_probability,
+            "contact_probability": rob.contact_probability,
+            "collision_probability": rob.collision_probability,
+            "failure_probability": rob.failure_probability,
+            "unsafe_probability": rob.unsafe_probability,
+            "worst_extension": finite_or_none(rob.worst_extension),
+            "worst_height_margin": finite_or_none(rob.worst_height_margin),
+            "worst_clearance": finite_or_none(rob.worst_clearance)}
 
 
 # --- cable-driven parallel robots -----------------------------------------------------------
