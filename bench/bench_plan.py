@@ -23,11 +23,12 @@ machine (report the load: the times are wall-clock):
   time against the default margin where both succeed);
 * ``--robustness S``: per crossing plan, seeded Monte Carlo with every robot displaced up
   to ``S`` m (uniform in a disc) at every sample: tear and drop probabilities.
-* ``--library NAME``: instead, the crossing planner with taut's own RRT-Connect against
-  the same planner searching with ``plan(..., search=NAME)`` (an OMPL planner, extra
-  ``plan-ompl``), same validity checker, budget and seed, interleaved per scenario (the
-  order alternates): success counts, plan times, which plans the SE(2) search itself found
-  (not a fallback), and whether each succeeds on a superset of the other's scenarios.
+* ``--library NAME``: instead, the crossing planner with ``--search`` (default ``auto``)
+  against the same planner searching with ``plan(..., search=NAME)`` (e.g. an OMPL
+  planner, extra ``plan-ompl``), same validity checker, library, budget and seed,
+  interleaved per scenario (the order alternates): success counts, plan times, who found
+  each plan (the lattice, a sampling search, or a fallback), time to the goal where both
+  succeed, and whether each succeeds on a superset of the other's scenarios.
 """
 
 from __future__ import annotations
@@ -189,32 +190,43 @@ def _dump(args, rows: list[dict], meta: dict, done: bool) -> None:
 
 
 def compare_libraries(suite: list, library: str, budget: dict) -> bool:
-    """``--library``: own RRT-Connect vs ``library`` on every scenario (module docstring)."""
+    """``--library``: plan(search=<--search>) vs plan(search=``library``) on every
+    scenario, interleaved (the order alternates), same budget and seed."""
+    own = budget["search"]
     rows = []
     for k, sc in enumerate(suite):
         runs = {}
-        order = ("rrtconnect", library) if k % 2 == 0 else (library, "rrtconnect")
+        order = (own, library) if k % 2 == 0 else (library, own)
         for name in order:
             r, dt = timed(plan, sc, **{**budget, "search": name})
-            runs[name] = (r.success, r.search is not None, dt, r.status)
+            runs[name] = (r.success, r.search, dt, r.status, r.duration)
         rows.append(runs)
         print(f"{sc.name:<18} " + "  ".join(
-            f"{n}: {runs[n][3]:<16} {'(search)' if runs[n][1] else '        '} "
-            f"{runs[n][2]:5.1f} s" for n in ("rrtconnect", library)), flush=True)
+            f"{n}: {runs[n][3]:<16} {str(runs[n][1]):<16} {runs[n][2]:5.1f} s"
+            for n in (own, library)), flush=True)
     n = len(rows)
-    print(f"\n{'search':<16} {'success':>9} {'by SE(2) search':>16} {'median s':>9} "
-          f"{'min s':>6} {'max s':>6}")
-    for name in ("rrtconnect", library):
+    print(f"\n{'search':<16} {'success':>9} {'median s':>9} {'IQR s':>11} {'max s':>6}")
+    for name in (own, library):
         ts = [x[name][2] for x in rows]
+        q1, q3 = np.percentile(ts, [25, 75])
         print(f"{name:<16} {sum(x[name][0] for x in rows):>4}/{n:<4} "
-              f"{sum(x[name][1] for x in rows):>11}/{n:<4} {statistics.median(ts):>9.2f} "
-              f"{min(ts):>6.2f} {max(ts):>6.2f}")
-    own_sup = all(x["rrtconnect"][0] for x in rows if x[library][0])
-    lib_sup = all(x[library][0] for x in rows if x["rrtconnect"][0])
-    only_lib = sum(x[library][0] and not x["rrtconnect"][0] for x in rows)
-    only_own = sum(x["rrtconnect"][0] and not x[library][0] for x in rows)
-    print(f"own superset of {library}: {own_sup} ({only_lib} solved only by {library}); "
-          f"{library} superset of own: {lib_sup} ({only_own} solved only by own)")
+              f"{statistics.median(ts):>9.2f} {q1:>5.2f}-{q3:<5.2f} {max(ts):>6.2f}")
+        found = {}
+        for x in rows:
+            if x[name][0]:
+                found[x[name][1]] = found.get(x[name][1], 0) + 1
+        print(f"  found by {found}")
+    both = [x for x in rows if x[own][0] and x[library][0]]
+    if both:
+        print(f"time to the goal where both succeed ({len(both)}): "
+              f"{np.mean([x[own][4] for x in both]):.2f} s ({own}) vs "
+              f"{np.mean([x[library][4] for x in both]):.2f} s ({library})")
+    own_sup = all(x[own][0] for x in rows if x[library][0])
+    lib_sup = all(x[library][0] for x in rows if x[own][0])
+    only_lib = sum(x[library][0] and not x[own][0] for x in rows)
+    only_own = sum(x[own][0] and not x[library][0] for x in rows)
+    print(f"{own} superset of {library}: {own_sup} ({only_lib} solved only by {library}); "
+          f"{library} superset of {own}: {lib_sup} ({only_own} solved only by {own})")
     return own_sup
 
 
@@ -241,7 +253,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.library is not None:
         suite = generate_suite(args.count, args.seed)
         print(f"suite: {args.count} scenarios (seed {args.seed}); {args.iterations} "
-              f"iterations, time cap {args.time_cap}; own RRT-Connect vs {args.library}")
+              f"iterations, time cap {args.time_cap}; {args.search} vs {args.library}")
         return 0 if compare_libraries(suite, args.library, budget) else 1
     if not args.no_paper:
         paper(budget)
