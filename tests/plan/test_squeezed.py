@@ -129,3 +129,26 @@ def test_impossible_requirements_give_none():
 def test_start_must_match_the_team():
     with pytest.raises(InvalidInputError):
         squeezed_formation(_team(20), start=_narrow(3))                 # six robots, not five
+
+
+@pytest.mark.parametrize("index", [5, 20])
+def test_squeezed_state_survives_position_error(index):
+    """40 draws other than the design's (another seed): 5 mm of error per robot keeps a
+    stable state with the same taut cables, above the height safety, inside their hull,
+    within 10 cm of the design (the design asks 5 cm on its own 12 draws)."""
+    team = _team(index)
+    f = squeezed_formation(team, sheet_margin=SHEET_MARGIN, width=NEEDED.get(index, 1.0))
+    e0 = forward_kinematics(team.sheet, f.robots, team.hold_height).stable[0]
+    rng = np.random.default_rng(777)
+    for _ in range(40):
+        r = 0.005 * np.sqrt(rng.uniform(0, 1, team.n))
+        a = rng.uniform(0, 2 * np.pi, team.n)
+        P = f.robots + np.column_stack([r * np.cos(a), r * np.sin(a)])
+        same = [e for e in forward_kinematics(team.sheet, P, team.hold_height).stable
+                if e.taut == e0.taut]
+        assert same
+        e = min(same, key=lambda e: np.linalg.norm(e.object - e0.object))
+        assert np.linalg.norm(e.object - e0.object) <= 0.10
+        assert e.height >= team.height_safety
+        hull = MultiPoint([tuple(p) for p in P[list(e.taut)]]).convex_hull
+        assert hull.contains(Point(*e.object[:2]))
