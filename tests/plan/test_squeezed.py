@@ -134,8 +134,8 @@ def test_start_must_match_the_team():
 @pytest.mark.parametrize("index", [5, 20])
 def test_squeezed_state_survives_position_error(index):
     """40 draws other than the design's (another seed): 5 mm of error per robot keeps a
-    stable state with the same taut cables, above the height safety, inside their hull,
-    within 10 cm of the design (the design asks 5 cm on its own 12 draws)."""
+    stable state above the height safety, inside its taut robots' hull, within 10 cm of
+    the design (the design asks 5 cm on its own 12 draws)."""
     team = _team(index)
     f = squeezed_formation(team, sheet_margin=SHEET_MARGIN, width=NEEDED.get(index, 1.0))
     e0 = forward_kinematics(team.sheet, f.robots, team.hold_height).stable[0]
@@ -144,11 +144,36 @@ def test_squeezed_state_survives_position_error(index):
         r = 0.005 * np.sqrt(rng.uniform(0, 1, team.n))
         a = rng.uniform(0, 2 * np.pi, team.n)
         P = f.robots + np.column_stack([r * np.cos(a), r * np.sin(a)])
-        same = [e for e in forward_kinematics(team.sheet, P, team.hold_height).stable
-                if e.taut == e0.taut]
-        assert same
-        e = min(same, key=lambda e: np.linalg.norm(e.object - e0.object))
+        stable = forward_kinematics(team.sheet, P, team.hold_height).stable
+        assert stable
+        e = min(stable, key=lambda e: np.linalg.norm(e.object - e0.object))
         assert np.linalg.norm(e.object - e0.object) <= 0.10
         assert e.height >= team.height_safety
         hull = MultiPoint([tuple(p) for p in P[list(e.taut)]]).convex_hull
         assert hull.contains(Point(*e.object[:2]))
+
+
+def test_library_refuses_a_crossing_formation_that_loses_the_object():
+    """Suite scenario 2042 (3 robots): lifting the object over the 0.178 m post needs the
+    sheet nearly flat (every pair within 11 mm of its sheet distance); 5 mm of robot error
+    then leaves no rest state at all in about one case in twenty (checked here on other
+    draws), so the library keeps that formation out and says why."""
+    from taut.plan import optimal_formation
+    from taut.plan.library import _robust
+    sc = generate_scenario(2042, 3)
+    _, others, notes = formation_library(sc, SHEET_MARGIN)
+    assert all(f.object_height < 0.2 for f in others)
+    assert any("'o2' (0.178 m tall) cannot be crossed" in n and "loses it" in n for n in notes)
+    flat = optimal_formation(sc.team, kind="crossing", height=0.178, diameter=0.2,
+                             width=sc.world.width, max_reach=0.49 * sc.world.width,
+                             sheet_margin=SHEET_MARGIN)
+    assert flat is not None and not _robust(sc.team, flat)
+    rng = np.random.default_rng(99)
+    lost = 0
+    for _ in range(300):
+        r = 0.005 * np.sqrt(rng.uniform(0, 1, 3))
+        a = rng.uniform(0, 2 * np.pi, 3)
+        P = flat.robots + np.column_stack([r * np.cos(a), r * np.sin(a)])
+        lost += not forward_kinematics(sc.team.sheet, P, sc.team.hold_height).stable
+    assert 0 < lost < 60
+    assert _robust(sc.team, others[0])

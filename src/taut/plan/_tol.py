@@ -136,3 +136,10 @@ SQUEEZE_MAX_SHIFT = 0.05
 #: the paper's all-taut formations share the load between every robot, so the search keeps
 #: them wherever they fit and squeezes only where a passage needs it.
 SQUEEZED_WEIGHT = 1.5
+#: Least curvature of the potential at a squeezed formation's rest state (the reduced
+#: Hessian's smallest eigenvalue, normalised by the sheet size): a stiffer pocket moves the
+#: object less under the robots' position error. With the threshold of the all-taut
+#: optimiser (``MIN_CURVATURE``) the search found pockets so flat that most failed the
+#: robustness check; with 0.05 every seed-2024 scenario needing a squeezed formation gets
+#: one that passes it (0.01 and 0.2 leave some without).
+SQUEEZE_MIN_CURVATURE = 0.05

@@ -11,7 +11,9 @@ import functools
 import numpy as np
 
 from . import _tol
+from ..sheet import FKSolver
 from ._squeeze import squeezed_formation
+from ._squeeze_robust import LIBRARY_DRAWS, tolerates
 from .certificate import narrowest_cut
 from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
 from .result import compact_formation
@@ -56,7 +58,8 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
     narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
                                                         width=world.width,
                                                         sheet_margin=sheet_margin)
-    if narrow is not None and _min_width(narrow) < _min_width(compact) - _tol.NARROWER_BY:
+    if (narrow is not None and _min_width(narrow) < _min_width(compact) - _tol.NARROWER_BY
+            and _robust(team, narrow)):
         crossing.append(narrow)
     for h in _height_classes(scenario):
         group = [o for o in world.obstacles if o.height <= h]
@@ -67,12 +70,33 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
         if f is None:
             f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
                                   width=world.width, sheet_margin=sheet_margin)
+        ids = ", ".join(repr(o.id) for o in group if o.height == h)
         if f is None:
-            notes.append(_why_not_crossable(
-                scenario, h, ", ".join(repr(o.id) for o in group if o.height == h)))
-            continue
-        crossing.append(f)
+            notes.append(_why_not_crossable(scenario, h, ids))
+        elif not _robust(team, f):
+            notes.append(f"obstacle {ids} ({h:.3g} m tall) cannot be crossed: the formation "
+                         f"lifting the object to {f.object_height:.3g} m loses it under "
+                         f"{_tol.POSITION_ACCURACY * 1e3:g} mm of robot position error (the "
+                         "sheet is nearly flat)")
+        else:
+            crossing.append(f)
     return compact, crossing, notes
+
+
+def _robust(team, f: Formation, max_shift: float = np.inf) -> bool:
+    """Does ``f``'s rest state survive the robots' position error (a stable state above
+    the ground after each of ``LIBRARY_DRAWS`` seeded errors of up to 5 mm, and for a
+    squeezed formation above the height safety;
+    :func:`~taut.plan._squeeze_robust.tolerates`; and within ``max_shift`` m of where it
+    was: squeezed formations are held to ``SQUEEZE_MAX_SHIFT``)? A formation holding the
+    object with the sheet nearly flat (every pair near its sheet distance) loses it under
+    some."""
+    solver = FKSolver(team.sheet, team.hold_height)
+    fk = solver.solve(np.ascontiguousarray(f.robots, dtype=float)).stable
+    e = min(fk, key=lambda e: abs(e.height - f.object_height))
+    floor = 0.0 if f.kind != "squeezed" else team.height_safety
+    return tolerates(solver, np.asarray(f.robots, dtype=float), e, floor,
+                     max_shift=max_shift, draws=LIBRARY_DRAWS)
 
 
 Library = tuple[Formation, list[Formation], list[str]]
@@ -124,6 +148,8 @@ def _with_squeezed(scenario: Scenario, forms: list[Formation], allow_crossing: b
     width = _squeeze_width(scenario, forms, allow_crossing)
     f = None if width is None else _squeezed(scenario, sheet_margin, round(width, 6))
     if f is None or _min_width(f) >= min(_min_width(g) for g in forms) - _tol.NARROWER_BY:
+        return forms
+    if not _robust(scenario.team, f, _tol.SQUEEZE_MAX_SHIFT):
         return forms
     return [*forms, f]
 
