@@ -5,10 +5,13 @@ Checked (vectorised over samples):
 
 1. the formation is feasible: the sheet does not tear (FK paper's FormationFeasible),
    every robot pair stays ``sheet_margin`` inside its sheet distance, robot footprints do
-   not overlap;
+   not overlap, also between samples (rigid intervals keep every distance; on the others
+   robots move straight, and a pair's least distance has a closed form);
 2. the object's rest state, followed continuously. Between two samples related by a rigid
-   motion of the whole team the rest state is carried rigidly (the model is invariant under
-   planar rigid motions), so it cannot jump there: this is the per-interval proof. Every
+   motion of the whole team (a rotation and a translation, fitted; equal pair distances
+   alone would admit a mirror image) the rest state is carried rigidly (the model is
+   invariant under planar rigid motions), so it cannot jump there: this is the
+   per-interval proof. Every
    other interval (formation changes) is simulated (:func:`taut.sheet.simulate`) with
    samples added adaptively until the object moves at most ``max_object_step`` between
    two; a jump, a lost state, or an interval that cannot be refined below the bound fails
