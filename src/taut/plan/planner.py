@@ -239,12 +239,13 @@ def plan(scenario: Scenario, *, method: Method = "se2",
         Every robot pair stays this far inside its sheet distance, m (default 0.01 m:
         robots off by at most 5 mm each never tear the sheet).
     time_budget : float or None
-        Optional wall-clock safety cap of each SE(2) search, s (default None: no cap).
-        The budget that decides success is ``iterations``, so the answer does not depend
-        on the machine's load; a cap that stops a search is reported in the message, and
-        then the answer may depend on the load.
+        Optional wall-clock safety cap of each sampling search, s (default None: no cap).
+        What decides success is the lattice (its spacing) and ``iterations``, so the
+        answer does not depend on the machine's load; a cap that stops a search is
+        reported in the message, and then the answer may depend on the load. The lattice
+        search is not interrupted: it is bounded by its node count (``MAX_NODES``).
     iterations : int
-        Samples per RRT-Connect run of the SE(2) search (the deterministic budget).
+        Samples per RRT-Connect run of the sampling search (its deterministic budget).
     seed : int
         Seed of the SE(2) search: plans are reproducible for a given seed and
         ``iterations`` (unless the optional time cap stops a search).
