@@ -1,8 +1,10 @@
 """In-place formation changes: robots moving straight must not run into each other, and the
 verifier sees a collision between samples."""
 
-import numpy as np
 from dataclasses import replace
+
+import numpy as np
+import pytest
 
 from taut.plan import verify_motion
 from taut.plan._se2_motion import change_profile
@@ -41,3 +43,36 @@ def test_rigid_turns_keep_touching_footprints_apart():
                        for a in np.linspace(0, 0.6, 4)])
     r = verify_motion(sc, robots, np.full((4, 3), np.nan))
     assert "overlap" not in r.message
+
+
+def test_a_benign_change_tolerates_position_error():
+    from taut.io import load_plan_scenario
+    from taut.plan.robustness import change_tolerates
+    from .test_plan import EXAMPLES
+    sc = load_plan_scenario(EXAMPLES / "paper_corridor.yaml")
+    compact, others, _ = _library(sc, 0.01)
+    assert change_tolerates(sc, compact, others[0]) is None
+    assert change_tolerates(sc, others[0], compact) is None
+
+
+@pytest.mark.slow
+def test_fragile_changes_are_refused_and_the_plan_survives_its_monte_carlo():
+    """Suite scenario 5027 (6 robots): the changes into and out of its squeezed formation
+    move robots up to 0.75 m in place and drop the object under 5 mm of drifting robot
+    error; the planner refuses them and its plan keeps the object in every trial."""
+    from taut.plan import generate_scenario, plan
+    from taut.plan.library import _with_squeezed
+    from taut.plan.robustness import change_tolerates
+    sc = generate_scenario(5027, 6)
+    compact, others, _ = _library(sc, 0.01)
+    forms = _with_squeezed(sc, [compact, *others], True, 0.01)
+    squeezed = forms[-1]
+    assert squeezed.kind == "squeezed"
+    why = change_tolerates(sc, compact, squeezed)
+    assert why is not None and "drops the object" in why
+    r = plan(sc)
+    assert r.success
+    kinds = [f.kind for f in r.formations]
+    assert not ("compact" in kinds and "squeezed" in kinds)
+    rob = r.robustness(0.005, 10, seed=4)
+    assert rob.failure_probability == 0.0

@@ -29,18 +29,19 @@ def _world(rng, kind):
         c = rng.uniform([0.5, 0.3], [4.5, 1.2])
         r = rng.uniform(0.03, 0.2)
         blocked = float(rng.random() < 0.5)
+        keep = float(rng.uniform(0.0, 0.01))          # hull margin from a blocked obstacle
         if rng.random() < 0.5:
-            rows.append([*c, r, blocked, 0, 0, 0])
-            geoms.append((Point(c).buffer(r, quad_segs=QUAD), blocked))
+            rows.append([*c, r, blocked, 0, 0, 0, keep])
+            geoms.append((Point(c).buffer(r, quad_segs=QUAD), blocked, keep))
         else:
             t = np.sort(rng.uniform(0, 2 * np.pi, rng.integers(3, 7)))
             pts = c + r * np.column_stack([np.cos(t), np.sin(t)])
             g = Polygon(pts)
             if not g.is_valid or g.area <= 1e-6:
                 continue
-            rows.append([*c, r, blocked, 1, sum(len(v) for v in verts), len(pts)])
+            rows.append([*c, r, blocked, 1, sum(len(v) for v in verts), len(pts), keep])
             verts.append(pts)
-            geoms.append((g, blocked))
+            geoms.append((g, blocked, keep))
     obst = np.array(rows, float).reshape(-1, OBST_COLS)
     vv = np.concatenate(verts) if verts else np.zeros((0, 2))
     return walls, obst, np.ascontiguousarray(vv), geoms
@@ -59,12 +60,12 @@ def _oracle(robots, walls, geoms, clearance):
         best = min(best, 0.0)
     else:
         best = min(best, float(world.exterior.distance(hull)))
-    for g, blocked in geoms:
+    for g, blocked, keep in geoms:
         dd = shapely.distance(g, pts)
         dd = np.where(shapely.contains(g, pts), -shapely.distance(g.exterior, pts), dd)
         best = min(best, float(dd.min()) - clearance)
         if blocked:
-            best = min(best, float(g.distance(hull)))
+            best = min(best, float(g.distance(hull)) - keep)
     return best
 
 
@@ -140,8 +141,9 @@ def test_morph_check_is_a_proof_for_the_continuous_change():
     rng = np.random.default_rng(11)
     walls, _, verts, _ = _world(rng, 1)
     # A tall (blocked) post beside the centre and a low one ahead of it.
-    obst = np.array([[1.9, 0.9, 0.05, 1, 0, 0, 0], [2.4, 0.6, 0.05, 0, 0, 0, 0]], float)
-    geoms = [(Point(c).buffer(0.05, quad_segs=QUAD), b) for c, b in
+    obst = np.array([[1.9, 0.9, 0.05, 1, 0, 0, 0, 0.005], [2.4, 0.6, 0.05, 0, 0, 0, 0, 0.005]],
+                    float)
+    geoms = [(Point(c).buffer(0.05, quad_segs=QUAD), b, 0.005) for c, b in
              (([1.9, 0.9], 1.0), ([2.4, 0.6], 0.0))]
     accepted = refused = 0
     for _ in range(200):

@@ -9,7 +9,10 @@ formation changes where they are valid for the geometry (every robot moving stra
 obstacles under the hull low enough for the lowest object on the way) and for the
 quasi-static model (:func:`~taut.plan._se2_motion.change_profile`: no jump, the change ends
 in the new formation's rest state; the model is invariant under planar rigid motions, so
-one simulation per ordered pair of formations decides it everywhere). Moves cost their
+one simulation per ordered pair of formations decides it everywhere). A change on the path
+found must also keep the object under the robots' position error
+(:func:`~taut.plan.robustness.change_tolerates`); one that does not is refused everywhere
+and the search runs again. Moves cost their
 duration, so the path found is the fastest lattice path, with any number of formation
 changes; time spent in a squeezed formation counts ``SQUEEZED_WEIGHT`` times (the
 all-taut formations of the paper share the load between every robot, so they are
@@ -36,6 +39,7 @@ from ._rrt import shortcut
 from ._se2_kernel import motion_clear
 from ._se2_motion import Piece, change_profile
 from ._se2_space import PoseChecker
+from .robustness import change_tolerates
 from .formation import Formation
 from .world import Scenario
 
@@ -205,13 +209,29 @@ def lattice_search(scenario: Scenario, formations: list[Formation],
                      for c in checkers for k in range(nk)]]
     motion = np.array([team.speed, team.rotation_speed, _tol.MOTION_MARGIN,
                        _tol.MIN_ADVANCE, _tol.STATE_CLEARANCE])
-    path, cost, expanded = lattice_astar(
-        grid.cells, grid.nbr, nk, np.array([grid.spacing, grid.dpsi]),
-        np.stack([c._local for c in checkers]), np.array([c.radius for c in checkers]),
-        checkers[0]._walls, np.stack([c._obst for c in checkers]), checkers[0]._verts,
-        checkers[0].clearance_rule, motion, cost, change_obst, starts, goals, goal_cost,
-        np.asarray(scenario.goal, dtype=float), int(expansions),
-        np.array([_tol.SQUEEZED_WEIGHT if f.kind == "squeezed" else 1.0 for f in formations]))
+    weight = np.array([_tol.SQUEEZED_WEIGHT if f.kind == "squeezed" else 1.0
+                       for f in formations])
+    total = 0
+    while True:
+        path, best, expanded = lattice_astar(
+            grid.cells, grid.nbr, nk, np.array([grid.spacing, grid.dpsi]),
+            np.stack([c._local for c in checkers]), np.array([c.radius for c in checkers]),
+            checkers[0]._walls, np.stack([c._obst for c in checkers]), checkers[0]._verts,
+            checkers[0].clearance_rule, motion, cost, change_obst, starts, goals, goal_cost,
+            np.asarray(scenario.goal, dtype=float), int(expansions), weight)
+        total += int(expanded)
+        layers = [int(n // (nk * C)) for n in path]
+        used = [(a, b) for a, b in zip(layers[:-1], layers[1:]) if a != b]
+        if all(change_tolerates(scenario, formations[a], formations[b]) is None
+               for a, b in used):
+            break
+        # A change of the path drops the object: check every allowed change now (so A*
+        # runs at most twice), refuse the fragile ones everywhere, and search again.
+        for a, b in zip(*np.nonzero(np.isfinite(cost))):
+            why = change_tolerates(scenario, formations[a], formations[b])
+            if why is not None:
+                cost[a, b] = np.inf
+                refused.append(why)
     pieces = None
     if len(path):
         poses = [(int(n // (nk * C)), np.array([*grid.cells[(n // nk) % C],
@@ -219,8 +239,8 @@ def lattice_search(scenario: Scenario, formations: list[Formation],
                  for n in path]
         poses.append((poses[-1][0], np.array([*scenario.goal, poses[-1][1][2]])))
         pieces = _pieces(formations, checkers, poses, rng)
-    return LatticeResult(pieces, grid.spacing, nk, int(expanded),
-                         bool(expanded > expansions), tuple(refused), float(cost))
+    return LatticeResult(pieces, grid.spacing, nk, total, bool(expanded > expansions),
+                         tuple(refused), float(best))
 
 
 def _pieces(forms: list[Formation], checkers: list[PoseChecker],

@@ -10,7 +10,9 @@ robot and the robots' convex hull may move before a rule of
 * the hull against every wall: the distance from each wall edge to the hull (zero when
   they meet: walls are tall);
 * the hull against every *blocked* obstacle (too tall for the formation, or every
-  obstacle when crossing is disabled): their distance (zero when they meet).
+  obstacle when crossing is disabled): their distance less the obstacle's hull margin
+  (the caller's ``POSITION_ACCURACY``: robots that far off their places cannot bring the
+  sheet onto an obstacle it must not pass over).
 
 Each term is 1-Lipschitz in the robots' displacement (the hull's points are convex
 combinations of the robots), so a pose whose clearance is ``s`` stays valid while no
@@ -30,7 +32,7 @@ hull's points then move at most as far as the farthest robot).
 
 Obstacles are rows of ``obst`` (``OBST_COLS`` columns): centre x, y, enclosing radius,
 blocked flag, kind (0 a disc of that radius, 1 a polygon), first vertex and vertex count
-in ``verts``. A disc is the circle circumscribing the obstacle's 64-gon footprint (its
+in ``verts``, and the distance the hull keeps from the obstacle when it is blocked (m). A disc is the circle circumscribing the obstacle's 64-gon footprint (its
 ``mec_radius``), so it contains that footprint: the clearance is never overstated.
 """
 
@@ -46,7 +48,7 @@ __all__ = ["OBST_COLS", "robots_clearance", "poses_clearance", "motion_clear", "
            "convex_hull", "segment_point_distance", "convex_point_signed_distance"]
 
 #: Columns of an obstacle row (module docstring).
-OBST_COLS = 7
+OBST_COLS = 8
 
 
 @jit
@@ -261,11 +263,12 @@ def robots_clearance(robots, walls, obst, verts, clearance, cx, cy, radius, orde
             d -= clearance
             if d < best:
                 best = d
-        if obst[o, 3] > 0.5 and far < best:             # blocked
+        if obst[o, 3] > 0.5 and far - obst[o, 7] < best:             # blocked
             if disc:
                 d = convex_point_signed_distance(hull, ox, oy) - orad
             else:
                 d = _convex_polygon_distance(hull, verts, start, count)
+            d -= obst[o, 7]
             if d < best:
                 best = d
         if best < 0.0:

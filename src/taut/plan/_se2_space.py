@@ -7,8 +7,10 @@ turned by ``psi`` (rad). It is *valid* when
    every obstacle (robots drive on the ground: they never pass over an obstacle);
 2. the robots' convex hull (the sheet's projection when every cable is taut) lies in the
    free space (walls are tall) and meets only obstacles the formation can hold the object
-   above: ``height <= f.max_height`` (eq. 2: object height minus the height safety). With
-   crossing disabled it meets no obstacle at all;
+   above: ``height <= f.max_height`` (eq. 2: object height minus the height safety), and
+   keeps ``POSITION_ACCURACY`` from the others (so that robots off their places by that
+   much cannot bring the sheet onto them). With crossing disabled it meets no obstacle at
+   all;
 
 each with ``STATE_CLEARANCE`` to spare. An obstacle passing under the sheet between two
 robots is then automatically narrower than the gap it passes through: it would otherwise
@@ -49,12 +51,13 @@ def _kernel_world(scenario: Scenario, blocked: list[bool]) -> tuple[np.ndarray, 
     walls = np.ascontiguousarray(world.free_space, dtype=float)
     rows, verts = [], []
     count = 0
+    margin = _tol.POSITION_ACCURACY
     for o, bl in zip(world.obstacles, blocked):
         if o.polygon is None:
-            rows.append([*o.mec_center, o.mec_radius, float(bl), 0.0, 0.0, 0.0])
+            rows.append([*o.mec_center, o.mec_radius, float(bl), 0.0, 0.0, 0.0, margin])
         else:
             v = np.asarray(o.polygon, dtype=float)
-            rows.append([*o.mec_center, o.mec_radius, float(bl), 1.0, count, len(v)])
+            rows.append([*o.mec_center, o.mec_radius, float(bl), 1.0, count, len(v), margin])
             verts.append(v)
             count += len(v)
     obst = np.array(rows, dtype=float).reshape(-1, OBST_COLS)

@@ -28,6 +28,7 @@ tear, drop, contact or collision.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -40,6 +41,7 @@ from . import _tol
 from .world import Scenario
 
 if TYPE_CHECKING:
+    from .formation import Formation
     from .result import PlanResult, Robustness
 
 __all__: list[str] = []
@@ -162,3 +164,59 @@ def monte_carlo(scenario: Scenario, result: "PlanResult", sigma: float, trials: 
                       max(t.extension for t in out), p("contact"), p("unsafe"),
                       p("collision"), p("failed"), min(margins, default=np.nan),
                       min(t.clearance for t in out))
+
+
+#: Perturbed replays of a formation change before a plan may use it (seeded): the changes
+#: that failed in the suites' Monte Carlo dropped the object in most trials, so a few
+#: draws find them.
+CHANGE_DRAWS = 6
+
+
+def change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str | None:
+    """Does the in-place change from ``f`` to ``g`` keep the object under the robots'
+    position error? ``CHANGE_DRAWS`` seeded replays of the change (at the origin: the model
+    is invariant under rigid motions), each robot off by a drifting error of up to
+    ``POSITION_ACCURACY`` (:func:`position_error`), must neither lose the object nor drop
+    it by more than ``MAX_OBJECT_STEP``. Returns None, or why not (memoised per pair)."""
+    return _change_tolerates(scenario, f, g)
+
+
+@functools.lru_cache(maxsize=256)
+def _change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str | None:
+    team = scenario.team
+    zero = np.zeros(2)
+    a, b = f.placed(zero, np.asarray(0.0)), g.placed(zero, np.asarray(0.0))
+    dist = float(np.linalg.norm(b - a, axis=1).max())
+    k = max(2, int(np.ceil(dist / _tol.REFORM_STEP)))
+    s = np.arange(0, k + 1) / k
+    robots = a[None] + s[:, None, None] * (b - a)[None]
+    times = s * dist / team.speed
+    rng = np.random.default_rng(CHANGE_SEED)
+    start = np.array([0.0, 0.0, f.object_height])
+    limits = team.sheet.side_lengths()
+    iu, ju = np.triu_indices(team.n, 1)
+    for _ in range(CHANGE_DRAWS):
+        P = robots + position_error(rng, times, team.n, _tol.POSITION_ACCURACY, "disc", 1.0)
+        torn = bool((np.linalg.norm(P[:, iu] - P[:, ju], axis=2) > limits[iu, ju]).any())
+        if torn or _drops(scenario, P, start):
+            return (f"the change from {f.kind} (object at {f.object_height:.3g} m) to "
+                    f"{g.kind} ({g.object_height:.3g} m) "
+                    + ("tears the sheet" if torn else "drops the object")
+                    + f" under {_tol.POSITION_ACCURACY * 1e3:g} mm of robot position error")
+    return None
+
+
+def _drops(scenario: Scenario, robots: np.ndarray, start: np.ndarray) -> bool:
+    """Does the quasi-static replay of ``robots`` from ``start`` lose the object or drop
+    it by more than ``MAX_OBJECT_STEP``?"""
+    team = scenario.team
+    try:
+        sim = simulate(team.sheet, robots, team.hold_height, start=start)
+    except TautError:
+        return True
+    return any(e.kind == "lost" or (e.kind == "jump" and e.drop > _tol.MAX_OBJECT_STEP)
+               for e in sim.events)
+
+
+#: Seed of :func:`change_tolerates`.
+CHANGE_SEED = 20242
