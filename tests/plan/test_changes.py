@@ -76,3 +76,20 @@ def test_fragile_changes_are_refused_and_the_plan_survives_its_monte_carlo():
     assert not ("compact" in kinds and "squeezed" in kinds)
     rob = r.robustness(0.005, 10, seed=4)
     assert rob.failure_probability == 0.0
+
+
+@pytest.mark.slow
+def test_a_change_that_brings_the_object_below_the_height_safety_is_refused():
+    """Suite scenario 5057: between its compact formation (object at the 0.04 m safety)
+    and its squeezed one the object dips to 0.038 m; the verifier would refuse a plan with
+    that change, so the planner must not use it (it found one that did, before)."""
+    from taut.plan import generate_scenario, plan
+    from taut.plan.library import _with_squeezed
+    sc = generate_scenario(5057, 6)
+    compact, others, _ = _library(sc, 0.01)
+    squeezed = _with_squeezed(sc, [compact, *others], True, 0.01)[-1]
+    prof = change_profile(sc, compact, squeezed)
+    assert prof.message is not None and "below the height safety" in prof.message
+    assert prof.lowest < sc.team.height_safety
+    r = plan(sc)
+    assert r.success and r.verification.min_height_margin >= sc.team.height_safety - 1e-9

@@ -173,7 +173,12 @@ def change_profile(scenario: Scenario, f: Formation, g: Formation) -> ChangeProf
     if isinstance(change, str):
         return ChangeProfile(change, -np.inf, np.inf)
     _, obj, dist = change
-    return ChangeProfile(None, float(obj[:, 2].min()), dist / scenario.team.speed)
+    lowest = float(obj[:, 2].min())
+    safety = scenario.team.height_safety
+    if lowest < safety - _tol.GEOMETRY_TOL:
+        return ChangeProfile(f"the object comes down to {lowest:.3g} m during the change, "
+                             f"below the height safety {safety:.3g} m", lowest, np.inf)
+    return ChangeProfile(None, lowest, dist / scenario.team.speed)
 
 
 def sample_pieces(scenario: Scenario, pieces: list[Piece]) -> SampledMotion:
