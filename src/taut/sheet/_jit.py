@@ -2,6 +2,12 @@
 
 :func:`jit` is ``numba.njit(cache=True, nogil=True, error_model="numpy")`` (float
 division by zero gives inf/NaN as in numpy) or, without numba, the plain function.
+
+numba invalidates a cached function when *its own* source file changes, not when a
+compiled function it calls from another module does (e.g. ``taut.plan._lattice_kernel``
+calling ``taut.plan._se2_kernel``). An install writes every file anew, so this only bites
+a working tree in which a kernel was edited: ``make clean-cache`` removes the cached
+machine code (``*.nbi``, ``*.nbc``).
 """
 
 from __future__ import annotations
