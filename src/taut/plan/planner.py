@@ -142,21 +142,15 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
          search: Search = "auto") -> PlanResult:
     """One SE(2) search (crossing planner or its bypass baseline) and its best plan."""
     compact, others, notes = library
-    forms = [compact, *others]
+    # A squeezed formation joins where passages are too narrow for all the others; the
+    # search weighs time in it, so it is used only where it is needed.
+    forms = _with_squeezed(scenario, [compact, *others], allow_crossing, sheet_margin)
     lattice_note = ""
     if search in ("auto", "lattice"):
         found_lattice, lattice_note = _lattice(scenario, forms, allow_crossing, budget,
                                                planner, sheet_margin)
         if found_lattice is not None:
             return found_lattice
-    more = _with_squeezed(scenario, forms, allow_crossing, sheet_margin)
-    if len(more) > len(forms):
-        forms = more
-        if search in ("auto", "lattice"):
-            found_lattice, lattice_note = _lattice(scenario, forms, allow_crossing, budget,
-                                                   planner, sheet_margin)
-            if found_lattice is not None:
-                return found_lattice
     results: list[PlanResult] = []
 
     def accept(pieces: list[Piece]) -> bool:

@@ -176,8 +176,9 @@ def change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str 
     """Does the in-place change from ``f`` to ``g`` keep the object under the robots'
     position error? ``CHANGE_DRAWS`` seeded replays of the change (at the origin: the model
     is invariant under rigid motions), each robot off by a drifting error of up to
-    ``POSITION_ACCURACY`` (:func:`position_error`), must neither lose the object nor drop
-    it by more than ``MAX_OBJECT_STEP``. Returns None, or why not (memoised per pair)."""
+    ``POSITION_ACCURACY`` (:func:`position_error`) and the pair turned by a random heading,
+    must neither lose the object nor drop it by more than ``MAX_OBJECT_STEP``. Returns
+    None, or why not (memoised per pair)."""
     return _change_tolerates(scenario, f, g)
 
 
@@ -185,17 +186,20 @@ def change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str 
 def _change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str | None:
     team = scenario.team
     zero = np.zeros(2)
-    a, b = f.placed(zero, np.asarray(0.0)), g.placed(zero, np.asarray(0.0))
-    dist = float(np.linalg.norm(b - a, axis=1).max())
-    k = max(2, int(np.ceil(dist / _tol.REFORM_STEP)))
-    s = np.arange(0, k + 1) / k
-    robots = a[None] + s[:, None, None] * (b - a)[None]
-    times = s * dist / team.speed
     rng = np.random.default_rng(CHANGE_SEED)
     start = np.array([0.0, 0.0, f.object_height])
     limits = team.sheet.side_lengths()
     iu, ju = np.triu_indices(team.n, 1)
     for _ in range(CHANGE_DRAWS):
+        # At a random heading: the model is invariant under rotations, but its branch
+        # following at a bifurcation is not exactly, and plans change at any heading.
+        psi = np.asarray(rng.uniform(-np.pi, np.pi))
+        a, b = f.placed(zero, psi), g.placed(zero, psi)
+        dist = float(np.linalg.norm(b - a, axis=1).max())
+        k = max(2, int(np.ceil(dist / _tol.REFORM_STEP)))
+        s = np.arange(0, k + 1) / k
+        robots = a[None] + s[:, None, None] * (b - a)[None]
+        times = s * dist / team.speed
         P = robots + position_error(rng, times, team.n, _tol.POSITION_ACCURACY, "disc", 1.0)
         torn = bool((np.linalg.norm(P[:, iu] - P[:, ju], axis=2) > limits[iu, ju]).any())
         if torn or _drops(scenario, P, start):
