@@ -109,15 +109,24 @@ def _clearances(ax, scenario: Scenario, r: PlanResult) -> None:
 
 
 def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
-    """Pairwise robot distances against their sheet limits (and the margin)."""
+    """Pairwise robot distances against their sheet limits (and the margin); above ten
+    pairs the others are grey and only the pair with the least slack is named."""
     n = r.robots.shape[1]
     V = scenario.team.sheet.vertices
     iu, ju = np.triu_indices(n, 1)
     d = np.linalg.norm(r.robots[:, iu] - r.robots[:, ju], axis=2)
     limit = np.linalg.norm(V[iu] - V[ju], axis=1)
     ratio = d / limit
+    tightest = int(np.argmin((limit[None] - d).min(axis=0)))
     for k in range(len(iu)):
-        ax.plot(r.times, ratio[:, k], lw=0.8, label=f"|r{iu[k] + 1} - r{ju[k] + 1}|")
+        name = f"|r{iu[k] + 1} - r{ju[k] + 1}|"
+        if len(iu) <= 10:
+            ax.plot(r.times, ratio[:, k], lw=0.8, label=name)
+        elif k == tightest:               # many pairs: name only the one nearest its limit
+            ax.plot(r.times, ratio[:, k], lw=1.2, color="tab:red",
+                    label=f"{name} (least slack)", zorder=3)
+        else:
+            ax.plot(r.times, ratio[:, k], lw=0.6, color="0.7")
     ax.axhline(1.0, color="k", lw=1.0, label="sheet limit")
     if r.sheet_margin > 0:
         ax.axhline(1.0 - r.sheet_margin / limit.min(), color="k", ls=":", lw=0.8,
@@ -127,8 +136,7 @@ def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
     ax.set_title(f"pair distances vs sheet limits (least slack "
                  f"{(limit[None] - d).min() * 1e3:.1f} mm)")
     ax.set_ylim(min(0.0, float(ratio.min()) - 0.05), 1.08)
-    if len(iu) <= 10:
-        ax.legend(fontsize=6, ncol=2)
+    ax.legend(fontsize=6, ncol=2 if len(iu) <= 10 else 1)
 
 
 def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
