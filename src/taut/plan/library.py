@@ -54,7 +54,9 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
     world, team = scenario.world, scenario.team
     compact = compact_formation(scenario, sheet_margin)
     crossing, notes = [], []
-    # A triangle's narrowest stable formation is its compact one.
+    # Triangles use the compact formation: their narrow one (least width, object at the
+    # height safety) lost the object under 5 mm of position error on all 26 triangles of
+    # the two benchmark suites (seeds 2024 and 5000), e.g. 0.368 m against 0.486 m wide.
     narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
                                                         width=world.width,
                                                         sheet_margin=sheet_margin)
