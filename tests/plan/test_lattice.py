@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import dijkstra
 from taut.plan import Obstacle, Scenario, World, formation_library, generate_scenario, plan
 from taut.plan import _lattice, _tol
 from taut.plan._lattice_kernel import OFFSETS
-from taut.plan._se2_kernel import morph_clear, motion_clear
+from taut.plan._se2_kernel import morph_clear
 from taut.plan._se2_space import PoseChecker
 
 from .test_plan import corridor_team

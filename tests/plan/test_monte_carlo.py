@@ -1,24 +1,16 @@
 """Monte Carlo of a plan under robot position error: the replay through the quasi-static
 simulation and what it counts."""
 
-import numpy as np
 import pytest
 
-from taut.io import load_plan_scenario
-from taut.plan import _tol, plan
+from taut.plan import _tol
 from taut.plan.robustness import replay
 
 from .test_plan import EXAMPLES
 
 
-@pytest.fixture(scope="module")
-def paper():
-    sc = load_plan_scenario(EXAMPLES / "paper_corridor.yaml")
-    return sc, plan(sc)
-
-
-def test_exact_replay_matches_the_verification(paper):
-    sc, r = paper
+def test_exact_replay_matches_the_verification(paper_corridor_plan):
+    sc, r = paper_corridor_plan
     t = replay(sc, r.robots, r.object)
     assert not t.failed and not t.unsafe
     assert t.deviation < 1e-6 * sc.team.sheet.size
@@ -31,8 +23,9 @@ def test_exact_replay_matches_the_verification(paper):
     assert t.extension == pytest.approx(-r.verification.min_sheet_slack, abs=1e-12)
 
 
-def test_a_robot_pushed_into_a_wall_is_a_collision_and_a_pair_pulled_apart_a_tear(paper):
-    sc, r = paper
+def test_a_robot_pushed_into_a_wall_is_a_collision_and_a_pair_pulled_apart_a_tear(
+        paper_corridor_plan):
+    sc, r = paper_corridor_plan
     bad = r.robots.copy()
     bad[5, 0, 1] = 1.0 - 0.5 * sc.team.robot_radius         # half inside the wall y = 1
     assert replay(sc, bad, r.object).collision
@@ -42,8 +35,8 @@ def test_a_robot_pushed_into_a_wall_is_a_collision_and_a_pair_pulled_apart_a_tea
     assert t.torn and t.failed and t.extension > 9.0
 
 
-def test_probabilities_follow_the_margins(paper):
-    sc, r = paper
+def test_probabilities_follow_the_margins(paper_corridor_plan):
+    sc, r = paper_corridor_plan
     small = r.robustness(0.005, 10, seed=2)       # the default 5 mm position accuracy
     assert small.tear_probability == 0.0 and small.worst_extension < 0
     assert small.failure_probability == 0.0 and small.collision_probability == 0.0

@@ -8,11 +8,10 @@ import shapely
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from taut.io import load_plan_scenario
-from taut.plan import Obstacle, plan, resample_motion, verify_motion
+from taut.plan import Obstacle, resample_motion, verify_motion
 from taut.plan import _tol
 
-from .test_plan import EXAMPLES, corridor
+from .test_plan import corridor
 
 #: Tolerance of the rules, m (as the verifier's).
 TOL = 1e-6
@@ -174,14 +173,8 @@ def test_hull_gliding_past_a_tall_fin_passes():
     assert len(rules_broken(sc, dense, np.full(len(dense), check.object[0, 2]))) == 0
 
 
-@pytest.fixture(scope="module")
-def paper_plan():
-    sc = load_plan_scenario(EXAMPLES / "paper_corridor.yaml")
-    return sc, plan(sc)
-
-
-def test_paper_plan_passes_at_any_sampling(paper_plan):
-    sc, r = paper_plan
+def test_paper_plan_passes_at_any_sampling(paper_corridor_plan):
+    sc, r = paper_corridor_plan
     assert r.success, r.message
     check = verify_motion(sc, r.robots, r.object)
     assert check.success, check.message

@@ -74,10 +74,7 @@ def plan_command(
     plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
     _check_options(budget, sheet_margin, seed, iterations, search, spacing,
-                   baseline and disc_baseline)
-    if robustness is not None and not 0 <= robustness <= 1.0:
-        raise InvalidInputError("--robustness", f"must be in [0, 1] m, got {robustness:g}")
-    as_count(trials, "--trials", minimum=1, maximum=MAX_TRIALS)
+                   baseline and disc_baseline, robustness, trials)
     sc = load_plan_scenario(scenario)
     with working("plan"):
         result = plan(sc, baseline="disc" if disc_baseline else baseline,
@@ -129,7 +126,8 @@ def _report(result, rob, doc: dict, as_json: bool, plot: Optional[Path],
 
 
 def _check_options(budget: float | None, sheet_margin: float, seed: int, iterations: int,
-                   search: str, spacing: float, both_baselines: bool) -> None:
+                   search: str, spacing: float, both_baselines: bool,
+                   robustness: float | None, trials: int) -> None:
     """Every option's range, before any work (one line naming the option)."""
     if budget is not None and not 0 < budget <= MAX_BUDGET_S:
         raise InvalidInputError("--budget", f"must be in (0, {MAX_BUDGET_S:g}] s, got {budget:g}")
@@ -143,6 +141,9 @@ def _check_options(budget: float | None, sheet_margin: float, seed: int, iterati
     if both_baselines:
         raise InvalidInputError("--baseline", "give at most one of --baseline and "
                                 "--disc-baseline")
+    if robustness is not None and not 0 <= robustness <= 1.0:
+        raise InvalidInputError("--robustness", f"must be in [0, 1] m, got {robustness:g}")
+    as_count(trials, "--trials", minimum=1, maximum=MAX_TRIALS)
 
 
 def _check_search(search: str) -> None:

@@ -40,7 +40,7 @@ from ._se2_kernel import morph_clear, motion_clear, robots_clearance
 __all__ = ["lattice_astar", "OFFSETS"]
 
 #: The eight position moves (di, dj) of a lattice cell, in the order of the caller's
-#: neighbour table, and the heading moves.
+#: neighbour table.
 OFFSETS = np.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0], [1, 1]])
 
 
@@ -153,9 +153,9 @@ def lattice_astar(cells, nbr, nk, geo, locals_, radii, walls, obsts, verts, rule
 
     ``cells`` (C, 2) cell positions; ``nbr`` (C, 8) neighbour cells in ``OFFSETS`` order
     (-1: none); ``geo`` = (spacing, dpsi); ``locals_`` (L, N, 2) formations; ``radii``
-    (L,); ``obsts`` (L, O, 7) each layer's obstacle rows; ``motion`` = (speed, rotation
+    (L,); ``obsts`` (L, O, OBST_COLS) each layer's obstacle rows; ``motion`` = (speed, rotation
     speed, margin, least advance, least clearance of a node); ``change_cost`` (L, L)
-    seconds (inf: not allowed); ``change_obst`` (L, L, O, 7) the obstacle rows during a
+    seconds (inf: not allowed); ``change_obst`` (L, L, O, OBST_COLS) the obstacle rows during a
     change; ``goal_nodes`` sorted node ids joined to the goal at ``goal_cost`` seconds.
     Returns ``(path node ids from a start to the last node before the goal, seconds,
     expansions)``; the path is empty when the goal is not reached within

@@ -193,7 +193,8 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
 
 
 def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
-                     time_budget: float | None, iterations: int, seed: int) -> SearchBudget:
+                     time_budget: float | None, iterations: int, seed: int, spacing: float
+                     ) -> SearchBudget:
     """Validate :func:`plan`'s options (typed errors naming the field); the budget."""
     if not isinstance(scenario, Scenario):
         raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
@@ -210,7 +211,8 @@ def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_ma
         raise InvalidInputError("time_budget", "must be a positive time in s, or None")
     return SearchBudget(iterations=as_count(iterations, "iterations", minimum=1),
                         seed=as_count(seed, "seed", minimum=0),
-                        time_budget=None if time_budget is None else float(time_budget))
+                        time_budget=None if time_budget is None else float(time_budget),
+                        spacing=as_bounded(spacing, "spacing", MAX_SHEET_LENGTH, "m"))
 
 
 def plan(scenario: Scenario, *, method: Method = "se2",
@@ -279,9 +281,8 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     if time_budget is not None:
         as_bounded(time_budget, "time_budget", MAX_DURATION_S, "s")
     as_count(iterations, "iterations", minimum=1, maximum=10_000_000)
-    budget = replace(_checked_options(scenario, method, baseline, sheet_margin, time_budget,
-                                      iterations, seed),
-                     spacing=as_bounded(spacing, "spacing", MAX_SHEET_LENGTH, "m"))
+    budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
+                              iterations, seed, spacing)
     engine(search)                      # validates the name and that OMPL is installed
     margin = float(sheet_margin)
     r = _dispatch(scenario, method, baseline, straight_crossings, margin, budget, search)
