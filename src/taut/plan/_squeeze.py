@@ -48,7 +48,7 @@ from ..errors import InvalidInputError, TautError
 from ..sheet import Equilibrium, FKSolver, formation_metrics
 from . import _tol
 from ._formation_problem import MIN_DEPTH_FRACTION
-from ._squeeze_robust import LIBRARY_DRAWS, convex_hull, hull_inset, tolerates
+from ._squeeze_robust import convex_hull, hull_inset, tolerates
 from .formation import Formation, optimal_formation
 from .world import Team
 
@@ -261,8 +261,8 @@ def _accept(solver: FKSolver, lim: _Limits, R: np.ndarray) -> _Candidate | None:
     e = stable[0]
     up = e.height - m["z_min"]
     inside = hull_inset(R[list(e.taut)], e.object[:2]) - m["inset"]
-    if up < 0 or inside < 0 or not tolerates(solver, R, e, m["z_min"] - _tol.SQUEEZE_HEIGHT_MARGIN,
-                                             draws=LIBRARY_DRAWS):
+    if up < 0 or inside < 0 or not tolerates(solver, R, e,
+                                             m["z_min"] - _tol.SQUEEZE_HEIGHT_MARGIN):
         return None
     return _Candidate(float(np.ptp(R[:, 1])), min(up, inside), R, e)
 

@@ -23,14 +23,12 @@ from scipy.spatial import ConvexHull, QhullError
 from ..errors import TautError
 from ..sheet import Equilibrium, FKSolver
 from . import _tol
+from .robustness import _noise
 
 __all__ = ["tolerates", "convex_hull", "hull_inset"]
 
-#: Perturbations drawn per check of a candidate of the squeezed-formation search (every
-#: accepted iterate is checked, so this stays small) ...
-DRAWS = 12
-#: ... and per check of a formation about to join the library: a formation that loses its
-#: state under one error in twenty passes 12 draws half the time, 100 draws 0.6 % of it.
+#: Perturbations drawn per check: a formation that loses its state under one error in
+#: twenty passes 12 draws half the time, 100 draws 0.6 % of it.
 LIBRARY_DRAWS = 100
 #: Seed of the perturbations (the check is deterministic).
 SEED = 20241
@@ -55,7 +53,7 @@ def hull_inset(P: np.ndarray, q: np.ndarray) -> float:
 
 
 def tolerates(solver: FKSolver, robots: np.ndarray, state: Equilibrium, z_min: float,
-              max_shift: float = _tol.SQUEEZE_MAX_SHIFT, draws: int = DRAWS) -> bool:
+              max_shift: float = _tol.SQUEEZE_MAX_SHIFT, draws: int = LIBRARY_DRAWS) -> bool:
     """Does the rest state ``state`` of ``robots`` (N, 2, m) survive the perturbations
     (module docstring)? ``z_min``: least object height, m; ``max_shift``: farthest the
     object may move, m (the library's all-taut formations are held to inf: only a lost
@@ -63,9 +61,7 @@ def tolerates(solver: FKSolver, robots: np.ndarray, state: Equilibrium, z_min: f
     rng = np.random.default_rng(SEED)
     n = robots.shape[0]
     for _ in range(draws):
-        r = _tol.POSITION_ACCURACY * np.sqrt(rng.uniform(0, 1, n))
-        a = rng.uniform(0, 2 * np.pi, n)
-        P = robots + np.column_stack([r * np.cos(a), r * np.sin(a)])
+        P = robots + _noise(rng, (n,), _tol.POSITION_ACCURACY, "disc")
         try:
             stable = solver.solve(np.ascontiguousarray(P), check=False).stable
         except TautError:

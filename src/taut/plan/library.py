@@ -13,7 +13,7 @@ import numpy as np
 from . import _tol
 from ..sheet import FKSolver
 from ._squeeze import squeezed_formation
-from ._squeeze_robust import LIBRARY_DRAWS, tolerates
+from ._squeeze_robust import tolerates
 from .certificate import narrowest_cut
 from .formation import MIN_DEPTH_FRACTION, Formation, optimal_formation
 from .result import compact_formation
@@ -44,8 +44,7 @@ def _why_not_crossable(scenario: Scenario, h: float, ids: str) -> str:
     return f"obstacle {ids} ({h:.3g} m tall) cannot be crossed: {why}"
 
 
-def formation_library(scenario: Scenario, sheet_margin: float = 0.0
-                      ) -> tuple[Formation, list[Formation], list[str]]:
+def formation_library(scenario: Scenario, sheet_margin: float = 0.0) -> Library:
     """The compact formation; the others (the narrow one when it differs, and the crossing
     formations, one per obstacle-height class, eqs. 11-15, preferring one that fits the
     widest passage); and why some height classes have none."""
@@ -85,20 +84,16 @@ def formation_library(scenario: Scenario, sheet_margin: float = 0.0
     return compact, crossing, notes
 
 
-def _robust(team, f: Formation, max_shift: float = np.inf) -> bool:
-    """Does ``f``'s rest state survive the robots' position error (a stable state above
-    the ground after each of ``LIBRARY_DRAWS`` seeded errors of up to 5 mm, and for a
-    squeezed formation above the height safety;
-    :func:`~taut.plan._squeeze_robust.tolerates`; and within ``max_shift`` m of where it
-    was: squeezed formations are held to ``SQUEEZE_MAX_SHIFT``)? A formation holding the
-    object with the sheet nearly flat (every pair near its sheet distance) loses it under
-    some."""
+def _robust(team, f: Formation) -> bool:
+    """Does the all-taut formation ``f``'s rest state survive the robots' position error
+    (a stable state above the ground after each of ``LIBRARY_DRAWS`` seeded errors of up to
+    5 mm, :func:`~taut.plan._squeeze_robust.tolerates`)? A formation holding the object
+    with the sheet nearly flat (every pair near its sheet distance) loses it under some.
+    (Squeezed formations pass a stricter form of this check when they are designed.)"""
     solver = FKSolver(team.sheet, team.hold_height)
     fk = solver.solve(np.ascontiguousarray(f.robots, dtype=float)).stable
     e = min(fk, key=lambda e: abs(e.height - f.object_height))
-    floor = 0.0 if f.kind != "squeezed" else team.height_safety
-    return tolerates(solver, np.asarray(f.robots, dtype=float), e, floor,
-                     max_shift=max_shift, draws=LIBRARY_DRAWS)
+    return tolerates(solver, np.asarray(f.robots, dtype=float), e, 0.0, max_shift=np.inf)
 
 
 Library = tuple[Formation, list[Formation], list[str]]
@@ -111,6 +106,12 @@ def _library(scenario: Scenario, sheet_margin: float
     eqs. 11-15 dominate a plan's time; baselines and re-plans reuse them)."""
     compact, others, notes = formation_library(scenario, sheet_margin)
     return compact, tuple(others), tuple(notes)
+
+
+def library(scenario: Scenario, sheet_margin: float) -> Library:
+    """The memoised :func:`formation_library` (fresh lists the caller may extend)."""
+    compact, others, notes = _library(scenario, sheet_margin)
+    return compact, list(others), list(notes)
 
 
 def _min_width(f: Formation) -> float:
@@ -126,9 +127,7 @@ def _squeeze_width(scenario: Scenario, forms: list[Formation], allow_crossing: b
     ``forms`` can cross (the narrowest cut's widest gap, less two clearances and
     ``SQUEEZE_ROOM``), or None when the narrowest formation of ``forms`` already fits
     there (or nothing blocks)."""
-    top = max(f.max_height for f in forms) if allow_crossing else -np.inf
-    blockers = [o for o in scenario.world.obstacles if o.height > top + _tol.GEOMETRY_TOL]
-    cut = narrowest_cut(scenario, blockers)
+    cut = _blocking_cut(scenario, forms, allow_crossing)
     clearance = scenario.team.clearance
     if cut is None or cut[0] >= min(_min_width(f) for f in forms) + 2 * clearance:
         return None
@@ -151,27 +150,32 @@ def _with_squeezed(scenario: Scenario, forms: list[Formation], allow_crossing: b
     f = None if width is None else _squeezed(scenario, sheet_margin, round(width, 6))
     if f is None or _min_width(f) >= min(_min_width(g) for g in forms) - _tol.NARROWER_BY:
         return forms
-    if not _robust(scenario.team, f, _tol.SQUEEZE_MAX_SHIFT):
-        return forms
     return [*forms, f]
+
+
+def _blocking_cut(scenario: Scenario, forms: list[Formation], allow_crossing: bool
+                  ) -> tuple[float, str] | None:
+    """The narrowest cut (its widest gap, m, and obstacle id) through the obstacles no
+    formation of ``forms`` can cross (:func:`~taut.plan.certificate.narrowest_cut`)."""
+    top = max(f.max_height for f in forms) if allow_crossing else -np.inf
+    blockers = [o for o in scenario.world.obstacles if o.height > top + _tol.GEOMETRY_TOL]
+    return narrowest_cut(scenario, blockers)
 
 
 def _diagnosis(scenario: Scenario, forms: list[Formation], allow_crossing: bool) -> str:
     """Why the search likely failed (not a proof): the narrowest passage beside obstacles
     no formation of the library can cross, against what the narrowest formation needs."""
-    top = max(f.max_height for f in forms) if allow_crossing else -np.inf
-    blockers = [o for o in scenario.world.obstacles if o.height > top + _tol.GEOMETRY_TOL]
-    cut = narrowest_cut(scenario, blockers)
+    cut = _blocking_cut(scenario, forms, allow_crossing)
     if cut is None:
         return ""
-    narrowest = min(forms, key=_min_width)
-    need = _min_width(narrowest) + 2 * scenario.team.clearance
+    width = min(_min_width(f) for f in forms)
+    need = width + 2 * scenario.team.clearance
     if cut[0] >= need:
         return ""
     return (f"diagnosis: on the narrowest line through obstacle {cut[1]!r} (which no "
             f"formation of the library can cross) the widest passage is {cut[0]:.3g} m, "
             f"less than the {need:.3g} m the narrowest formation found needs (its width "
-            f"{_min_width(narrowest):.3g} m plus twice the clearance); a narrower formation "
+            f"{width:.3g} m plus twice the clearance); a narrower formation "
             "outside the library is not ruled out")
 
 

@@ -42,8 +42,7 @@ from ._se2_space import PoseChecker
 from ._se2_motion import Piece, sample_pieces
 from .certificate import find_certificate
 from .formation import Formation
-from .library import (Library, _diagnosis, _library, _with_squeezed,
-                      formation_library)
+from .library import Library, _diagnosis, _with_squeezed, formation_library, library
 from .result import PlanResult, _summary, attempt, failure, relabel
 from .route import crossable
 from .verify import verify_motion
@@ -292,8 +291,7 @@ def plan(scenario: Scenario, *, method: Method = "se2",
 def _dispatch(scenario: Scenario, method: str, baseline: object, straight_crossings: bool,
               margin: float, budget: SearchBudget, search: Search) -> PlanResult:
     """:func:`plan` after its options are checked."""
-    cached = _library(scenario, margin)
-    lib: Library = (cached[0], list(cached[1]), list(cached[2]))
+    lib = library(scenario, margin)
     if baseline == "disc":
         return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
                        sheet_margin=margin)
@@ -326,7 +324,6 @@ def _bypass(scenario: Scenario, sheet_margin: float, budget: SearchBudget,
     """The SE(2) bypass search (the baseline, and the crossing planner's last fallback),
     memoised: it is deterministic for a given scenario, margin and sample budget, so the
     fallback and the baseline are one search, run once."""
-    cached = _library(scenario, sheet_margin)
-    lib: Library = (cached[0], list(cached[1]), list(cached[2]))
+    lib = library(scenario, sheet_margin)
     return _se2(scenario, allow_crossing=False, sheet_margin=sheet_margin, budget=budget,
                 planner="se2-bypass", library=lib, search=search)

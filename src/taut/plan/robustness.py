@@ -38,6 +38,7 @@ import shapely
 from ..errors import InvalidInputError, TautError
 from ..sheet import simulate
 from . import _tol
+from .verify import _sheet_slack
 from .world import Scenario
 
 if TYPE_CHECKING:
@@ -90,10 +91,7 @@ def replay(scenario: Scenario, robots: np.ndarray, planned_object: np.ndarray) -
     """Replay robot positions ``robots`` (T, N, 2) (a perturbed plan) from the planned
     object's first state ``planned_object[0]`` (module docstring)."""
     team = scenario.team
-    limits = team.sheet.side_lengths()
-    iu, ju = np.triu_indices(robots.shape[1], 1)
-    ext = float((np.linalg.norm(robots[:, iu] - robots[:, ju], axis=2)
-                 - limits[iu, ju]).max())
+    ext = -_sheet_slack(scenario, robots)[0]
     clear = _clearance(scenario, robots)
     collision = clear < team.robot_radius
     if ext > 0:
@@ -102,8 +100,7 @@ def replay(scenario: Scenario, robots: np.ndarray, planned_object: np.ndarray) -
         sim = simulate(team.sheet, robots, team.hold_height, start=planned_object[0])
     except TautError:             # no rest state at the first sample: counted as a drop
         return Trial(False, True, False, False, collision, ext, np.nan, clear, np.nan)
-    dropped = any(e.kind == "lost" or (e.kind == "jump" and e.drop > _tol.MAX_OBJECT_STEP)
-                  for e in sim.events)
+    dropped = _dropped(sim.events)
     obj = np.asarray(sim.object)
     margin = float(np.nanmin(obj[:, 2] - _beneath(scenario, robots)))
     dev = float(np.nanmax(np.linalg.norm(obj - planned_object, axis=1)))
@@ -170,8 +167,11 @@ def monte_carlo(scenario: Scenario, result: "PlanResult", sigma: float, trials: 
 #: that failed in the suites' Monte Carlo dropped the object in most trials, so a few
 #: draws find them.
 CHANGE_DRAWS = 6
+#: Seed of :func:`change_tolerates`.
+CHANGE_SEED = 20242
 
 
+@functools.lru_cache(maxsize=256)
 def change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str | None:
     """Does the in-place change from ``f`` to ``g`` keep the object under the robots'
     position error? ``CHANGE_DRAWS`` seeded replays of the change (at the origin: the model
@@ -179,17 +179,10 @@ def change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str 
     ``POSITION_ACCURACY`` (:func:`position_error`) and the pair turned by a random heading,
     must neither lose the object nor drop it by more than ``MAX_OBJECT_STEP``. Returns
     None, or why not (memoised per pair)."""
-    return _change_tolerates(scenario, f, g)
-
-
-@functools.lru_cache(maxsize=256)
-def _change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str | None:
     team = scenario.team
     zero = np.zeros(2)
     rng = np.random.default_rng(CHANGE_SEED)
     start = np.array([0.0, 0.0, f.object_height])
-    limits = team.sheet.side_lengths()
-    iu, ju = np.triu_indices(team.n, 1)
     for _ in range(CHANGE_DRAWS):
         # At a random heading: the model is invariant under rotations, but its branch
         # following at a bifurcation is not exactly, and plans change at any heading.
@@ -201,7 +194,7 @@ def _change_tolerates(scenario: Scenario, f: "Formation", g: "Formation") -> str
         robots = a[None] + s[:, None, None] * (b - a)[None]
         times = s * dist / team.speed
         P = robots + position_error(rng, times, team.n, _tol.POSITION_ACCURACY, "disc", 1.0)
-        torn = bool((np.linalg.norm(P[:, iu] - P[:, ju], axis=2) > limits[iu, ju]).any())
+        torn = _sheet_slack(scenario, P)[0] < 0
         if torn or _drops(scenario, P, start):
             return (f"the change from {f.kind} (object at {f.object_height:.3g} m) to "
                     f"{g.kind} ({g.object_height:.3g} m) "
@@ -218,9 +211,10 @@ def _drops(scenario: Scenario, robots: np.ndarray, start: np.ndarray) -> bool:
         sim = simulate(team.sheet, robots, team.hold_height, start=start)
     except TautError:
         return True
+    return _dropped(sim.events)
+
+
+def _dropped(events) -> bool:
+    """Did the simulation lose the object or drop it by more than ``MAX_OBJECT_STEP``?"""
     return any(e.kind == "lost" or (e.kind == "jump" and e.drop > _tol.MAX_OBJECT_STEP)
-               for e in sim.events)
-
-
-#: Seed of :func:`change_tolerates`.
-CHANGE_SEED = 20242
+               for e in events)
