@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import TautError
 from ..sheet import simulate
 from . import _tol
+from ._verify_geometry import pair_closest
 from .formation import Formation
 from .world import Scenario
 
@@ -108,11 +109,7 @@ def _closest_pass(a: np.ndarray, b: np.ndarray) -> tuple[float, int, int]:
     """Least distance between two robots moving straight from ``a`` to ``b`` (N, 2) at
     the same time, m, and which pair: each pair's relative position is linear in time."""
     iu, ju = np.triu_indices(len(a), 1)
-    d0, d1 = a[iu] - a[ju], b[iu] - b[ju]
-    e = d1 - d0
-    ee = (e * e).sum(axis=1)
-    t = np.clip(-(d0 * e).sum(axis=1) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
-    gap = np.linalg.norm(d0 + t[:, None] * e, axis=1)
+    gap = pair_closest(a, b)
     k = int(np.argmin(gap))
     return float(gap[k]), int(iu[k]), int(ju[k])
 

@@ -177,9 +177,7 @@ class _Motion:
         a, b = robots[:-1], robots[1:]
         ca, cb = a.mean(axis=1), b.mean(axis=1)
         rel = a - ca[:, None]
-        h = np.einsum("kni,knj->kij", rel, b - cb[:, None])
-        self.angle = np.arctan2(h[:, 0, 1] - h[:, 1, 0], h[:, 0, 0] + h[:, 1, 1])
-        fit = _turn(rel, self.angle) + cb[:, None]
+        self.angle, fit = rigid_fits(a, b)
         resid = np.linalg.norm(fit - b, axis=2).max(axis=1)
         turn = np.linalg.norm(cb - ca, axis=1) + (np.linalg.norm(rel, axis=2).max(axis=1)
                                                   * np.abs(self.angle)) + resid
@@ -204,6 +202,28 @@ class _Motion:
         turned = _turn(a - c, u * self.angle[k]) + c + (u[:, None] * self.move[k])[:, None]
         lin = a + u[:, None, None] * (b - a)
         return np.where(self.rigid[k][:, None, None], turned, lin)
+
+
+def rigid_fits(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Best rigid motions (Kabsch without reflection) mapping each ``a[k]`` (K, N, 2) onto
+    ``b[k]``: their angles (K,), rad, and ``a`` so moved (K, N, 2)."""
+    ca, cb = a.mean(axis=1, keepdims=True), b.mean(axis=1, keepdims=True)
+    rel = a - ca
+    h = np.einsum("kni,knj->kij", rel, b - cb)
+    angle = np.arctan2(h[:, 0, 1] - h[:, 1, 0], h[:, 0, 0] + h[:, 1, 1])
+    return angle, _turn(rel, angle) + cb
+
+
+def pair_closest(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Least distance of every robot pair (``triu_indices`` order) while the robots move
+    straight from ``a`` to ``b`` (..., N, 2) at the same time, m (..., P): a pair's
+    relative position is linear in time, so the least distance has a closed form."""
+    iu, ju = np.triu_indices(a.shape[-2], 1)
+    d0 = a[..., iu, :] - a[..., ju, :]
+    e = (b[..., iu, :] - b[..., ju, :]) - d0
+    ee = (e * e).sum(axis=-1)
+    t = np.clip(-(d0 * e).sum(axis=-1) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+    return np.linalg.norm(d0 + t[..., None] * e, axis=-1)
 
 
 def _turn(rel: np.ndarray, angle: np.ndarray) -> np.ndarray:

@@ -51,7 +51,7 @@ from .._outcome import check_status, deprecated_alias
 from ..errors import InvalidInputError, TautError
 from ..sheet import check_formations, forward_kinematics, simulate
 from . import _tol
-from ._verify_geometry import Shapes, prove_between, shapes_of
+from ._verify_geometry import Shapes, pair_closest, prove_between, rigid_fits, shapes_of
 from .world import Scenario
 from .._validate import MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance, require_nonempty
 
@@ -124,14 +124,8 @@ def _rigid_mask(robots: np.ndarray, tol: float) -> np.ndarray:
     """Bool (T-1,): sample pairs related by a rigid motion of the plane (a rotation and a
     translation: the best such fit, Kabsch without reflection, leaves every robot within
     ``tol``; equal pair distances alone would also admit a mirror image)."""
-    a, b = robots[:-1], robots[1:]
-    ca, cb = a.mean(axis=1, keepdims=True), b.mean(axis=1, keepdims=True)
-    h = np.einsum("tni,tnj->tij", a - ca, b - cb)
-    ang = np.arctan2(h[:, 0, 1] - h[:, 1, 0], h[:, 0, 0] + h[:, 1, 1])
-    c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]
-    x, y = (a - ca)[..., 0], (a - ca)[..., 1]
-    fit = np.stack([c * x - s * y, s * x + c * y], axis=-1) + cb
-    return np.abs(fit - b).max(axis=(1, 2)) <= tol
+    _, fit = rigid_fits(robots[:-1], robots[1:])
+    return np.abs(fit - robots[1:]).max(axis=(1, 2)) <= tol
 
 
 def _follow_rigid(obj: np.ndarray, robots: np.ndarray, t: int) -> np.ndarray:
@@ -173,9 +167,10 @@ def _simulate_run(scenario: Scenario, robots: np.ndarray, start: np.ndarray,
 
 
 def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
-                  max_step: float):
-    """Rest state along the motion (module docstring, check 2): (object, taut sets,
-    largest object step, message or None, lowest object height per interval, m)."""
+                  max_step: float, rigid: np.ndarray):
+    """Rest state along the motion (module docstring, check 2) with the rigid intervals
+    ``rigid`` (T-1,) carried rigidly: (object, taut sets, largest object step, message or
+    None, lowest object height per interval, m)."""
     team = scenario.team
     size = team.sheet.size
     T = len(robots)
@@ -189,7 +184,6 @@ def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
     obj = np.full((T, 3), np.nan)
     taut: list[tuple[int, ...]] = [()] * T
     obj[0], taut[0] = e0.object, e0.taut
-    rigid = _rigid_mask(robots, _tol.RIGID_RTOL * size * 10)
     low = np.full(T - 1, np.nan)
     worst = 0.0
     t = 0
@@ -261,13 +255,11 @@ def _least_gap(robots: np.ndarray, rigid: np.ndarray) -> float:
     so a pair's relative position is linear in time and its least distance has a closed
     form."""
     iu, ju = np.triu_indices(robots.shape[1], 1)
-    d = robots[:, iu] - robots[:, ju]                    # (T, P, 2)
-    if len(d) < 2:
-        return float(np.linalg.norm(d, axis=2).min())
-    a, e = d[:-1], np.where(rigid[:, None, None], 0.0, d[1:] - d[:-1])
-    ee = (e * e).sum(axis=2)
-    t = np.clip(-(a * e).sum(axis=2) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
-    return float(np.linalg.norm(a + t[..., None] * e, axis=2).min())
+    kept = np.linalg.norm(robots[:, iu] - robots[:, ju], axis=2)     # (T, P)
+    if len(robots) < 2:
+        return float(kept.min())
+    moving = pair_closest(robots[:-1], robots[1:])
+    return float(np.where(rigid[:, None], kept[:-1], moving).min())
 
 
 def _sheet_slack(scenario: Scenario, robots: np.ndarray) -> tuple[float, int, int, int]:
@@ -326,12 +318,13 @@ def verify_motion(scenario: Scenario, robots: ArrayLike, planned_object: ArrayLi
     if slack < sheet_margin - TOLERANCE:
         return fail(f"robots {i + 1} and {j + 1} only {slack:.3g} m inside their sheet "
                     f"distance at sample {ts} (sheet margin {sheet_margin:.3g} m)", slack=slack)
-    gap = _least_gap(robots, _rigid_mask(robots, _tol.RIGID_RTOL * team.sheet.size * 10))
+    rigid = _rigid_mask(robots, _tol.RIGID_RTOL * team.sheet.size * 10)
+    gap = _least_gap(robots, rigid)
     if gap < 2 * team.robot_radius - TOLERANCE:
         return fail(f"robots overlap (centres {gap:.3g} m apart)", slack=slack)
     try:
         obj, taut, step, why, low = _model_states(scenario, robots, planned,
-                                                  max_object_step)
+                                                  max_object_step, rigid)
     except TautError as exc:
         return fail(f"simulation failed: {exc}", slack=slack)
     if why is not None:
@@ -340,7 +333,6 @@ def verify_motion(scenario: Scenario, robots: ArrayLike, planned_object: ArrayLi
     margin, clear, why = _geometry(scenario, robots, obj, shapes)
     if why is not None:
         return fail(why, obj, taut, slack)
-    rigid = _rigid_mask(robots, _tol.RIGID_RTOL * team.sheet.size * 10)   # as _model_states
     margin2, clear2, why = prove_between(scenario, robots, low, rigid, max_object_step, shapes)
     if why is not None:
         return fail(why, obj, taut, slack)
