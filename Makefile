@@ -30,7 +30,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/bench_fk.py
 
 # numba's cache notices edits to a kernel's own file only, not to kernels it calls from
-# other files (src/taut/sheet/_jit.py): after editing a kernel, drop the cached code.
+# other files (src/taut/_jit.py): after editing a kernel, drop the cached code.
 clean-cache:
 	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from taut.cdpr import (ModelErrors, TorqueController, VelocityController, monte_carlo,
                        pick_and_place, simulate, with_stabilisers)
-from taut.cdpr.sim import _loop_numba, _prepare
+from taut.cdpr.control.simulate import _loop_numba, _prepare
 from taut.io.cdpr_model import load_cdpr_model
 
 WAYPOINTS = [[-1.5, 0.0, 0.6], [-1.5, 0.0, 1.1], [1.5, 0.0, 1.1], [1.5, 0.0, 0.6]]

@@ -1,4 +1,4 @@
-"""Benchmark of the mobile-CDPR motion analyses (taut.cdpr.twist / redundancy / deploy) on
+"""Benchmark of the mobile-CDPR motion analyses (taut.cdpr.sets.twist / redundancy / deploy) on
 the FASTKIT preset.
 
 Measures, in one run on this machine:

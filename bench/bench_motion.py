@@ -25,7 +25,7 @@ import numpy as np
 from taut.io.trajectory import load_trajectory
 from taut.sheet import Sheet, forward_kinematics
 from taut.sheet import inverse_kinematics
-from taut.sheet._ik_certificate import verify_certificate
+from taut.sheet.ik._certificate import verify_certificate
 from taut.sheet import random_team
 from taut.sheet import simulate
 

@@ -53,7 +53,8 @@ def timed(fn, *args, **kw):
     """Run ``fn`` from cold memo caches (the formation library and the memoised bypass
     search are shared between the planner and its baseline; each timed call pays for its
     own), and time it."""
-    from taut.plan import library, planner
+    from taut.plan.formations import library
+    from taut.plan import planner
     library._library.cache_clear()
     library._squeezed.cache_clear()
     planner._bypass.cache_clear()

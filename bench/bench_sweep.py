@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from taut.io import load_sheet_scenario
-from taut.io.sweep_file import sweep_from_mapping
+from taut.sweep.file import sweep_from_mapping
 from taut.sheet import forward_kinematics_batch
 from taut.sweep import run_sweep
 from taut.sweep.points import chunk_bounds, expand, point_seeds

@@ -67,7 +67,7 @@ def fixtures() -> dict[str, Any]:
     sheet = Sheet.regular(4, 1.0)
     formation = 0.8 * np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
     limits = fastkit_motion_limits()
-    from taut.io.sweep_file import load_sweep
+    from taut.sweep.file import load_sweep
     spec = load_sweep(str(ROOT / "examples/sweeps/octagon_stability_small.yaml"))
     return dict(
         robot=robot, pose=pose, state=state, scenario=scenario, nominal=nominal,

@@ -11,8 +11,8 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "taut"
 CORES = ("sheet", "plan", "cdpr", "physics")
 #: Small float literals that are not thresholds: (file, value) -> reason.
 NOT_THRESHOLDS = {
-    ("cdpr/dynamics_model.py", 4.5e-5): "motor rotor inertia, kg m^2 (a physical parameter)",
-    ("cdpr/dynamics_model.py", 2e-5): "viscous friction coefficient (a physical parameter)",
+    ("cdpr/control/dynamics.py", 4.5e-5): "motor rotor inertia, kg m^2 (a physical parameter)",
+    ("cdpr/control/dynamics.py", 2e-5): "viscous friction coefficient (a physical parameter)",
 }
 
 

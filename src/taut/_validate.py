@@ -226,7 +226,7 @@ def as_box(value: Any, field: str, *, limit: float = MAX_CDPR_LENGTH_M, unit: st
 
 
 def _type_name(cls: type) -> str:
-    """``taut.cdpr.model.CableRobot`` -> ``taut.cdpr.model.CableRobot`` (private modules'
+    """``taut.cdpr.model.robot.CableRobot`` -> ``taut.cdpr.model.robot.CableRobot`` (private modules'
     leading underscores dropped), builtins by their bare name."""
     if cls.__module__ == "builtins":
         return cls.__name__

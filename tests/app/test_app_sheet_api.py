@@ -14,7 +14,8 @@ from taut.cli import main
 from taut.errors import InfeasibleFormationError, TautError
 from taut.io import load_sheet_scenario
 from taut.io.trajectory import load_trajectory
-from taut.sheet import forward_kinematics, simulate
+from taut.sheet import forward_kinematics
+from taut.sheet import simulate
 
 ROOT = Path(__file__).parents[2]
 EX2 = ROOT / "examples" / "sheet" / "example2_r2_r4_353mm.yaml"

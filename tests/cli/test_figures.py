@@ -12,7 +12,8 @@ matplotlib = pytest.importorskip("matplotlib")
 
 from taut.io.sheet_scenario import load_sheet_scenario  # noqa: E402
 from taut.io.trajectory import load_trajectory  # noqa: E402
-from taut.sheet import forward_kinematics, simulate  # noqa: E402
+from taut.sheet import forward_kinematics  # noqa: E402
+from taut.sheet import simulate  # noqa: E402
 
 ROOT = Path(__file__).parents[2]
 

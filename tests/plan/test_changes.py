@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from taut.plan import verify_motion
-from taut.plan._se2_motion import change_profile
-from taut.plan.library import _library
+from taut.plan.se2.motion import change_profile
+from taut.plan.formations.library import _library
 
 from .test_plan import corridor
 
@@ -47,7 +47,7 @@ def test_rigid_turns_keep_touching_footprints_apart():
 
 def test_a_benign_change_tolerates_position_error():
     from taut.io import load_plan_scenario
-    from taut.plan.robustness import change_tolerates
+    from taut.plan.checks.robustness import change_tolerates
     from .test_plan import EXAMPLES
     sc = load_plan_scenario(EXAMPLES / "paper_corridor.yaml")
     compact, others, _ = _library(sc, 0.01)
@@ -61,8 +61,8 @@ def test_fragile_changes_are_refused_and_the_plan_survives_its_monte_carlo():
     move robots up to 0.75 m in place and drop the object under 5 mm of drifting robot
     error; the planner refuses them and its plan keeps the object in every trial."""
     from taut.plan import generate_scenario, plan
-    from taut.plan.library import _with_squeezed
-    from taut.plan.robustness import change_tolerates
+    from taut.plan.formations.library import _with_squeezed
+    from taut.plan.checks.robustness import change_tolerates
     sc = generate_scenario(5027, 6)
     compact, others, _ = _library(sc, 0.01)
     forms = _with_squeezed(sc, [compact, *others], True, 0.01)
@@ -84,7 +84,7 @@ def test_a_change_that_brings_the_object_below_the_height_safety_is_refused():
     and its squeezed one the object dips to 0.038 m; the verifier would refuse a plan with
     that change, so the planner must not use it (it found one that did, before)."""
     from taut.plan import generate_scenario, plan
-    from taut.plan.library import _with_squeezed
+    from taut.plan.formations.library import _with_squeezed
     sc = generate_scenario(5057, 6)
     compact, others, _ = _library(sc, 0.01)
     squeezed = _with_squeezed(sc, [compact, *others], True, 0.01)[-1]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import yaml
 
-import taut.plan._formation_problem as problem
+import taut.plan.formations._problem as problem
 from taut.cli import main
 from taut.errors import InvalidInputError, PlanningError, ScenarioError
 from taut.io.plan_scenario import plan_scenario_from_mapping
@@ -117,7 +117,7 @@ def test_budget_exhaustion_diagnoses_a_passage_too_narrow():
     # less the clearance, so the message says so, without claiming impossibility.
     import re
     from taut.plan import Obstacle
-    from taut.plan.library import _library, _min_width, _with_squeezed
+    from taut.plan.formations.library import _library, _min_width, _with_squeezed
     sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
     r = plan(sc, iterations=40)
     assert r.status == "budget_exhausted" and r.certificate is None

@@ -2,7 +2,7 @@
 
 import pytest
 
-from taut.io.sweep_file import load_sweep
+from taut.sweep.file import load_sweep
 from taut.sweep import TASKS
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from taut.errors import SweepError
-from taut.io.sweep_results import read_results
+from taut.sweep.results import read_results
 from taut.sweep import run_sweep
 
 

@@ -61,7 +61,7 @@ def test_jitter_is_seeded_per_point(fk_spec):
 def test_cdpr_workspace_row_equals_the_workspace_analysis():
     from taut.cdpr import grid_points, wrench_feasible_workspace
     from taut.io import load_cdpr_model
-    from taut.io.sweep_file import sweep_from_mapping
+    from taut.sweep.file import sweep_from_mapping
 
     spec = sweep_from_mapping({"task": "cdpr_workspace", "base": "fastkit",
                                "options": {"grid": [6, 1, 4]},
@@ -76,7 +76,7 @@ def test_cdpr_workspace_row_equals_the_workspace_analysis():
 
 
 def test_cdpr_invalid_variant_is_a_row_with_its_reason():
-    from taut.io.sweep_file import sweep_from_mapping
+    from taut.sweep.file import sweep_from_mapping
 
     spec = sweep_from_mapping({"task": "cdpr_workspace", "base": "fastkit",
                                "options": {"grid": [3, 1, 2]},

@@ -5,7 +5,7 @@ and the scenario as a YAML file ``taut fk`` reads back.
 Every function takes the decoded JSON body (a dict) and returns a JSON-ready dict; bad
 input raises :class:`taut.errors.TautError`. All physics is the library's:
 :func:`taut.sheet.forward_kinematics`, :func:`taut.sheet.inverse_kinematics`,
-:func:`taut.sheet.simulate`. Lengths are in the scenario's unit, masses kg, tensions N.
+:func:`taut.sheet.sim.simulate`. Lengths are in the scenario's unit, masses kg, tensions N.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ from ..io.serialize import ik_to_dict, simulation_to_dict
 from ..errors import InfeasibleFormationError, InvalidInputError
 from ..io import SheetScenario, sheet_scenario_from_mapping
 from ..io.serialize import equilibrium_to_dict
-from ..sheet import Sheet, forward_kinematics, inverse_kinematics, simulate
+from ..sheet import Sheet, forward_kinematics, inverse_kinematics
+from ..sheet import simulate
 from .catalog import Catalog, regular_team
 from .payload import ModelCache, field, mapping_from_upload
 

@@ -9,22 +9,23 @@ All quantities are SI (m, kg, N, rad), float64; batched functions take a leading
 poses ``(x, y, z, roll, pitch, yaw)``.
 """
 
-from .kinematics import (CableState, as_poses, cable_state, gravity_wrench,
-                         rotation_matrices, tipping_matrix, wrench_matrix)
-from .model import Base, Cable, CableRobot, Payload, Platform, check_footprint, with_stabilisers
-from .tension import METHODS, TensionResult, distribute_tensions
-from .tipping import TippingResult, tipping_moments
-from .deploy import DeploymentResult, plan_deployment
-from .lift import LiftBound, lift_bound, upward_force_bound
-from .placement import place_bases, workspace_box
-from .tallest import TallestWorkspace, tallest_workspace
-from .redundancy import OBJECTIVES, RedundancyResult, resolve_redundancy
-from .twist import AvailableTwistSet, TwistCapacities, available_twist_set, twist_capacities
-from .first_order import FirstOrderModel, first_order_model
-from .motion_modes import MODES, TWIST_LABELS, MotionLimits, fastkit_motion_limits
-from .workspace import WorkspaceResult, grid_points, wrench_feasible_workspace
-from .wrench_set import (AXIS_LABELS, AvailableWrenchSet, AxisCapacities, available_wrench_set,
-                         axis_capacities, capacity_margin, disturbance_box, wrench_feasible)
+from .kinematics.cables import (CableState, as_poses, cable_state, gravity_wrench,
+    rotation_matrices, tipping_matrix, wrench_matrix)
+from .model.robot import (Base, Cable, CableRobot, Payload, Platform, check_footprint,
+    with_stabilisers)
+from .statics.tension import METHODS, TensionResult, distribute_tensions
+from .statics.tipping import TippingResult, tipping_moments
+from .deployment.deploy import DeploymentResult, plan_deployment
+from .deployment.lift import LiftBound, lift_bound, upward_force_bound
+from .deployment.placement import place_bases, workspace_box
+from .deployment.tallest import TallestWorkspace, tallest_workspace
+from .deployment.redundancy import OBJECTIVES, RedundancyResult, resolve_redundancy
+from .sets.twist import AvailableTwistSet, TwistCapacities, available_twist_set, twist_capacities
+from .kinematics.first_order import FirstOrderModel, first_order_model
+from .kinematics.modes import MODES, TWIST_LABELS, MotionLimits, fastkit_motion_limits
+from .workspace.wrench_feasible import WorkspaceResult, grid_points, wrench_feasible_workspace
+from .sets.wrench import (AXIS_LABELS, AvailableWrenchSet, AxisCapacities, available_wrench_set,
+    axis_capacities, capacity_margin, disturbance_box, wrench_feasible)
 
 __all__ = [
     "Base", "Cable", "CableRobot", "Payload", "Platform", "check_footprint", "with_stabilisers",
@@ -44,15 +45,15 @@ __all__ = [
 ]
 
 # Re-exports of every name the submodules' __all__ list (one public import path: taut.cdpr).
-from .deploy import DeploymentOptions, evaluate_deployment  # noqa: E402
-from .first_order import base_jacobians, parallel_jacobian  # noqa: E402
-from .motion_modes import BASE_JOINTS, Mode, ModeName, joint_bounds, resolve_mode  # noqa: E402
-from .placement import footprint_overlap  # noqa: E402
-from .polytope import HPolytopeBatch, lp_max_step  # noqa: E402
-from .tension import QPSolver, TensionMethod  # noqa: E402
-from .twist import support  # noqa: E402
-from .wrench_set import external_wrench_box  # noqa: E402
-from .zonotope import zonotope_hrep  # noqa: E402
+from .deployment.deploy import DeploymentOptions, evaluate_deployment  # noqa: E402
+from .kinematics.first_order import base_jacobians, parallel_jacobian  # noqa: E402
+from .kinematics.modes import BASE_JOINTS, Mode, ModeName, joint_bounds, resolve_mode  # noqa: E402
+from .deployment.placement import footprint_overlap  # noqa: E402
+from .sets.polytope import HPolytopeBatch, lp_max_step  # noqa: E402
+from .statics.tension import QPSolver, TensionMethod  # noqa: E402
+from .sets.twist import support  # noqa: E402
+from .sets.wrench import external_wrench_box  # noqa: E402
+from .sets.zonotope import zonotope_hrep  # noqa: E402
 
 __all__ += [
     "DeploymentOptions", "evaluate_deployment", "base_jacobians", "parallel_jacobian",
@@ -61,27 +62,27 @@ __all__ += [
     "external_wrench_box", "zonotope_hrep",
 ]
 
-from .model import with_friction  # noqa: E402
-from .sliding import sliding_rows  # noqa: E402
+from .model.robot import with_friction  # noqa: E402
+from .statics.sliding import sliding_rows  # noqa: E402
 
 __all__ += ["with_friction", "sliding_rows"]
 
-from .closure import wrench_closure  # noqa: E402
+from .sets.closure import wrench_closure  # noqa: E402
 
 __all__ += ["wrench_closure"]
 
-from .interference import Interference, cable_interference, segment_distance  # noqa: E402
+from .kinematics.interference import (Interference, cable_interference, segment_distance)  # noqa: E402
 
 __all__ += ["Interference", "cable_interference", "segment_distance"]
 
 # Moving robot: forward kinematics, elastic cables and winches, control simulation (issue 13).
-from .cable_fk import CableFKResult, cable_forward_kinematics
-from .dynamics_model import DynamicsModel
-from .model_errors import ModelErrors
-from .references import Reference, pick_and_place, reference_from_samples
-from .controllers import CONTROLLERS, Controller, TorqueController, VelocityController
-from .monitors import ControlEvent
-from .sim import BaseMotion, ControlResult, MonteCarloResult, monte_carlo, simulate
+from .kinematics.forward import CableFKResult, cable_forward_kinematics
+from .control.dynamics import DynamicsModel
+from .control.model_errors import ModelErrors
+from .control.references import Reference, pick_and_place, reference_from_samples
+from .control.controllers import CONTROLLERS, Controller, TorqueController, VelocityController
+from .control.monitors import ControlEvent
+from .control.simulate import BaseMotion, ControlResult, MonteCarloResult, monte_carlo, simulate
 
 __all__ += [
     "CableFKResult", "cable_forward_kinematics", "DynamicsModel", "ModelErrors", "Reference",
@@ -90,9 +91,9 @@ __all__ += [
     "monte_carlo", "simulate",
 ]
 
-from .base_motion import (MovingDeploymentResult, plan_moving_deployment,  # noqa: E402
-                          staged_lift_bound)
-from .exit_box import platform_inside_exits  # noqa: E402
+from .deployment.moving_base import (MovingDeploymentResult, plan_moving_deployment,
+    staged_lift_bound)
+from .workspace.exit_box import platform_inside_exits  # noqa: E402
 
 __all__ += ["MovingDeploymentResult", "plan_moving_deployment", "staged_lift_bound",
             "platform_inside_exits"]

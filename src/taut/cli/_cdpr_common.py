@@ -11,7 +11,7 @@ from .._validate import MAX_CDPR_LENGTH_M, MAX_MASS_KG, MAX_SPEED, check_range
 from ..errors import InvalidModelError
 
 if TYPE_CHECKING:
-    from ..cdpr.model import CableRobot
+    from ..cdpr.model.robot import CableRobot
 
 Vec3 = tuple[float, float, float]
 Vec6 = tuple[float, float, float, float, float, float]

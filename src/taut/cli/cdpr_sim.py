@@ -21,7 +21,7 @@ from ._cdpr_common import load_robot
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
 
-#: Controllers the command offers (taut.cdpr.controllers.CONTROLLERS, without importing it).
+#: Controllers the command offers (taut.cdpr.control.controllers.CONTROLLERS, without importing it).
 _CONTROLLERS = ("velocity", "torque")
 
 __all__ = ["add_simulate"]
@@ -89,7 +89,7 @@ def add_simulate(sub: typer.Typer) -> None:
         output_path(plot, "--plot", FIGURE_SUFFIXES)
         output_path(animate, "--animate", ANIMATION_SUFFIXES)
         from ..cdpr import ModelErrors, pick_and_place
-        from ..cdpr.controllers import CONTROLLERS
+        from ..cdpr.control.controllers import CONTROLLERS
         from ..io.cdpr_dynamics import load_cdpr_dynamics
         from ..io.cdpr_reference import read_reference_csv
         from ..io.files import write_json

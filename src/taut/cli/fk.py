@@ -15,7 +15,7 @@ from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 
 if TYPE_CHECKING:
-    from ..sheet.results import FKResult
+    from ..sheet.fk.results import FKResult
 
 #: Largest team the ``subsets`` method accepts: it tries every set of <= 5 cables, so its
 #: work grows as N**5 (N = 40: 760 000 systems, about a minute on one core).

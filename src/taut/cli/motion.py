@@ -16,8 +16,8 @@ from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 
 if TYPE_CHECKING:
-    from ..sheet.ik import IKResult
-    from ..sheet.simulate import SimulationResult
+    from ..sheet.ik.inverse import IKResult
+    from ..sheet.sim.simulate import SimulationResult
 
 
 def _ik_table(r: "IKResult", units: str | None) -> str:
@@ -76,7 +76,7 @@ def register(app: typer.Typer) -> None:
         """Inverse kinematics: where the robots must stand so that the object rests
         stably at the target with every cable taut."""
         from ..io.sheet_scenario import load_sheet_scenario
-        from ..sheet.ik import inverse_kinematics
+        from ..sheet.ik.inverse import inverse_kinematics
 
         check_range(object_position, "--object", MAX_SHEET_LENGTH, "scenario units")
         if contact is not None:
@@ -109,7 +109,7 @@ def register(app: typer.Typer) -> None:
         """Quasi-static simulation of the object while the robots follow a trajectory."""
         from ..io.sheet_scenario import load_sheet_scenario
         from ..io.trajectory import load_trajectory
-        from ..sheet.simulate import simulate
+        from ..sheet.sim.simulate import simulate
 
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
         m = as_mass(mass, "--mass") if mass is not None else None

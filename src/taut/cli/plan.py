@@ -148,7 +148,7 @@ def _check_options(budget: float | None, sheet_margin: float, seed: int, iterati
 
 def _check_search(search: str) -> None:
     """``--search`` names a known search whose library is installed."""
-    from ..plan._ompl import engine
+    from ..plan.se2._ompl import engine
     try:
         engine(search)
     except InvalidInputError as exc:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cdpr.model import Base, Cable, CableRobot, Platform
+from ..cdpr.model.robot import Base, Cable, CableRobot, Platform
 from ..errors import ScenarioError
 
 __all__ = ["load_caspr_model"]

@@ -15,7 +15,7 @@ from typing import Any, Optional
 
 from pydantic import BaseModel, ConfigDict
 
-from ..cdpr.dynamics_model import DynamicsModel
+from ..cdpr.control.dynamics import DynamicsModel
 from .cdpr_model import preset_path
 from .files import read_mapping, validate_mapping
 

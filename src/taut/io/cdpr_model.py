@@ -25,7 +25,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from ..cdpr.model import Base, Cable, CableRobot, Payload, Platform
+from ..cdpr.model.robot import Base, Cable, CableRobot, Payload, Platform
 from ..errors import InvalidModelError, ScenarioError, TautError
 from .files import read_mapping, validate_mapping
 from .._validate import as_path

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cdpr.model import CableRobot
-from ..cdpr.references import Reference, reference_from_samples
+from ..cdpr.model.robot import CableRobot
+from ..cdpr.control.references import Reference, reference_from_samples
 from ..errors import ScenarioError
 from .files import read_text
 

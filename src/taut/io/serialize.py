@@ -17,16 +17,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:                                  # imported lazily: keep `taut --help` fast
-    from ..cdpr.deploy import DeploymentResult
-    from ..cdpr.model import CableRobot
-    from ..cdpr.sim import ControlResult, MonteCarloResult
-    from ..cdpr.tension import TensionResult
-    from ..cdpr.twist import TwistCapacities
-    from ..cdpr.workspace import WorkspaceResult
+    from ..cdpr.deployment.deploy import DeploymentResult
+    from ..cdpr.model.robot import CableRobot
+    from ..cdpr.control.simulate import ControlResult, MonteCarloResult
+    from ..cdpr.statics.tension import TensionResult
+    from ..cdpr.sets.twist import TwistCapacities
+    from ..cdpr.workspace.wrench_feasible import WorkspaceResult
     from ..plan.result import PlanResult, Robustness
-    from ..sheet.ik import IKResult
-    from ..sheet.results import Equilibrium, FKResult
-    from ..sheet.simulate import SimulationResult
+    from ..sheet.ik.inverse import IKResult
+    from ..sheet.fk.results import Equilibrium, FKResult
+    from ..sheet.sim.simulate import SimulationResult
 
 __all__ = ["to_json", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dict",
            "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",

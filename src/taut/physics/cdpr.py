@@ -21,7 +21,7 @@ from .._outcome import check_status
 from .._validate import MAX_DURATION_S, as_array, as_bounded, as_positive
 from ..cdpr import (CableRobot, TensionMethod, distribute_tensions, rotation_matrices,
                     tipping_moments)
-from ..cdpr.kinematics import as_poses
+from ..cdpr.kinematics.cables import as_poses
 from ..errors import InvalidInputError
 from . import _tol
 

@@ -5,15 +5,15 @@ bypass-only baselines, certificates of impossibility, an SE(2) search over a for
 library and a seeded scenario suite."""
 
 from .baseline import plan_baseline
-from .crossing import CrossingRecord, Motion, motion_from_legs
-from .formation import (CostWeights, Formation, crossing_pairs, offset_crossings,
-                        optimal_formation)
-from .certificate import Certificate, find_certificate
+from .roadmap.crossing import CrossingRecord, Motion, motion_from_legs
+from .formations.optimal import (CostWeights, Formation, crossing_pairs, offset_crossings,
+    optimal_formation)
+from .checks.certificate import Certificate, find_certificate
 from .planner import formation_library, plan
 from .result import PlanResult, Robustness
-from .route import Leg, Route, find_route
+from .roadmap.route import Leg, Route, find_route
 from .suite import generate_scenario, generate_suite
-from .verify import Verification, resample_motion, verify_motion
+from .checks.verify import Verification, resample_motion, verify_motion
 from .world import Obstacle, Scenario, Team, UnknownObstacleError, World
 
 __all__ = [

@@ -25,7 +25,7 @@ POSITION_ACCURACY = 0.005
 #: Default largest object step between verification samples, m ("a few mm").
 MAX_OBJECT_STEP = 0.005
 #: Clearance to spare at every pose of a motion the SE(2) search accepts, m: the motion
-#: check (conservative advancement, :mod:`taut.plan._se2_kernel`) proves every pose of the
+#: check (conservative advancement, :mod:`taut.plan._kernels.clearance`) proves every pose of the
 #: continuous motion keeps the rules by at least this much; far below the robots'
 #: position accuracy, above round-off of the distances.
 MOTION_MARGIN = 1e-3
@@ -84,7 +84,7 @@ INSCRIBED_CIRCLE_RTOL = 1e-3
 #: passage the compact one cannot pass and only adds a formation to search with.
 NARROWER_BY = 0.01
 #: Most bisections of one sample interval when proving the geometric rules between samples
-#: (:mod:`taut.plan._verify_geometry`), a count: a piece is proved when its ends' slacks
+#: (:mod:`taut.plan.checks._geometry`), a count: a piece is proved when its ends' slacks
 #: (m, the tolerance ``GEOMETRY_TOL`` included) add up to its robot travel, so an interval
 #: of ``SAMPLE_STEP`` still unproved after 16 halvings (pieces of 0.3 um) comes within
 #: 0.3 um of breaking a rule even with the tolerance: it is refused as unproved.
@@ -94,7 +94,7 @@ PROOF_DEPTH = 16
 #: (~40 us a pose). A plan keeping 1 mm of slack needs about 20 poses per 2 cm interval
 #: where it keeps so little; one needing more keeps micrometres over a long stretch.
 MAX_PROOF_POSES = 50_000
-#: Squeezed formations (:mod:`taut.plan._squeeze`): the object rests at least this much
+#: Squeezed formations (:mod:`taut.plan.formations.squeezed`): the object rests at least this much
 #: above the ground safety height ``team.height_safety``, m, so that the robots' position
 #: error (``POSITION_ACCURACY``) does not lower it under the safety height at once.
 SQUEEZE_HEIGHT_MARGIN = 5e-3
@@ -129,7 +129,7 @@ CLEARANCE_ACCURACY = 1e-7
 #: some room to find a way through, and robots some room for their position error.
 SQUEEZE_ROOM = 0.06
 #: Farthest the object of a squeezed formation may move when every robot is off by up to
-#: ``POSITION_ACCURACY``, m (:mod:`taut.plan._squeeze_robust`: about the 90th percentile of
+#: ``POSITION_ACCURACY``, m (:mod:`taut.plan.formations._squeeze_robust`: about the 90th percentile of
 #: what the all-taut formations of the seed-2024 suite move).
 SQUEEZE_MAX_SHIFT = 0.05
 #: Weight of the time spent in a squeezed formation in the lattice search's cost (1: none):

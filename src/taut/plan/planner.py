@@ -4,18 +4,18 @@ Methods (one private module each):
 
 ``"se2"`` (default)
     The team is a rigid body in SE(2) per formation of a small library
-    (:mod:`taut.plan.library`: the compact one, the narrow one, per obstacle-height class
+    (:mod:`taut.plan.formations.library`: the compact one, the narrow one, per obstacle-height class
     the optimal crossing formation of eqs. 11-15, and a squeezed one where passages are
-    too narrow for all of them). The lattice search (:mod:`taut.plan._lattice`) searches
+    too narrow for all of them). The lattice search (:mod:`taut.plan.se2._lattice`) searches
     every formation at once with any number of in-place formation changes; where it finds
     nothing, a seeded RRT-Connect searches each formation and pairs with one change
-    (:mod:`taut.plan._se2`), or OMPL does (``search=``). Low obstacles pass under the sheet
+    (:mod:`taut.plan.se2.search`), or OMPL does (``search=``). Low obstacles pass under the sheet
     between any two robots at any heading. When no SE(2) candidate verifies, the
     disc-model roadmap plan and the SE(2) bypass baseline are tried too, so the planner
     succeeds wherever either baseline does. Failures carry a certificate (status
     ``refuted``) or say the budget ran out (``budget_exhausted``).
 ``"roadmap"``
-    The disc-model roadmap of :func:`~taut.plan.route.find_route` with Algorithm 2 and
+    The disc-model roadmap of :func:`~taut.plan.roadmap.route.find_route` with Algorithm 2 and
     straight offset crossings (the planner of issue 4).
 ``"algorithm2"``
     The same roadmap with the paper's Algorithm 2 only (paper-faithful mode).
@@ -35,17 +35,17 @@ import numpy as np
 from .._validate import as_count
 from ..errors import InvalidInputError
 from . import _tol
-from ._ompl import Search, engine
-from ._lattice import MAX_NODES, lattice_search
-from ._se2 import SE2Search, SearchBudget, search_se2
-from ._se2_space import PoseChecker
-from ._se2_motion import Piece, sample_pieces
-from .certificate import find_certificate
-from .formation import Formation
-from .library import Library, _diagnosis, _with_squeezed, formation_library, library
+from .se2._ompl import Search, engine
+from .se2._lattice import MAX_NODES, lattice_search
+from .se2.search import SE2Search, SearchBudget, search_se2
+from .se2.space import PoseChecker
+from .se2.motion import Piece, sample_pieces
+from .checks.certificate import find_certificate
+from .formations.optimal import Formation
+from .formations.library import Library, _diagnosis, _with_squeezed, formation_library, library
 from .result import PlanResult, _summary, attempt, failure, relabel
-from .route import crossable
-from .verify import verify_motion
+from .roadmap.route import crossable
+from .checks.verify import verify_motion
 from .world import Scenario
 from .._validate import MAX_DURATION_S, MAX_SHEET_LENGTH, as_bounded, require_instance
 
@@ -119,7 +119,7 @@ def _finish_se2(scenario: Scenario, pieces: list[Piece], planner: str, sheet_mar
 def _lattice(scenario: Scenario, forms: list[Formation], allow_crossing: bool,
              budget: SearchBudget, planner: str, sheet_margin: float
              ) -> tuple[PlanResult | None, str]:
-    """The lattice search over every formation (:mod:`taut.plan._lattice`): its verified
+    """The lattice search over every formation (:mod:`taut.plan.se2._lattice`): its verified
     plan, or None and what it found."""
     checkers = [PoseChecker(scenario, f, allow_crossing=allow_crossing) for f in forms]
     lat = lattice_search(scenario, forms, checkers, spacing=budget.spacing,
@@ -247,13 +247,13 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     search : {"auto", "lattice", "rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"}
         Who searches SE(2) (``method="se2"`` and ``baseline="se2"``). ``"lattice"``: A*
         over a lattice of poses of every formation at once, with any number of formation
-        changes (:mod:`taut.plan._lattice`; deterministic, the fastest lattice path,
+        changes (:mod:`taut.plan.se2._lattice`; deterministic, the fastest lattice path,
         resolution-complete at ``spacing``); ``"rrtconnect"``: taut's own seeded
         RRT-Connect per formation and formation pair (narrow passages below the lattice's
         resolution); ``"auto"`` (default): the lattice, then RRT-Connect where it finds
         nothing. ``"ompl-*"``: OMPL's RRT-Connect / RRT* / PRM in place of taut's
         RRT-Connect, on the same validity checker, formations, bounds and verification
-        (optional extra ``plan-ompl``; seeding in :mod:`taut.plan._ompl`).
+        (optional extra ``plan-ompl``; seeding in :mod:`taut.plan.se2._ompl`).
     spacing : float
         Lattice spacing, m (the headings are spaced so that a heading step moves the
         farthest robot about as far).

@@ -11,11 +11,11 @@ import numpy as np
 from .._outcome import check_status, deprecated_alias
 from ..errors import PlanningError
 from . import _tol
-from .certificate import Certificate
-from .crossing import CrossingRecord, motion_from_legs
-from .formation import Formation, optimal_formation
-from .route import find_route
-from .verify import Verification, verify_motion
+from .checks.certificate import Certificate
+from .roadmap.crossing import CrossingRecord, motion_from_legs
+from .formations.optimal import Formation, optimal_formation
+from .roadmap.route import find_route
+from .checks.verify import Verification, verify_motion
 from .world import Scenario
 
 __all__ = ["PlanResult", "Robustness"]
@@ -79,7 +79,7 @@ class PlanResult:
     Attributes
     ----------
     success : bool
-        True only for a plan that passed :func:`~taut.plan.verify.verify_motion`.
+        True only for a plan that passed :func:`~taut.plan.checks.verify.verify_motion`.
     status : {"ok", "refuted", "budget_exhausted", "no_route", "unverified"}
         ``refuted``: a certificate proves no plan exists (see ``certificate``);
         ``budget_exhausted``: none found within the search budget (no claim either way);
@@ -154,7 +154,7 @@ class PlanResult:
                    noise: str = "disc", seed: int = 0, correlation: float = 1.0
                    ) -> Robustness:
         """Probability of failure under robot position error (seeded Monte Carlo through
-        the quasi-static simulation, :mod:`taut.plan.robustness`).
+        the quasi-static simulation, :mod:`taut.plan.checks.robustness`).
 
         Parameters
         ----------
@@ -172,7 +172,7 @@ class PlanResult:
         -------
         Robustness
         """
-        from .robustness import monte_carlo
+        from .checks.robustness import monte_carlo
         if not self.success or self.scenario is None:
             raise PlanningError("plan", "robustness needs a successful plan")
         return monte_carlo(self.scenario, self, sigma, trials, noise=noise, seed=seed,

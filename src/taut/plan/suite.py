@@ -16,7 +16,7 @@ from shapely.geometry import Point, Polygon
 
 from .._validate import as_count
 from ..sheet import Sheet
-from .formation import optimal_formation
+from .formations.optimal import optimal_formation
 from .world import Obstacle, Scenario, Team, World
 
 #: Crossable obstacles are at most this fraction of the holding height tall.

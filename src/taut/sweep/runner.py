@@ -173,8 +173,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     A 3 x 2 stability map of a square team, run serially:
 
     >>> import tempfile, pathlib
-    >>> from taut.io.sweep_file import sweep_from_mapping
-    >>> from taut.io.sweep_results import read_results
+    >>> from taut.sweep.file import sweep_from_mapping
+    >>> from taut.sweep.results import read_results
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> _ = (tmp / "team.yaml").write_text(
     ...     "hold_height: 800\nsheet: [[0, 0], [1000, 0], [1000, 1000], [0, 1000]]\n"

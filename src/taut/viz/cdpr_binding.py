@@ -13,8 +13,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..cdpr.model import CableRobot  # noqa: E402
-from ..cdpr.workspace import WorkspaceResult  # noqa: E402
+from ..cdpr.model.robot import CableRobot  # noqa: E402
+from ..cdpr.workspace.wrench_feasible import WorkspaceResult  # noqa: E402
 
 __all__ = ["plot_binding"]
 

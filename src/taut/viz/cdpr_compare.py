@@ -14,9 +14,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..cdpr.model import CableRobot  # noqa: E402
+from ..cdpr.model.robot import CableRobot  # noqa: E402
 from ..errors import InvalidInputError  # noqa: E402
-from ..cdpr.workspace import WorkspaceResult  # noqa: E402
+from ..cdpr.workspace.wrench_feasible import WorkspaceResult  # noqa: E402
 from .cdpr import draw_robot_outline  # noqa: E402
 from .cdpr_binding import _STYLE  # noqa: E402
 

@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..cdpr.deploy import DeploymentResult  # noqa: E402
+from ..cdpr.deployment.deploy import DeploymentResult  # noqa: E402
 
 __all__ = ["plot_capacity_bars", "plot_deployment"]
 

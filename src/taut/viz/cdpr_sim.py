@@ -14,10 +14,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
 
-from ..cdpr._bases import moved_exits  # noqa: E402
-from ..cdpr.kinematics import rotation_matrices  # noqa: E402
-from ..cdpr.model import CableRobot  # noqa: E402
-from ..cdpr.sim import ControlResult  # noqa: E402
+from ..cdpr.kinematics._bases import moved_exits  # noqa: E402
+from ..cdpr.kinematics.cables import rotation_matrices  # noqa: E402
+from ..cdpr.model.robot import CableRobot  # noqa: E402
+from ..cdpr.control.simulate import ControlResult  # noqa: E402
 
 __all__ = ["plot_control", "plot_comparison", "animate_control"]
 

@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..sheet.simulate import SimulationResult  # noqa: E402
+from ..sheet.sim.simulate import SimulationResult  # noqa: E402
 
 __all__ = ["plot_simulation"]
 

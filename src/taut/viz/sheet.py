@@ -15,7 +15,7 @@ import numpy as np  # noqa: E402
 
 from matplotlib.lines import Line2D  # noqa: E402
 
-from ..sheet.results import Equilibrium, FKResult  # noqa: E402
+from ..sheet.fk.results import Equilibrium, FKResult  # noqa: E402
 
 __all__ = ["draw_equilibrium", "plot_fk", "STATUS_COLOURS"]
 

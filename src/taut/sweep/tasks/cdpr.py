@@ -30,7 +30,7 @@ class _Context:
 
 
 def _prepare(spec: Any) -> _Context:
-    from ...io.sweep_file import base_model
+    from ..file import base_model
 
     robot = base_model(spec)
     opts = dict(spec.options)

@@ -41,7 +41,7 @@ class _Context:
 
 
 def _prepare(spec: Any) -> _Context:
-    from ...io.sweep_file import base_model
+    from ..file import base_model
 
     sc = base_model(spec)
     return _Context(sc.sheet, np.asarray(sc.formation, float), float(sc.hold_height),

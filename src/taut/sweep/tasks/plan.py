@@ -4,8 +4,8 @@ plan under robot position noise.
 ``plan_robustness`` plans the base scenario once per worker process (the planner is
 deterministic), then for each point adds seeded normal noise of standard deviation
 ``sigma`` (m, per robot coordinate, drawn every second of the plan and linear in time in
-between, modelling drifting position error; :func:`taut.plan.robustness.position_error`)
-and replays the noisy formations (:func:`taut.plan.robustness.replay`): ``torn`` when some
+between, modelling drifting position error; :func:`taut.plan.checks.robustness.position_error`)
+and replays the noisy formations (:func:`taut.plan.checks.robustness.replay`): ``torn`` when some
 robot pair stands farther apart than its sheet vertices (the sheet would tear or a robot
 slip), else the quasi-static simulation runs and ``jumped`` says whether the object
 dropped.
@@ -68,7 +68,7 @@ class _PlanContext:
 
 
 def _prepare_robustness(spec: Any) -> _PlanContext:
-    from ...io.sweep_file import base_model
+    from ..file import base_model
     from ...plan import plan
 
     sc = base_model(spec)
@@ -81,7 +81,7 @@ def _prepare_robustness(spec: Any) -> _PlanContext:
 
 
 def _run_robustness(ctx: _PlanContext, cols: Columns, seeds: np.ndarray) -> Columns:
-    from ...plan.robustness import position_error, replay
+    from ...plan.checks.robustness import position_error, replay
 
     b = len(seeds)
     out: Columns = {"torn": np.zeros(b, dtype=bool), "max_extension": np.full(b, np.nan),

@@ -1,0 +1,169 @@
+"""Parameters of the moving cable robot: elastic cables and winches (FASTKIT paper, §2.1.1
+and Table 1). Kept apart from :class:`~taut.cdpr.model.robot.CableRobot` (geometry and statics) so
+the static analyses stay unchanged; a model file carries them in an optional ``dynamics:``
+section (see :mod:`taut.io.cdpr_model`).
+
+Units: SI, float64. Motor-side quantities (torque N m, speed rad/s, inertia kg m^2) are at the
+motor shaft, before the gearhead.
+
+Winch model (one per cable). With ``theta`` the motor angle, ``N`` the gear ratio, ``r`` the
+drum radius and ``eta`` the transmission efficiency, the unstretched (paid-out) cable length is
+``L0 = L0(0) + (r / N) theta`` and
+
+    J theta_ddot = (r / N) T - eta tau - tau_f(theta_dot),
+
+where ``T`` is the cable tension, ``tau`` the motor torque (positive winds the cable in) and
+``tau_f = (tau_c + (tau_s - tau_c) exp(-(w / w_s)^2)) tanh(w / w_eps) + b w`` the motor friction
+(static ``tau_s``, Coulomb ``tau_c``, viscous ``b``, Stribeck speed ``w_s``). Efficiency is
+modelled as a constant loss factor on the motor torque (the paper gives one 70 % figure, not
+its dependence on the direction of power flow). Holding 45 N then needs
+``45 * 0.04 / (5 * 0.7) = 0.514 N m``, inside Table 1's 0.6 N m working point.
+
+Cable model: tension ``T = max(0, (EA (L - L0) + d (L_dot - L0_dot)) / L0)``: stiffness ``k = EA / L0``,
+unilateral (no force when the cable is shorter than its unstretched length).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from ..._validate import as_finite_scalar
+from ...errors import InvalidModelError
+
+__all__ = ["DynamicsModel"]
+
+# Values the FASTKIT paper gives (Table 1, §2.1.1).
+_PAPER = ("drum_diameter", "gear_ratio", "efficiency", "motor_torque_limit",
+          "motor_speed_limit")
+
+
+@dataclass(frozen=True)
+class DynamicsModel:
+    """Elastic cables and winches of a CDPR, validated on construction.
+
+    Defaults are the FASTKIT values: from the paper where it gives them (Table 1), otherwise
+    documented assumptions (marked *assumed*).
+
+    Parameters
+    ----------
+    cable_stiffness : float
+        ``EA`` of every cable, N (*assumed* 20 kN, of the order of a 1.5-2 mm UHMWPE braid;
+        the paper gives no cable data). ``k = EA / L0``.
+    cable_damping : float
+        ``d`` of every cable, N s (*assumed* 50 N s, a few % of critical damping of the
+        platform modes); the damping force is ``d (L_dot - L0_dot) / L0`` (strain rate). 0 disables it.
+    drum_diameter : float
+        m (Table 1: 0.08 m).
+    gear_ratio : float
+        Motor turns per drum turn (Table 1: 5:1).
+    efficiency : float
+        Transmission efficiency in (0, 1] (Table 1: 70 %).
+    motor_torque_limit : float
+        N m (Table 1 gives the 0.6 N m working point; taken as the limit).
+    motor_speed_limit : float
+        rad/s (250 rad/s = 2387 rpm: the 2 m/s maximum cable speed of Table 1 through the
+        5:1 gearhead and 0.04 m drum radius; the 1600 rpm of Table 1 is the working point).
+    rotor_inertia : float
+        Motor rotor + gearhead + drum reflected to the motor shaft, kg m^2 (*assumed*
+        4.5e-5: 3e-5 rotor of a 0.6 N m servo, 1e-5 gearhead, drum 1.3e-4 / 25).
+    friction_static, friction_coulomb : float
+        N m at the motor (*assumed* 0.02 and 0.015 N m, ~3 % of the working torque).
+    friction_viscous : float
+        N m s/rad at the motor (*assumed* 2e-5).
+    stribeck_speed : float
+        rad/s at the motor (*assumed* 5 rad/s).
+    drive_speed_gain, drive_integral_gain : float
+        Proportional (N m s/rad) and integral (N m/rad) gains of the servo drive's speed loop,
+        used when a controller sends speed set-points (*assumed* 0.027 and 4: a ~420 rad/s
+        speed-loop bandwidth ``eta K / J`` for the rotor inertia above).
+    """
+
+    cable_stiffness: float = 2.0e4
+    cable_damping: float = 50.0
+    drum_diameter: float = 0.08
+    gear_ratio: float = 5.0
+    efficiency: float = 0.7
+    motor_torque_limit: float = 0.6
+    motor_speed_limit: float = 250.0
+    rotor_inertia: float = 4.5e-5
+    friction_static: float = 0.02
+    friction_coulomb: float = 0.015
+    friction_viscous: float = 2.0e-5
+    stribeck_speed: float = 5.0
+    drive_speed_gain: float = 0.027
+    drive_integral_gain: float = 4.0
+
+    def __post_init__(self) -> None:
+        positive = ("cable_stiffness", "drum_diameter", "gear_ratio", "efficiency",
+                    "motor_torque_limit", "motor_speed_limit", "rotor_inertia",
+                    "stribeck_speed")
+        for f in fields(self):
+            v = as_finite_scalar(getattr(self, f.name), f"dynamics.{f.name}")
+            if f.name in positive and not v > 0:
+                raise InvalidModelError(f"dynamics.{f.name}", f"must be positive, got {v:g}")
+            if v < 0:
+                raise InvalidModelError(f"dynamics.{f.name}",
+                                        f"must be non-negative, got {v:g}")
+            object.__setattr__(self, f.name, v)
+        if self.efficiency > 1.0:
+            raise InvalidModelError("dynamics.efficiency",
+                                    f"must be in (0, 1], got {self.efficiency:g}")
+        if self.friction_static < self.friction_coulomb:
+            raise InvalidModelError("dynamics.friction_static", "static friction "
+                                    f"{self.friction_static:g} N m is below Coulomb friction "
+                                    f"{self.friction_coulomb:g} N m")
+
+    @property
+    def drum_radius(self) -> float:
+        """m."""
+        return 0.5 * self.drum_diameter
+
+    @property
+    def length_per_rad(self) -> float:
+        """Cable length paid out per motor radian, ``r / N``, m/rad."""
+        return self.drum_radius / self.gear_ratio
+
+    @property
+    def max_cable_speed(self) -> float:
+        """Cable speed at the motor speed limit, m/s."""
+        return self.motor_speed_limit * self.length_per_rad
+
+    @property
+    def max_cable_tension(self) -> float:
+        """Tension the motor holds at its torque limit (static, no friction), N."""
+        return self.motor_torque_limit * self.efficiency / self.length_per_rad
+
+    def friction(self, speed: np.ndarray, scale: Any = 1.0) -> np.ndarray:
+        """Motor friction torque ``tau_f`` (N m, same sign as ``speed``) at motor speeds
+        (rad/s), multiplied by ``scale`` (broadcast).
+
+        Examples
+        --------
+        >>> d = DynamicsModel()
+        >>> float(d.friction(np.array(100.0)))          # Coulomb + viscous at speed
+        0.017
+        >>> float(d.friction(np.array(0.0)))
+        0.0
+        """
+        from .._tol import FRICTION_SPEED_WIDTH
+        w = np.asarray(speed, dtype=float)
+        level = self.friction_coulomb + (self.friction_static - self.friction_coulomb) * \
+            np.exp(-(w / self.stribeck_speed) ** 2)
+        return np.asarray(scale) * (level * np.tanh(w / FRICTION_SPEED_WIDTH)
+                                    + self.friction_viscous * w)
+
+    def without_losses(self) -> "DynamicsModel":
+        """The same winches with no friction, no cable damping and 100 % efficiency
+        (for energy-conservation checks)."""
+        from dataclasses import replace
+        return replace(self, cable_damping=0.0, friction_static=0.0, friction_coulomb=0.0,
+                       friction_viscous=0.0, efficiency=1.0)
+
+    def describe(self) -> dict[str, Any]:
+        """JSON-friendly parameters, with which ones come from the FASTKIT paper."""
+        out: dict[str, Any] = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["from_paper"] = list(_PAPER)
+        return out

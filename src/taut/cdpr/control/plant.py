@@ -1,0 +1,263 @@
+"""The simulated cable robot (private to the control simulation): a 6-DoF rigid platform on
+elastic unilateral cables wound on winches, batched over B plants (Monte Carlo).
+
+State per plant: centre of mass ``x_c`` and velocity ``v_c`` (world), rotation ``R`` and body
+angular velocity ``w_b``, unstretched cable lengths ``L0`` (m), motor speeds (rad/s) and the
+servo-drive integrators (N m). Forces: gravity, cable tensions
+``T_i = max(0, (EA (L_i - L0_i) + d (L_dot_i - L0_dot_i)) / L0_i)`` along ``u_i`` (FASTKIT eq. 18), and an
+optional constant external wrench. Winches: see :mod:`taut.cdpr.control.dynamics`.
+
+Integrator: semi-implicit (symplectic) Euler with ``substeps`` steps per control period: the
+velocities (platform and rotors) are advanced with the forces at the current configuration,
+then the configuration with the new velocities, the rotation on SO(3) by the exponential map
+(``R <- R exp(h [w_b])``, so R stays orthonormal). It is first-order accurate and symplectic:
+without losses its energy error stays bounded (no drift), which the tests check over 2 s. It
+is stable while ``omega_max h < 2`` for the stiffest mode ``omega_max`` of the linearised
+platform-cable-rotor system; :func:`stiffest_mode` computes it, and a step with
+``omega_max h > taut.cdpr._tol.STABILITY_OMEGA_H`` is refused before the run.
+
+Energy: with no damping, friction or efficiency loss and constant motor torques the model is
+conservative up to one term: the strain energy ``EA (L - L0)^2 / (2 L0)`` of a cable whose
+unstretched length changes pulls the drum with ``T + T^2 / (2 EA)`` while the model (like
+the real drum) feels ``T``; for FASTKIT ``T / EA ~ 1e-3``, so total energy is conserved to
+~2e-5 relative over 2 s (tests/cdpr/control/test_control_sim.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._tol import EQUILIBRIUM_FD_STEP, EQUILIBRIUM_FORCE_TOL
+from ..kinematics.forward import so3_exp
+from .dynamics import DynamicsModel
+from ..kinematics.cables import rotation_matrices
+from ..model.robot import CableRobot
+from .model_errors import PlantPerturbation
+
+
+@dataclass
+class PlantState:
+    """Mutable batched state (B plants); arrays are updated in place by :meth:`Plant.step`."""
+
+    xc: np.ndarray        # (B, 3) centre of mass, m
+    vc: np.ndarray        # (B, 3) m/s
+    R: np.ndarray         # (B, 3, 3)
+    wb: np.ndarray        # (B, 3) body angular velocity, rad/s
+    L0: np.ndarray        # (B, m) unstretched lengths, m
+    speed: np.ndarray     # (B, m) motor speeds, rad/s (positive pays cable out)
+    integ: np.ndarray     # (B, m) drive speed-loop integrators, N m
+
+
+class Plant:
+    """Batched plant of ``len(perturbations)`` copies of ``robot`` with their model errors.
+
+    Parameters
+    ----------
+    robot, dynamics
+        Nominal model; each plant applies its :class:`PlantPerturbation`.
+    perturbations : list of PlantPerturbation
+    external_wrench : (6,), optional
+        Constant extra wrench on the platform (N, then N m about the centre of mass).
+    """
+
+    def __init__(self, robot: CableRobot, dynamics: DynamicsModel,
+                 perturbations: list[PlantPerturbation], external_wrench: Any = None) -> None:
+        self.robot, self.dyn = robot, dynamics
+        B = len(perturbations)
+        self.B = B
+        ms = np.array([p.mass_scale for p in perturbations])
+        mp, ml = robot.platform.mass, robot.payload.mass
+        com = (mp * robot.platform.com + ml * robot.payload.com) / (mp + ml)
+        dp, dl = robot.platform.com - com, robot.payload.com - com
+        inertia = (robot.platform.inertia + mp * (dp @ dp * np.eye(3) - np.outer(dp, dp))
+                   + ml * (dl @ dl * np.eye(3) - np.outer(dl, dl)))
+        self.com_local = com                                     # P -> CoM, platform frame
+        self.mass = ms * (mp + ml)                               # (B,)
+        self.inertia = ms[:, None, None] * inertia               # (B, 3, 3) about the CoM
+        self.inertia_inv = np.linalg.inv(self.inertia)
+        self.attach_c = (robot.attach_local - com).T.copy()      # (3, m) from the CoM
+        self.exit_offsets = np.stack([p.exit_offsets for p in perturbations]).transpose(0, 2, 1)
+        self.length_offsets = np.stack([p.length_offsets for p in perturbations])
+        self.friction_scale = np.array([p.friction_scale for p in perturbations])[:, None]
+        self.g = robot.gravity
+        ext = np.zeros(6) if external_wrench is None else np.asarray(external_wrench, float)
+        self.f_ext, self.m_ext = ext[:3], ext[3:]
+        # Constant blocks that turn the per-step cross products into matrix products.
+        skews = _skew(self.attach_c.T)                          # (m, 3, 3): [b_i]x
+        self._skew_row_T = np.concatenate(list(skews), axis=1).T.copy()     # (3m, 3)
+        self._skew_stack_T = np.concatenate(list(skews), axis=0).T.copy()   # (3, 3m)
+        self._skew_com_T = _skew(self.com_local[None])[0].T.copy()
+        self._inv_mass = (1.0 / self.mass)[:, None]
+        self._inertia_T = np.swapaxes(self.inertia, 1, 2).copy()
+        self._inertia_inv_T = np.swapaxes(self.inertia_inv, 1, 2).copy()
+
+    # -- geometry --------------------------------------------------------------------------
+    def cables(self, s: PlantState, exits: np.ndarray, exit_vel: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Tensions (B, m), unit vectors (B, 3, m) and CoM-to-attachment vectors (B, 3, m) for
+        world exits (3, m) (nominal, before offsets) moving at ``exit_vel`` (3, m)."""
+        B = s.xc.shape[0]
+        r = s.R @ self.attach_c
+        vec = (exits - r) + (self.exit_offsets - s.xc[:, :, None])
+        L = np.sqrt((vec * vec).sum(axis=1))
+        u = vec / L[:, None, :]
+        stretch = L - s.L0
+        d = self.dyn
+        if d.cable_damping > 0.0:
+            # velocity of the attachments: v_c + R (w_b x b_i) = v_c - R [b_i]x w_b
+            bxw = (s.wb @ self._skew_stack_T).reshape(B, -1, 3)
+            va = s.vc[:, :, None] - s.R @ np.swapaxes(bxw, 1, 2)
+            # strain rate: L_dot - L0_dot (paying out at the rotor speed is not stretching)
+            sdot = (u * (exit_vel - va)).sum(axis=1) - d.length_per_rad * s.speed
+            f = (d.cable_stiffness * stretch + d.cable_damping * sdot) / s.L0
+            T = np.where(stretch > 0.0, np.maximum(f, 0.0), 0.0)
+        else:
+            T = np.maximum(d.cable_stiffness * stretch / s.L0, 0.0)
+        return T, u, r
+
+    def motor_torque(self, s: PlantState, mode: str, command: np.ndarray, h: float
+                     ) -> np.ndarray:
+        """Motor torques (B, m), N m, saturated: ``command`` directly in ``"torque"`` mode, or
+        the drive's PI speed loop towards the speed set-points ``command`` (rad/s, clipped to
+        the speed limit) in ``"speed"`` mode (its integrator advances by ``h``)."""
+        d = self.dyn
+        lim = d.motor_torque_limit
+        if mode == "torque":
+            return np.clip(command, -lim, lim)
+        err = s.speed - np.clip(command, -d.motor_speed_limit, d.motor_speed_limit)
+        tau = np.clip(d.drive_speed_gain * err + s.integ, -lim, lim)
+        s.integ[:] = np.clip(s.integ + h * d.drive_integral_gain * err, -lim, lim)
+        return tau
+
+    def step(self, s: PlantState, h: float, exits: np.ndarray, exit_vel: np.ndarray,
+             tau: np.ndarray) -> np.ndarray:
+        """Advance every plant by ``h`` s with motor torques ``tau`` (B, m); returns the
+        tensions (B, m) at the start of the step."""
+        B = s.xc.shape[0]
+        T, u, r = self.cables(s, exits, exit_vel)
+        Tu = u * T[:, None, :]
+        F = Tu.sum(axis=2) + self.f_ext
+        # Body-frame moment about the CoM: sum_i b_i x (R^T f_i) = [[b_1]x ... [b_m]x] g.
+        g = np.swapaxes(s.R, 1, 2) @ Tu
+        tb = np.swapaxes(g, 1, 2).reshape(B, -1) @ self._skew_row_T + self.m_ext @ s.R
+        Iw = (s.wb[:, None, :] @ self._inertia_T)[:, 0, :]
+        gyro = _cross_rows(s.wb, Iw)
+        s.vc += h * (F * self._inv_mass + self.g)
+        s.wb += h * ((tb - gyro)[:, None, :] @ self._inertia_inv_T)[:, 0, :]
+        s.xc += h * s.vc
+        s.R[:] = s.R @ so3_exp(h * s.wb)
+        d = self.dyn
+        k = d.length_per_rad
+        acc = (k * T - d.efficiency * tau - d.friction(s.speed, self.friction_scale)) \
+            * (1.0 / d.rotor_inertia)
+        s.speed += h * acc
+        s.L0 += (h * k) * s.speed
+        return T
+
+    # -- measurements and energy -----------------------------------------------------------
+    def pose_of(self, s: PlantState) -> tuple[np.ndarray, np.ndarray]:
+        """Platform reference point P (B, 3) and its velocity (B, 3)."""
+        rc = s.R @ self.com_local
+        # v_P = v_c - R (w_b x c) = v_c + R ([c]x w_b)
+        cxw = s.wb @ self._skew_com_T
+        return s.xc - rc, s.vc + (s.R @ cxw[:, :, None])[:, :, 0]
+
+    def energy(self, s: PlantState, exits: np.ndarray, tau: np.ndarray,
+               L0_start: np.ndarray) -> np.ndarray:
+        """Total mechanical energy (B,), J: platform and rotor kinetic energy, gravity (zero
+        at the ground), cable strain energy ``EA (L - L0)^2 / (2 L0)`` and the potential of
+        constant motor torques ``eta tau N / r (L0 - L0_start)`` (valid for constant tau)."""
+        d = self.dyn
+        T, _, _ = self.cables(s, exits, np.zeros_like(exits))
+        stretch = T * s.L0 / d.cable_stiffness
+        ke = 0.5 * self.mass * np.einsum("bi,bi->b", s.vc, s.vc) + 0.5 * np.einsum(
+            "bi,bij,bj->b", s.wb, self.inertia, s.wb) + 0.5 * d.rotor_inertia * np.einsum(
+            "bm,bm->b", s.speed, s.speed)
+        pe = -self.mass * (s.xc @ self.g) + 0.5 * np.einsum(
+            "bm,bm->b", d.cable_stiffness * stretch ** 2, 1.0 / s.L0)
+        pm = np.einsum("bm,bm->b", d.efficiency * tau / d.length_per_rad, s.L0 - L0_start)
+        return ke + pe + pm
+
+
+def _skew(r: np.ndarray) -> np.ndarray:
+    """Cross-product matrices ``[r]x`` (n, 3, 3) of vectors (n, 3)."""
+    S = np.zeros((len(r), 3, 3))
+    S[:, 0, 1], S[:, 0, 2], S[:, 1, 2] = -r[:, 2], r[:, 1], -r[:, 0]
+    S[:, 1, 0], S[:, 2, 0], S[:, 2, 1] = r[:, 2], -r[:, 1], r[:, 0]
+    return S
+
+
+def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (B, 3) arrays (cheaper than ``np.cross`` on tiny arrays)."""
+    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=1)
+
+
+def stiffest_mode(plant: Plant, state: PlantState, exits: np.ndarray) -> float:
+    """Largest natural frequency (rad/s) of the linearised platform-cable-rotor system at the
+    state of plant 0: ``sqrt(max eig(M^-1 K))`` with generalised coordinates (platform twist
+    about the CoM, 6; unstretched lengths, m) and the axial cable stiffnesses
+    ``k_i = EA / L0_i`` (taut cables only). The integrator needs ``omega_max h < 2``."""
+    d = plant.dyn
+    T, u, r = plant.cables(state, exits, np.zeros_like(exits))
+    u0, r0 = u[0].T, r[0].T
+    G = np.hstack([u0, np.cross(r0, u0)])                  # (m, 6): dL = -G dx
+    k = np.where(T[0] > 0, d.cable_stiffness / state.L0[0], 0.0)
+    m = plant.robot.m
+    J = np.hstack([-G, -np.eye(m)])                         # stretch = J [dx; dL0]
+    K = J.T @ (k[:, None] * J)
+    Minv_mat = np.zeros((6 + m, 6 + m))
+    Minv_mat[:3, :3] = np.eye(3) / plant.mass[0]
+    Rw = state.R[0]
+    Minv_mat[3:6, 3:6] = Rw @ plant.inertia_inv[0] @ Rw.T
+    Minv_mat[6:, 6:] = np.eye(m) * d.length_per_rad ** 2 / d.rotor_inertia
+    ev = np.linalg.eigvals(Minv_mat @ K)
+    return float(np.sqrt(max(float(np.max(ev.real)), 0.0)))
+
+
+def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.ndarray
+                  ) -> PlantState:
+    """Every plant at rest in elastic static equilibrium with unstretched lengths ``L0``
+    (B, m) under gravity (the external wrench, a disturbance, starts acting at the first
+    step), found by Newton's method on the force and moment balance from the pose ``guess``
+    (6,) of P; drives initialised to hold the tensions."""
+    B = plant.B
+    R0 = np.repeat(rotation_matrices(guess[None, 3:]), B, axis=0)
+    xc0 = guess[:3] + R0[0] @ plant.com_local
+    s = PlantState(np.tile(xc0, (B, 1)), np.zeros((B, 3)), R0, np.zeros((B, 3)), L0.copy(),
+                   np.zeros_like(L0), np.zeros_like(L0))
+    zero_v = np.zeros_like(exits)
+
+    def residual(st: PlantState) -> np.ndarray:
+        T, u, r = plant.cables(st, exits, zero_v)
+        Tu = u * T[:, None, :]
+        F = Tu.sum(axis=2) + plant.mass[:, None] * plant.g
+        M = np.cross(r, Tu, axis=1).sum(axis=2)
+        return np.hstack([F, M])
+
+    eps = EQUILIBRIUM_FD_STEP
+    for _ in range(50):
+        res = residual(s)
+        if np.abs(res).max() < EQUILIBRIUM_FORCE_TOL:
+            break
+        Jac = np.empty((B, 6, 6))
+        for j in range(6):
+            dx = np.zeros((B, 6))
+            dx[:, j] = eps
+            Jac[:, :, j] = (residual(_moved(s, dx)) - res) / eps
+        step = -np.einsum("bij,bj->bi", np.linalg.pinv(Jac), res)   # robust if singular
+        s = _moved(s, step)
+    T, _, _ = plant.cables(s, exits, zero_v)
+    d = plant.dyn
+    s.integ[:] = d.length_per_rad * T / d.efficiency
+    return s
+
+
+def _moved(s: PlantState, dx: np.ndarray) -> PlantState:
+    """Copy of ``s`` with the CoM moved by dx[:, :3] and rotated by exp(dx[:, 3:]) (world)."""
+    return PlantState(s.xc + dx[:, :3], s.vc.copy(), so3_exp(dx[:, 3:]) @ s.R, s.wb.copy(),
+                      s.L0.copy(), s.speed.copy(), s.integ.copy())

@@ -1,0 +1,352 @@
+"""Control simulation of a CDPR on fixed or mobile bases (FASTKIT paper §2.2, §3.1): a
+controller at a fixed control rate drives the elastic-cable, winch and 6-DoF platform plant of
+:mod:`taut.cdpr.control.plant`, with seeded model errors, optional base motion (deployment, eq. 8),
+and monitors of tensions, tipping (eqs. 21-23) and motor saturation.
+
+Entry points: :func:`simulate` (one run, full time histories) and :func:`monte_carlo` (B runs
+with different seeded model errors, batched through one plant, summary numbers per run).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Literal, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
+    as_positive, require_instances)
+from ...errors import InvalidInputError
+from .._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
+from ..kinematics.forward import rpy_from_matrices
+from .controllers import (ControlContext, Controller, Measurement, TorqueController,
+    VelocityController)
+from .dynamics import DynamicsModel
+from ..model.robot import CableRobot
+from .model_errors import ModelErrors, stack_perturbations
+from .plant import Plant, PlantState, initial_state, stiffest_mode
+from .references import Reference
+from ._setup import BaseMotion, RefGeometry, build_context, reference_geometry
+from .results import ControlResult, MonteCarloResult, assemble_result, summarise
+
+__all__ = ["simulate", "monte_carlo", "ControlResult", "MonteCarloResult", "BaseMotion"]
+
+#: The integrators of :func:`simulate`: compiled (numba), plain numpy, or numba when available.
+Engine = Literal["auto", "numba", "numpy"]
+
+_CHECK_EVERY = 50          # control steps between divergence checks
+_MC_RECORD_EVERY = 10      # Monte Carlo keeps every 10th state for the tipping monitor
+
+#: Most integration substeps per control step (1 MHz integration at a 1 kHz controller).
+MAX_SUBSTEPS = 1000
+
+
+@dataclass
+class _Setup:
+    robot: CableRobot
+    dyn: DynamicsModel
+    times: np.ndarray
+    ctx: ControlContext
+    geo: RefGeometry
+    plant: Plant
+    state: PlantState
+    h: float
+    substeps: int
+    k0: int                 # first recorded step (after the settling pre-roll)
+
+
+def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
+             model_errors: Any, base_motion: Any, control_rate: float, duration: Any,
+             dynamics: Any, substeps: int, external_wrench: Any, settle: Any) -> _Setup:
+    """Validate the inputs, precompute the nominal context, build and initialise the plant."""
+    if not isinstance(robot, CableRobot):
+        raise InvalidInputError("robot", "must be a taut.cdpr.CableRobot")
+    if not isinstance(reference, Reference):
+        raise InvalidInputError("reference", "must be a taut.cdpr.Reference (see "
+                                             "pick_and_place, reference_from_samples)")
+    if not isinstance(controller, Controller):
+        raise InvalidInputError("controller", "must be a taut.cdpr controller, e.g. "
+                                              "VelocityController() or TorqueController()")
+    if robot.dof != 6:
+        raise InvalidInputError("robot", "the dynamics need a 6-DoF platform")
+    dyn = DynamicsModel() if dynamics is None else dynamics
+    if not isinstance(dyn, DynamicsModel):
+        raise InvalidInputError("dynamics", "must be a taut.cdpr.DynamicsModel")
+    rate = as_bounded(control_rate, "control_rate", MAX_RATE_HZ, "Hz")
+    if (isinstance(substeps, bool) or not isinstance(substeps, (int, float, np.number))
+            or not np.isfinite(substeps) or int(substeps) != substeps or substeps < 1):
+        raise InvalidInputError("substeps", f"must be a positive integer, got {substeps!r}")
+    if substeps > MAX_SUBSTEPS:
+        raise InvalidInputError("substeps", f"{substeps:g} exceeds the accepted range "
+                                            f"{MAX_SUBSTEPS} substeps per control step")
+    dur = reference.duration if duration is None else \
+        as_bounded(duration, "duration", MAX_DURATION_S, "s")
+    if dur * rate > MAX_BATCH:
+        raise InvalidInputError("duration", f"{dur:g} s at {rate:g} Hz is {dur * rate:.3g} "
+                                f"control steps, more than {MAX_BATCH}")
+    settle_s = as_bounded(settle, "settle", MAX_DURATION_S, "s", positive=False)
+    if settle_s * rate > MAX_BATCH:
+        raise InvalidInputError("settle", f"{settle_s:g} s at {rate:g} Hz is "
+                                f"{settle_s * rate:.3g} control steps, more than {MAX_BATCH}")
+    dt = 1.0 / rate
+    n = max(int(np.ceil(dur * rate - STEP_COUNT_SLACK)), 1)
+    k0 = int(round(settle_s * rate))
+    times = (np.arange(n + 1 + k0) - k0) * dt
+    geo = reference_geometry(robot, times, base_motion)
+    ctx = build_context(robot, dyn, times, reference, geo, dt)
+    perts = stack_perturbations(robot, model_errors)
+    if external_wrench is not None:
+        external_wrench = as_array(external_wrench, "external_wrench", shape=(6,))
+    plant = Plant(robot, dyn, perts, external_wrench)
+    ex0 = geo.exits[0].T
+    state = initial_state(plant, ex0, _parked_lengths(plant, ex0, ctx), ctx.ref_poses[0])
+    h = dt / int(substeps)
+    w_max = stiffest_mode(plant, state, ex0)
+    w_drive = dyn.efficiency * dyn.drive_speed_gain / dyn.rotor_inertia   # speed-loop pole
+    w_max = max(w_max, w_drive) if controller.mode == "speed" else w_max
+    if w_max * h > STABILITY_OMEGA_H:
+        need = w_max / STABILITY_OMEGA_H / int(substeps)
+        raise InvalidInputError("control_rate", f"{rate:g} Hz with {int(substeps)} substep(s) "
+                                f"is too slow for the semi-implicit Euler integrator: the "
+                                f"stiffest mode ({w_max:.0f} rad/s) needs a rate of at least "
+                                f"{need:.0f} Hz (or more substeps)")
+    return _Setup(robot, dyn, times, ctx, geo, plant, state, h, int(substeps), k0)
+
+
+def _parked_lengths(plant: Plant, exits: np.ndarray, ctx: ControlContext) -> np.ndarray:
+    """Unstretched lengths (B, m) of each plant parked at the reference start pose with the
+    reference tensions on its *actual* geometry (tension-based homing): the run starts near
+    equilibrium whatever the exit errors, and the geometry errors act through the control
+    law (the velocity law drives the encoder lengths to its nominal set-points)."""
+    from ..kinematics.cables import rotation_matrices
+    R0 = rotation_matrices(ctx.ref_poses[:1, 3:])[0]
+    att = ctx.ref_poses[0, :3, None] + R0 @ plant.robot.attach_local.T      # (3, m)
+    L = np.linalg.norm(exits[None] + plant.exit_offsets - att[None], axis=1)  # (B, m)
+    EA = plant.dyn.cable_stiffness
+    return EA * L / (EA + ctx.tensions[0])
+
+
+def _measure(setup: _Setup) -> Measurement:
+    pl, s = setup.plant, setup.state
+    p, v = pl.pose_of(s)
+    w = (s.R @ s.wb[:, :, None])[:, :, 0]
+    return Measurement(p, s.R, v, w, s.L0 + pl.length_offsets, s.speed)
+
+
+def _loop(setup: _Setup, controller: Controller,
+          record: Callable[..., None],
+          progress: Callable[[int, int], None] | None) -> np.ndarray:
+    """Run the control loop; returns the first diverged step per plant (-1 if none)."""
+    pl, s, ctx, geo = setup.plant, setup.state, setup.ctx, setup.geo
+    n = len(setup.times)
+    lo, hi = setup.robot.bounds[0] - DIVERGENCE_MARGIN, setup.robot.bounds[1] + DIVERGENCE_MARGIN
+    diverged = np.full(pl.B, -1)
+    exits_T = np.swapaxes(geo.exits, 1, 2)
+    vel_T = np.swapaxes(geo.exit_vel, 1, 2)
+    with np.errstate(all="ignore"):
+        for k in range(n):
+            cmd = controller.command(ctx, k, _measure(setup))
+            ex, ev = exits_T[k], vel_T[k]
+            snap = (s.xc.copy(), s.R.copy(), s.speed.copy())
+            for j in range(setup.substeps):
+                tau = pl.motor_torque(s, controller.mode, cmd, setup.h)
+                T = pl.step(s, setup.h, ex, ev, tau)
+                if j == 0:
+                    record(k, T, tau, snap)
+            if k % _CHECK_EVERY == _CHECK_EVERY - 1 or k == n - 1:
+                bad = ~np.all(np.isfinite(s.xc) & (s.xc > lo) & (s.xc < hi), axis=1) \
+                    | ~np.all(np.isfinite(s.L0), axis=1)
+                new = bad & (diverged < 0)
+                diverged[new] = k
+                if np.all(diverged >= 0):
+                    break
+            if progress is not None and k % 200 == 0:
+                progress(k, n)
+    if progress is not None:
+        progress(n, n)
+    return diverged
+
+
+def _engine(engine: str, controller: Controller) -> str:
+    """Resolve ``engine`` to "numba" or "numpy"."""
+    if not isinstance(engine, str) or engine not in ("auto", "numba", "numpy"):
+        raise InvalidInputError("engine", f"unknown engine {engine!r}; choose auto, numba or "
+                                          "numpy")
+    compiled = type(controller) in (VelocityController, TorqueController)
+    if engine == "numpy" or (engine == "auto" and not compiled):
+        return "numpy"
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        if engine == "numba":
+            raise InvalidInputError("engine", "numba is not installed (it is a dependency "
+                                              "of taut; pip install numba)") from None
+        return "numpy"
+    if not compiled:
+        raise InvalidInputError("engine", "the numba engine runs VelocityController and "
+                                          "TorqueController only; use engine='numpy'")
+    return "numba"
+
+
+def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_plants: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Run the compiled loop; returns records (n/rec_every, Brec, 12 + 3m), per-plant
+    summaries (B, 6) and the first diverged step per plant (-1 if none)."""
+    from ._kernel import run
+    from .._tol import FRICTION_SPEED_WIDTH
+    pl, s, ctx, geo, d = setup.plant, setup.state, setup.ctx, setup.geo, setup.dyn
+    n, m, B = len(setup.times), setup.robot.m, pl.B
+    if isinstance(controller, VelocityController):
+        mode, gains = 0, np.array([controller.length_gain, 0, 0, 0, 0], float)
+    else:
+        c = controller
+        mode, gains = 1, np.array([c.position_stiffness, c.position_damping,  # type: ignore[attr-defined]
+                                   c.rotation_stiffness, c.rotation_damping,  # type: ignore[attr-defined]
+                                   c.joint_damping], float)  # type: ignore[attr-defined]
+    dyn = np.array([d.cable_stiffness, d.cable_damping, d.length_per_rad, d.efficiency,
+                    d.motor_torque_limit, d.motor_speed_limit, d.rotor_inertia,
+                    d.friction_static, d.friction_coulomb, d.friction_viscous,
+                    d.stribeck_speed, FRICTION_SPEED_WIDTH, d.drive_speed_gain,
+                    d.drive_integral_gain])
+    rec = np.full(((n + rec_every - 1) // rec_every, n_rec_plants, 12 + 3 * m), np.nan)
+    summ = np.zeros((B, 6))
+    summ[:, 2], summ[:, 3] = np.inf, -np.inf
+    diverged = np.full(B, -1, dtype=np.int64)
+    lo = setup.robot.bounds[0] - DIVERGENCE_MARGIN
+    hi = setup.robot.bounds[1] + DIVERGENCE_MARGIN
+    C = np.ascontiguousarray
+    with np.errstate(all="ignore"):
+        run(mode, gains, dyn, C(ctx.L0), C(ctx.L0_dot), C(ctx.L0_ddot), C(ctx.ref_poses),
+            C(ctx.ref_vel), C(ctx.R_ref), C(ctx.tensions), C(ctx.W_pinv), C(ctx.com_skew_T),
+            C(ctx.inertia), float(ctx.mass), C(ctx.t_min), C(ctx.t_max),
+            C(np.swapaxes(geo.exits, 1, 2)), C(np.swapaxes(geo.exit_vel, 1, 2)),
+            C(pl.exit_offsets), C(pl.length_offsets), C(pl.friction_scale[:, 0]),
+            C(pl.mass), C(pl.inertia), C(pl.inertia_inv), C(pl.attach_c), C(pl.com_local),
+            C(pl.g), C(np.r_[pl.f_ext, pl.m_ext]), s.xc, s.vc, s.R, s.wb, s.L0, s.speed,
+            s.integ, float(setup.h), int(setup.substeps), lo, hi, _CHECK_EVERY, rec,
+            int(rec_every), summ, int(setup.k0), diverged)
+    return rec, summ, diverged
+
+
+def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
+             model_errors: ModelErrors | None = None, base_motion: BaseMotion | None = None,
+             control_rate: float = 1000.0, duration: float | None = None,
+             dynamics: DynamicsModel | None = None, substeps: int = 1,
+             external_wrench: ArrayLike | None = None, settle: float = 1.0,
+             engine: Engine = "auto",
+             progress: Callable[[int, int], None] | None = None) -> ControlResult:
+    """Simulate a controller driving the cable robot along a reference.
+
+    Parameters
+    ----------
+    robot : CableRobot
+        Nominal model (the controller's); 6-DoF platform.
+    reference : Reference
+        Platform reference, e.g. :func:`taut.cdpr.pick_and_place`.
+    controller : Controller
+        :class:`~taut.cdpr.VelocityController` or :class:`~taut.cdpr.TorqueController`.
+    model_errors : ModelErrors, optional
+        Seeded errors of the plant against the nominal model (default none).
+    base_motion : BaseMotion, optional
+        Poses of the bases over time (deployment in task mode, eq. 8).
+    control_rate : float
+        Hz (default 1 kHz).
+    duration : float, optional
+        s (default the reference's duration).
+    dynamics : DynamicsModel, optional
+        Cables and winches (default the FASTKIT values).
+    substeps : int
+        Integrator steps per control period.
+    external_wrench : (6,), optional
+        Constant extra wrench on the plant (N, N m about the centre of mass), not known to
+        the controller.
+    settle : float
+        Pre-roll, s: before t = 0 the controller holds the reference's start pose for this
+        long (not recorded), so the run starts from the closed-loop rest state of this
+        controller and plant rather than from the switch-on transient. The plant starts the
+        pre-roll at rest in elastic equilibrium with the nominal unstretched lengths.
+    engine : {"auto", "numba", "numpy"}
+        The compiled loop (built-in controllers, needs the ``fast`` extra) or the numpy one
+        (any controller); "auto" picks numba when it can. Both compute the same model.
+    progress : callable(done, total), optional
+        Called during the run (numpy engine) or at its end (numba engine).
+
+    Returns
+    -------
+    ControlResult
+        ``status`` ``"ok"`` (every monitor clean), ``"infeasible"`` (limits violated: see
+        ``events``) or ``"diverged"`` (the message names the time; arrays end there).
+
+    Raises
+    ------
+    InvalidInputError, InfeasiblePoseError
+        Bad input: wrong types, NaN, non-positive rates, a control rate the integrator cannot
+        keep stable (the message gives the minimum), a reference leaving the wrench-feasible
+        workspace (first time and pose named).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> from taut.cdpr import pick_and_place, VelocityController, with_stabilisers
+    >>> robot = with_stabilisers(load_cdpr_model("fastkit"))  # task mode: stabilisers down
+    >>> ref = pick_and_place(robot, [[-0.5, 0, 1.0], [0.5, 0, 1.0]], dwell=0.1)
+    >>> run = simulate(robot, ref, VelocityController())
+    >>> run.success, bool(run.tracking_error.max() < 1e-3)
+    (True, True)
+    """
+    if model_errors is not None and not isinstance(model_errors, ModelErrors):
+        raise InvalidInputError("model_errors", "must be a taut.cdpr.ModelErrors")
+    eng = _engine(engine, controller)
+    setup = _prepare(robot, reference, controller, model_errors, base_motion, control_rate,
+                     duration, dynamics, substeps, external_wrench, settle)
+    n, m = len(setup.times), robot.m
+    if eng == "numba":
+        rec_n, _, div_n = _loop_numba(setup, controller, 1, 1)
+        r0 = rec_n[:, 0]
+        hist = {"xc": r0[:, :3], "R": r0[:, 3:12].reshape(-1, 3, 3), "T": r0[:, 12:12 + m],
+                "tau": r0[:, 12 + m:12 + 2 * m], "speed": r0[:, 12 + 2 * m:]}
+        if progress is not None:
+            progress(n, n)
+        return assemble_result(setup, controller, hist, int(div_n[0]))
+    rec = {"xc": np.empty((n, 3)), "R": np.empty((n, 3, 3)), "T": np.empty((n, m)),
+           "tau": np.empty((n, m)), "speed": np.empty((n, m))}
+    def record(k: int, T: np.ndarray, tau: np.ndarray, snap: tuple) -> None:
+        rec["xc"][k], rec["R"][k], rec["T"][k] = snap[0][0], snap[1][0], T[0]
+        rec["tau"][k], rec["speed"][k] = tau[0], snap[2][0]
+
+    div = int(_loop(setup, controller, record, progress)[0])
+    return assemble_result(setup, controller, rec, div)
+
+
+def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
+                model_errors: Sequence[ModelErrors], *, base_motion: BaseMotion | None = None,
+                control_rate: float = 1000.0, duration: float | None = None,
+                dynamics: DynamicsModel | None = None, substeps: int = 1,
+                settle: float = 1.0, engine: Engine = "auto",
+                progress: Callable[[int, int], None] | None = None) -> MonteCarloResult:
+    """Run one simulation per entry of ``model_errors``, batched through one plant (the
+    per-step work is vectorised over runs), keeping summary numbers per run.
+
+    Returns
+    -------
+    MonteCarloResult
+        Arrays (B,) of worst tracking error, tension extremes, slack time, over-tension,
+        minimum tipping margin and per-run success/status.
+    """
+    errs = list(require_instances(model_errors, ModelErrors, "model_errors"))
+    if not errs:
+        raise InvalidInputError("model_errors", "needs at least one ModelErrors")
+    eng = _engine(engine, controller)
+    setup = _prepare(robot, reference, controller, errs, base_motion, control_rate,
+                     duration, dynamics, substeps, None, settle)
+    acc = summarise(setup)
+    if eng == "numba":
+        rec, summ, div = _loop_numba(setup, controller, _MC_RECORD_EVERY, len(errs))
+        acc.from_kernel(rec, summ, _MC_RECORD_EVERY)
+        if progress is not None:
+            progress(len(setup.times), len(setup.times))
+    else:
+        div = _loop(setup, controller, acc.record, progress)
+    return acc.result(div, controller.name)
+

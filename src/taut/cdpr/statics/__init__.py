@@ -1,0 +1,1 @@
+"""Statics of cable robots: tension distribution, tipping and sliding of mobile bases."""

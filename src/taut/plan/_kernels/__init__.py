@@ -1,0 +1,1 @@
+"""Compiled (numba) kernels of the planner: clearance of a pose and the lattice A*. Private."""

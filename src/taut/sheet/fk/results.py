@@ -1,0 +1,311 @@
+"""Result objects of sheet forward kinematics: frozen, with named fields."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..._validate import as_array
+from ...errors import InvalidInputError
+from ..model import Sheet
+
+__all__ = ["Equilibrium", "Funnel", "FKResult", "BatchFKResult", "Status", "GRAVITY"]
+
+#: Gravitational acceleration used for tensions, m/s^2 (as in the FK paper).
+GRAVITY = 9.81
+
+Status = Literal["stable", "saddle", "not_equilibrium"]
+
+
+@dataclass(frozen=True, eq=False)
+class Equilibrium:
+    """One rest state of the object found by forward kinematics.
+
+    Attributes
+    ----------
+    taut : tuple of int
+        0-based indices of the taut cables :math:`\\mathcal{I}_t` (ascending).
+    object : ndarray, shape (3,)
+        Object position :math:`\\mathbf{p}_o = (x_o, y_o, z_o)` in the world frame.
+    contact : ndarray, shape (2,)
+        Contact point :math:`\\mathbf{v}_o` in the sheet frame.
+    weights : ndarray, shape (k,)
+        Share of the object's weight carried vertically by each taut cable
+        (:math:`w_i`, summing to 1, with :math:`\\mathbf{r}_o = \\sum w_i \\mathbf{r}_i` and
+        :math:`\\mathbf{v}_o = \\sum w_i \\mathbf{v}_i`). A negative weight means the state is
+        not an equilibrium of the model. Where more cables are taut than the state
+        determines (e.g. Lemma 2), the minimum-norm non-negative weights are reported.
+    tensions : ndarray, shape (k,), or None
+        Cable tensions :math:`F_i = w_i m g L_i / d` in newtons when a mass was given and
+        the state is an equilibrium (None otherwise: no tensions can hold it there).
+    cable_lengths : ndarray, shape (k,)
+        Lengths :math:`l_i = |\\mathbf{v}_i - \\mathbf{v}_o|` of the taut cables.
+    status : {"stable", "saddle", "not_equilibrium"}
+        ``stable``: strict local minimum of the object's height (all weights positive and
+        positive-definite reduced Hessian). ``saddle``: an equilibrium that is not a strict
+        minimum. ``not_equilibrium``: passes the paper's force-closure test (projection
+        inside the taut robots' polygon) but no non-negative weights exist, so the object
+        would move (docs/sheet_kinematics.md §3).
+    """
+
+    taut: tuple[int, ...]
+    object: np.ndarray
+    contact: np.ndarray
+    weights: np.ndarray
+    tensions: np.ndarray | None
+    cable_lengths: np.ndarray
+    status: Status
+
+    @property
+    def stable(self) -> bool:
+        """True when the state is a strict local minimum of the potential energy."""
+        return self.status == "stable"
+
+    @property
+    def is_equilibrium(self) -> bool:
+        """True unless the exact force-closure test fails."""
+        return self.status != "not_equilibrium"
+
+    @property
+    def height(self) -> float:
+        """Object height :math:`z_o`."""
+        return float(self.object[2])
+
+    def __repr__(self) -> str:
+        taut = "{" + ",".join(str(i + 1) for i in self.taut) + "}"
+        p = ", ".join(f"{c:.6g}" for c in self.object)
+        return f"Equilibrium(taut={taut} (1-based), object=({p}), status={self.status!r})"
+
+
+@dataclass(frozen=True)
+class Funnel:
+    """How many taut-cable sets survive each step of the FK paper's Algorithm 1.
+
+    ``combinations`` (step 1), ``form_closure`` (step 2, eq. 5 rank test),
+    ``cqp_feasible`` (step 3: slack cables stay slack, eq. 4 ``A2 x > b2``; this is the
+    count the paper prints in Tables II and IV), ``height_feasible`` (step 3's remaining
+    conditions: real depth and :math:`0 < z_o < z_r`), ``force_closure`` (step 4).
+    """
+
+    combinations: int
+    form_closure: int
+    cqp_feasible: int
+    height_feasible: int
+    force_closure: int
+
+
+def _equilibrium(taut: tuple[int, ...], obj: np.ndarray, contact: np.ndarray,
+                 weights: np.ndarray, tensions: np.ndarray | None, lengths: np.ndarray,
+                 status: str) -> Equilibrium:
+    """An :class:`Equilibrium` without the dataclass ``__init__`` (the hot path of
+    :class:`FKResult`; fields as in the class)."""
+    e = object.__new__(Equilibrium)
+    e.__dict__.update(taut=taut, object=obj, contact=contact, weights=weights,
+                      tensions=tensions, cable_lengths=lengths, status=status)
+    return e
+
+
+class FKResult:
+    """All rest states of the object for one formation (FK paper's output
+    :math:`\\mathbb{P}_o, \\mathbb{V}_o, \\mathbb{I}_t`). Frozen.
+
+    Attributes
+    ----------
+    equilibria : tuple of Equilibrium
+        Every state that passes the paper's Algorithm 1, sorted by number of taut cables
+        then by taut set. (Built on first access when the result came from the compiled
+        kernel; the numbers are fixed when the result is made.)
+    funnel : Funnel or None
+        Step counts of Algorithm 1 (``method="exhaustive"`` only).
+    method : str
+        The FK method used.
+    sheet, formation, hold_height, mass
+        The inputs (formation as an (N, 2) array).
+    """
+
+    _equilibria: tuple[Equilibrium, ...] | None
+    _rows: np.ndarray | None
+    funnel: Funnel | None
+    method: str
+    sheet: Sheet
+    formation: np.ndarray
+    hold_height: float
+    mass: float | None
+
+    def __init__(self, equilibria: tuple[Equilibrium, ...], funnel: Funnel | None,
+                 method: str, sheet: Sheet, formation: np.ndarray, hold_height: float,
+                 mass: float | None) -> None:
+        self.__dict__.update(_equilibria=tuple(equilibria), _rows=None, funnel=funnel,
+                             method=method, sheet=sheet, formation=formation,
+                             hold_height=hold_height, mass=mass)
+
+    @classmethod
+    def _from_rows(cls, rows: np.ndarray, method: str, sheet: Sheet, formation: np.ndarray,
+                   hold_height: float, mass: float | None) -> "FKResult":
+        """A result whose equilibria are built on access from kernel rows (layout of
+        ``_small_kernel``: status, taut-set size, object, contact, depth, taut mask,
+        weights, lengths, ...)."""
+        self = object.__new__(cls)
+        self.__dict__.update(_equilibria=None, _rows=rows, funnel=None, method=method,
+                             sheet=sheet, formation=formation, hold_height=hold_height,
+                             mass=mass)
+        return self
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"FKResult is frozen: cannot assign to {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"FKResult is frozen: cannot delete {name!r}")
+
+    @property
+    def equilibria(self) -> tuple[Equilibrium, ...]:
+        eqs = self._equilibria
+        if eqs is None:
+            eqs = self._build(self._rows)
+            self.__dict__.update(_equilibria=eqs, _rows=None)
+        return eqs
+
+    def _build(self, rows: np.ndarray | None) -> tuple[Equilibrium, ...]:
+        if rows is None or len(rows) == 0:
+            return ()
+        N = self.sheet.n
+        scale = self.sheet.size
+        names = ("stable", "saddle", "not_equilibrium")
+        force = None if self.mass is None else self.mass * GRAVITY
+        out = []
+        for row in rows:
+            idx = np.flatnonzero(row[8:8 + N])
+            w = row[8 + N + idx]
+            lengths = row[8 + 2 * N + idx]
+            st = int(row[0])
+            tensions = None
+            if force is not None and st != 2:
+                tensions = w * force * (lengths / scale) / row[7]
+            out.append(_equilibrium(tuple(idx.tolist()), row[2:5].copy(), row[5:7].copy(),
+                                    w, tensions, lengths, names[st]))
+        return tuple(out)
+
+    @property
+    def stable(self) -> tuple[Equilibrium, ...]:
+        """The stable equilibria."""
+        return tuple(e for e in self.equilibria if e.stable)
+
+    @property
+    def lowest(self) -> Equilibrium | None:
+        """The stable equilibrium with the lowest object (least potential energy)."""
+        st = self.stable
+        return min(st, key=lambda e: e.height) if st else None
+
+    def closest_stable(self, point: ArrayLike) -> Equilibrium | None:
+        """The stable equilibrium whose object is nearest to ``point``.
+
+        Parameters
+        ----------
+        point : array_like, shape (3,) or (2,)
+            A reference object position :math:`\\mathbf{p}_o` (e.g. the previous state
+            of a tracked object), same length unit as the formation; with two
+            coordinates only the horizontal distance counts.
+
+        Returns
+        -------
+        Equilibrium or None
+            The nearest stable state (Euclidean distance; the first in output order on
+            ties), None when there is no stable state.
+
+        Examples
+        --------
+        >>> import taut.sheet as ts
+        >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+        >>> res = ts.forward_kinematics(sheet, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], 1.0)
+        >>> e = res.closest_stable([0.45, 0.45, 0.5])
+        >>> e is not None and e.stable
+        True
+        """
+        p = as_array(point, "point", ndim=1)
+        if p.shape[0] not in (2, 3):
+            raise InvalidInputError("point", f"must have 2 (x, y) or 3 (x, y, z) "
+                                             f"coordinates, got {p.shape[0]}")
+        st = self.stable
+        if not st:
+            return None
+        d = [float(np.sum((e.object[:len(p)] - p) ** 2)) for e in st]
+        return st[int(np.argmin(d))]
+
+    def __len__(self) -> int:
+        if self._equilibria is None and self._rows is not None:
+            return len(self._rows)
+        return len(self.equilibria)
+
+    def __repr__(self) -> str:
+        return (f"FKResult(method={self.method!r}, N={self.sheet.n}, "
+                f"equilibria={len(self)}, stable={len(self.stable)})")
+
+
+@dataclass(frozen=True, eq=False)
+class BatchFKResult:
+    """Forward kinematics of ``B`` formations of one sheet, as padded arrays.
+
+    Row ``b`` holds ``count[b]`` solutions in slots ``0..count[b]-1`` (same order as
+    :class:`FKResult`); later slots are padding (``valid`` False, NaN positions).
+
+    Attributes
+    ----------
+    count : ndarray of int, shape (B,)
+    valid : ndarray of bool, shape (B, K)
+    taut : ndarray of bool, shape (B, K, N)
+        Taut cables of each solution.
+    object : ndarray, shape (B, K, 3)
+    contact : ndarray, shape (B, K, 2)
+    weights : ndarray, shape (B, K, N)
+        Weight of each cable (0 for slack cables).
+    tensions : ndarray, shape (B, K, N), or None
+        Tensions in N (0 for slack cables, NaN for the taut cables of non-equilibria)
+        when a mass was given.
+    status : ndarray of int8, shape (B, K)
+        0 stable, 1 saddle, 2 not_equilibrium, -1 padding.
+    """
+
+    count: np.ndarray
+    valid: np.ndarray
+    taut: np.ndarray
+    object: np.ndarray
+    contact: np.ndarray
+    weights: np.ndarray
+    tensions: np.ndarray | None
+    status: np.ndarray
+    sheet: Sheet
+    formations: np.ndarray
+    hold_height: float
+    mass: float | None
+    method: str
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Bool (B, K): which solutions are stable."""
+        return self.status == 0
+
+    def __len__(self) -> int:
+        return int(self.count.shape[0])
+
+    def result(self, b: int) -> FKResult:
+        """The solutions of formation ``b`` as an :class:`FKResult`."""
+        from .._lifted import STATUS_NAMES
+
+        eqs = []
+        for k in range(int(self.count[b])):
+            idx = np.flatnonzero(self.taut[b, k])
+            eqs.append(Equilibrium(
+                taut=tuple(int(i) for i in idx),
+                object=self.object[b, k].copy(),
+                contact=self.contact[b, k].copy(),
+                weights=self.weights[b, k, idx].copy(),
+                tensions=(None if self.tensions is None or self.status[b, k] == 2
+                          else self.tensions[b, k, idx].copy()),
+                cable_lengths=np.linalg.norm(self.sheet.vertices[idx] - self.contact[b, k], axis=1),
+                status=STATUS_NAMES[int(self.status[b, k])],  # type: ignore[arg-type]
+            ))
+        return FKResult(tuple(eqs), None, self.method, self.sheet, self.formations[b].copy(),
+                        self.hold_height, self.mass)

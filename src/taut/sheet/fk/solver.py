@@ -1,0 +1,425 @@
+"""A forward-kinematics solver object for one sheet at one hold height.
+
+Everything that depends only on the sheet and the hold height (normalised vertices,
+candidate subset tables, pair limits for the formation check) is computed once; each
+:meth:`FKSolver.solve` then costs the solve itself. Teams of up to ``KERNEL_MAX_N``
+robots run the compiled kernel of ``_small_kernel`` (numba): every candidate of at most
+five cables up to ``COMPILED_MAX_N`` robots, the upper-hull faces above. Larger teams, the
+exhaustive method, and every team when numba is missing or ``backend="numpy"``, run the
+vectorised numpy path of :mod:`taut.sheet.fk.forward`. Both give the same equilibria (tested
+against each other; docs/sheet_fk_solver.md).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import weakref
+from types import ModuleType
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..._validate import as_array, as_positive, require_nonempty
+from ...errors import InvalidInputError
+from ._candidates import hull_candidates, padded_small_subsets
+from ._finalize import _min_eig_family, _weights_family
+from .._lifted import Frame, pad_groups
+from .._tol import CURVATURE_TOL, GEOMETRY_RTOL, SCREEN_SLACK, SNAP_MIN, SNAP_TOL, WEIGHT_TOL
+from .forward import (Method, _check_mass, _check_method, _check_sheet, _forward_numpy,
+    _forward_numpy_batch)
+from ._batch_result import batch_result
+from ._similar import similar_copy
+from ..model import Sheet, check_formation, check_formations, check_hold_height
+from .results import BatchFKResult, FKResult
+
+__all__ = ["FKSolver", "Backend", "COMPILED_MAX_N", "HAVE_NUMBA"]
+
+#: numba importable (and not disabled by the environment variable TAUT_DISABLE_NUMBA).
+#: The kernel module (and numba) is imported on the first solver that uses it, so that
+#: ``import taut`` stays fast.
+HAVE_NUMBA = (importlib.util.find_spec("numba") is not None
+              and not os.environ.get("TAUT_DISABLE_NUMBA"))
+sk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._kernels.small, once loaded
+bk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._kernels.batch, once loaded
+
+
+def _load_kernel() -> ModuleType:
+    global sk
+    if sk is None:
+        from .._kernels import small as _small_kernel
+        sk = _small_kernel
+    return sk
+
+def _batch_kernel() -> ModuleType:
+    """taut.sheet._kernels.batch (imported with numba on first use)."""
+    global bk
+    if bk is None:
+        from .._kernels import batch as _batch_kernel
+        bk = _batch_kernel
+    return bk
+
+
+Backend = Literal["auto", "numba", "numpy"]
+_BACKENDS = ("auto", "numba", "numpy")
+
+#: Up to this team size the default method ("fast") gives the compiled kernel every
+#: subset of at most five cables (one cached table); above it, the upper-hull faces of
+#: each formation (Qhull) -- every subset costs O(N^5) and loses from N ~ 13 on
+#: (measured with bench/bench_fk.py: N = 12 all subsets 0.56 ms, hull path 1.5 ms).
+COMPILED_MAX_N = 12
+#: Largest team the kernel handles at all (its sort keys pack a taut set in 64 bits).
+KERNEL_MAX_N = 30
+
+
+class FKSolver:
+    """Forward kinematics of one sheet at one hold height, for many formations.
+
+    Parameters
+    ----------
+    sheet : Sheet or array_like, shape (N, 2)
+        The sheet (vertices in the sheet frame, any length unit).
+    hold_height : float
+        Height :math:`z_r` of the holding points (> 0), same unit.
+    method : {"fast", "exhaustive", "subsets"}
+        As in :func:`~taut.sheet.forward_kinematics`.
+    backend : {"auto", "numba", "numpy"}
+        ``"auto"``: the compiled kernel where it applies (numba installed, ``method`` not
+        ``"exhaustive"``, ``N <= KERNEL_MAX_N``), else numpy. ``"numba"`` insists on the
+        kernel (an error where it does not apply); ``"numpy"`` never uses it.
+
+    Attributes
+    ----------
+    backend : str
+        The backend actually used, ``"numba"`` or ``"numpy"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import taut.sheet as ts
+    >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
+    >>> solver = ts.FKSolver(sheet, 1.0)
+    >>> res = solver.solve([[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]])
+    >>> [e.taut for e in res.stable]
+    [(0, 1, 2, 3)]
+    >>> np.round(res.lowest.object, 4).tolist()   # 1 - sqrt(0.5 - 0.405): cables of 0.7071
+    [0.45, 0.45, 0.6918]
+    >>> batch = solver.solve_batch(np.stack([res.formation, res.formation + 0.1]))
+    >>> batch.count.tolist()
+    [1, 1]
+    """
+
+    __slots__ = ("sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
+                 "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
+                 "_fpack", "_ipack", "_out_shape",
+                 "__weakref__")
+
+    def __init__(self, sheet: Sheet | ArrayLike, hold_height: float, *,
+                 method: Method = "fast", backend: Backend = "auto") -> None:
+        self.sheet = sheet = _check_sheet(sheet)  # type: ignore[arg-type]
+        self.hold_height = check_hold_height(hold_height)
+        self.method = _check_method(method)
+        if not isinstance(backend, str) or backend not in _BACKENDS:
+            raise InvalidInputError("backend", f"must be one of {', '.join(_BACKENDS)}; "
+                                               f"got {backend!r}")
+        N = sheet.n
+        fits = method != "exhaustive" and N <= KERNEL_MAX_N
+        if backend == "numba":
+            if not HAVE_NUMBA:
+                raise InvalidInputError("backend", "numba is not installed (pip install numba)")
+            if not fits:
+                raise InvalidInputError("backend", f"the compiled kernel takes methods 'fast' "
+                                                   f"and 'subsets' with N <= {KERNEL_MAX_N}")
+        self.backend = "numba" if backend == "numba" or (backend == "auto" and fits
+                                                         and HAVE_NUMBA) else "numpy"
+        # "fast" above COMPILED_MAX_N: the kernel solves the hull's candidates instead.
+        self._hull = method == "fast" and N > COMPILED_MAX_N
+        V = sheet.vertices
+        self._scale = float(sheet.size)
+        vc = V.mean(axis=0)
+        self._vcx, self._vcy = float(vc[0]), float(vc[1])
+        self._Vn = np.ascontiguousarray((V - vc) / self._scale)
+        self._A = np.ascontiguousarray(V - vc)
+        # The all-subsets table (O(N^5) rows) only where it is used.
+        table = (padded_small_subsets(N, sheet.has_collinear_vertices)
+                 if self.backend == "numba" and not self._hull else np.zeros((0, 5), np.intp))
+        self._table = np.ascontiguousarray(table, dtype=np.int64)
+        self._sizes = np.ascontiguousarray((table >= 0).sum(axis=1), dtype=np.int64)
+        limit = sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
+        self._lim2 = np.ascontiguousarray(limit * limit)
+        self._width = 12 + 3 * N                   # _small_kernel.row_width(N)
+        self._args = (self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
+                      self.hold_height, self._lim2)
+        self._out_shape = (len(table), self._width)
+        if self.backend == "numba":
+            _load_kernel()
+            self._fpack, self._ipack = _batch_kernel().pack(
+                self._Vn, self._A, self._lim2, self._table, self._sizes, self._scale,
+                self._vcx, self._vcy, self.hold_height, _snap_screen(self._scale))
+
+    def __repr__(self) -> str:
+        return (f"FKSolver(N={self.sheet.n}, hold_height={self.hold_height:g}, "
+                f"method={self.method!r}, backend={self.backend!r})")
+
+    # -- one formation -------------------------------------------------------------------
+    def solve(self, formation: ArrayLike, *, mass: float | None = None,
+              check: bool = True) -> FKResult:
+        """Every rest state of the object for one formation (as
+        :func:`~taut.sheet.forward_kinematics`).
+
+        Parameters
+        ----------
+        formation : array_like, shape (N, 2)
+            Robot positions, same unit as the sheet.
+        mass : float, optional
+            Object mass in kg for the tensions (N).
+        check : bool
+            Validate ``formation`` and ``mass`` (shape, finite, no pair farther apart than
+            its sheet vertices). ``False`` skips the Python-side checks for trusted loops
+            (pass a C-contiguous float64 (N, 2) array); a torn or non-finite formation
+            still raises.
+
+        Raises
+        ------
+        InvalidInputError, InfeasibleFormationError
+            As :func:`~taut.sheet.forward_kinematics`.
+        """
+        if self.backend != "numba":
+            return _forward_numpy(self.sheet, formation, self.hold_height, mass, self.method)
+        if check:
+            R = _formation_array(formation, self.sheet)
+            if mass is not None:
+                mass = as_positive(mass, "mass")
+        else:
+            R = np.array(formation, dtype=np.float64, order="C")
+        if self._hull:
+            rows = self._rows(R)
+        else:                                       # the hot path, one compiled call
+            out = np.empty(self._out_shape)
+            k, stable, pending, near = bk.solve_packed(R, self._fpack, self._ipack, out)
+            if not near and ((stable and not pending) or k == 0):
+                rows = out[:k]
+            else:
+                rows = None if k < 0 else self._finish(R, out[:k], stable, pending, near)
+        if rows is None:
+            check_formation(self.sheet, R)          # raises with the usual message
+            return _forward_numpy(self.sheet, R, self.hold_height, mass, self.method)
+        return FKResult._from_rows(rows, self.method, self.sheet, R, self.hold_height, mass)
+
+    def _rows(self, R: np.ndarray) -> np.ndarray | None:
+        """Kernel rows of formation ``R`` (snapped and with weight families resolved);
+        None when the kernel found the formation infeasible."""
+        found = self._kernel(R)
+        if found is None:
+            return None
+        return self._finish(R, *found, 0)
+
+    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int,
+                near: bool | None = None) -> np.ndarray:
+        """Rows of ``R`` after the kernel: weight families resolved (``pending`` rows),
+        snapped to a similar copy of the sheet next to one, whether or not a state is stable
+        (docs/sheet_fk_solver.md; ``near``: the result of the snap screen when the kernel
+        already ran it)."""
+        if pending:
+            self._resolve_families(R, rows)
+        if near is not False:
+            snapped = self._snap(R, screened=near is True)
+            if snapped is not None:
+                return snapped
+        return rows
+
+    def _kernel(self, R: np.ndarray) -> tuple[np.ndarray, int] | None:
+        """Kernel rows of ``R`` with weight families resolved, and the number of stable
+        rows; None for an infeasible formation."""
+        table, sizes = (self._table, self._sizes) if not self._hull else self._hull_table(R)
+        out = np.empty((len(table), self._width))
+        k, stable, pending = sk.solve_formation(
+            R, self._Vn, table, sizes, self._scale, self._vcx, self._vcy,
+            self.hold_height, self._lim2, out)
+        if k < 0:
+            return None
+        rows = out[:k]
+        if pending:
+            stable = self._resolve_families(R, rows)
+        return rows, stable
+
+    def _hull_table(self, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Candidates of ``R`` from the upper hull of its lifted points (``"fast"``,
+        docs/sheet_kinematics.md §2), as a padded table and the set sizes."""
+        if not sk.feasible(R, self._lim2):
+            return self._table[:0], self._sizes[:0]    # the kernel reports infeasible
+        P = sk.lifted_points(R, self._Vn, self._scale)
+        hc = hull_candidates(P, self.sheet.has_collinear_vertices, shortcut=False,
+                             unique=False)
+        if not hc.subsets:
+            return self._table[:0], self._sizes[:0]
+        _, table = pad_groups({s: (np.zeros(len(i), np.intp), i) for s, i in hc.subsets.items()})
+        table = np.ascontiguousarray(table, dtype=np.int64)
+        return table, (table >= 0).sum(axis=1)
+
+    def _resolve_families(self, R: np.ndarray, rows: np.ndarray) -> int:
+        """Weights and status of rows whose taut set is larger than their candidate (LP,
+        as ``_finalize.classify``); returns the number of stable rows."""
+        N = self.sheet.n
+        frame = Frame.build(self.sheet.vertices, R[None], self.hold_height, self._scale)
+        xcol = 8 + 3 * N
+        for row in rows:
+            if row[0] != sk.PENDING:
+                continue
+            idx = np.flatnonzero(row[8:8 + N])
+            x = row[xcol:xcol + 4]
+            w, min_w = _weights_family(frame, 0, idx, x[:2], x[2:])
+            min_eig = _min_eig_family(frame, 0, idx)
+            row[8 + N:8 + 2 * N] = 0.0
+            row[8 + N + idx] = w
+            row[0] = (sk.NOT_EQUILIBRIUM if min_w < -WEIGHT_TOL
+                      else sk.STABLE if min_eig > CURVATURE_TOL else sk.SADDLE)
+        return int(np.count_nonzero(rows[:, 0] == sk.STABLE))
+
+    def _snap(self, R: np.ndarray, screened: bool = False) -> np.ndarray | None:
+        """``fk._snap_near_similar`` for one formation: the rows of the similar copy of
+        the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state,
+        whether or not ``R`` itself shows one (docs/sheet_fk_solver.md; ``screened``: the
+        cheap screen, ``_snap_screen``, already passed)."""
+        size = self.sheet.size
+        if not screened:
+            scale, dist = sk.similar_fit(R, self._A)    # cheap screen first
+            lo, hi, top = _snap_screen(size)
+            if not (lo < dist <= hi and scale <= top):
+                return None
+        copies, scales, dists = similar_copy(self.sheet.vertices, R[None])
+        if not (SNAP_MIN * size < dists[0] <= SNAP_TOL * size and scales[0] <= 1.0):
+            return None
+        found = self._kernel(np.ascontiguousarray(copies[0]))
+        if found is None or found[1] == 0:
+            return None
+        return found[0]
+
+    # -- many formations -----------------------------------------------------------------
+    def solve_batch(self, formations: ArrayLike, *, mass: float | None = None,
+                    check: bool = True) -> BatchFKResult:
+        """Forward kinematics of ``B`` formations (leading axis) of this sheet.
+
+        Parameters
+        ----------
+        formations : array_like, shape (B, N, 2)
+        mass, check
+            As in :meth:`solve`.
+
+        Returns
+        -------
+        BatchFKResult
+            As :func:`~taut.sheet.forward_kinematics_batch`.
+        """
+        if self.backend != "numba" or self.method == "exhaustive":
+            return _forward_numpy_batch(self.sheet, formations, self.hold_height, mass,
+                                        self.method)
+        N = self.sheet.n
+        if check:
+            Rb = require_nonempty(as_array(formations, "formations", ndim=3), "formations")
+            if Rb.shape[1:] != (N, 2):
+                check_formations(self.sheet, Rb)    # raises the shape error
+            mass = _check_mass(mass)
+        else:
+            Rb = np.asarray(formations, dtype=np.float64)
+        Rb = np.ascontiguousarray(Rb)
+        if self._hull:
+            return self._solve_batch_hull(Rb, mass)
+        rows, form, bad = bk.solve_formations_ws(
+            Rb, self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
+            self.hold_height, self._lim2)
+        if bad >= 0:
+            check_formations(self.sheet, Rb)        # raises with the step index
+            return _forward_numpy_batch(self.sheet, Rb, self.hold_height, mass, self.method)
+        rows, form = self._fix_batch(Rb, rows, form)
+        return batch_result(self, Rb, rows, form, mass)
+
+    def _solve_batch_hull(self, Rb: np.ndarray, mass: float | None) -> BatchFKResult:
+        """Batch of larger teams: one hull and one kernel call per formation."""
+        parts, forms = [], []
+        for b in range(len(Rb)):
+            rows = self._rows(Rb[b])
+            if rows is None:
+                check_formations(self.sheet, Rb)    # raises with the step index
+                return _forward_numpy_batch(self.sheet, Rb, self.hold_height, mass,
+                                            self.method)
+            parts.append(rows)
+            forms.append(np.full(len(rows), b, dtype=np.int64))
+        rows = np.vstack(parts) if parts else np.zeros((0, self._width))
+        form = np.concatenate(forms) if forms else np.zeros(0, np.int64)
+        return batch_result(self, Rb, rows, form, mass)
+
+    def _fix_batch(self, Rb: np.ndarray, rows: np.ndarray, form: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """Resolve weight families and snap formations next to a similar copy of the
+        sheet, per formation (both rare), keeping rows grouped by formation in order."""
+        pending = np.flatnonzero(rows[:, 0] == sk.PENDING) if len(rows) else rows[:0, 0]
+        for b in np.unique(form[pending.astype(np.intp)]) if len(pending) else ():
+            sel = np.flatnonzero(form == b)
+            block = rows[sel]
+            self._resolve_families(Rb[b], block)
+            rows[sel] = block
+        # The compiled screen on every formation (a few ns each); the exact test of
+        # ``_snap`` only on the (rare) formations that pass it.
+        near = np.flatnonzero(bk.snap_screen_batch(Rb, self._A, *_snap_screen(self._scale)))
+        if not len(near):
+            return rows, form
+        parts: dict[int, np.ndarray] = {}
+        for b in near:
+            snapped = self._snap(Rb[b], screened=True)
+            if snapped is not None:
+                parts[int(b)] = snapped
+        if not parts:
+            return rows, form
+        keep = ~np.isin(form, list(parts))
+        all_rows = [rows[keep]] + list(parts.values())
+        all_form = [form[keep]] + [np.full(len(r), b, dtype=form.dtype) for b, r in parts.items()]
+        rows, form = np.vstack(all_rows), np.concatenate(all_form)
+        order = np.argsort(form, kind="stable")
+        return rows[order], form[order]
+
+
+def _snap_screen(size: float) -> tuple[float, float, float]:
+    """Bounds of the snap screen on ``similar_fit``'s distance (low, high) and scale
+    (high): ``SNAP_MIN``/``SNAP_TOL`` of the sheet size widened by ``SCREEN_SLACK``."""
+    slack = 1.0 + SCREEN_SLACK
+    return SNAP_MIN * size / slack, SNAP_TOL * size * slack, slack
+
+
+def _formation_array(formation: ArrayLike, sheet: Sheet) -> np.ndarray:
+    """``formation`` as a fresh C-contiguous float64 (N, 2) array, or the usual
+    :class:`InvalidInputError` (finiteness and pair limits are checked in the kernel)."""
+    N = sheet.n
+    if (type(formation) is np.ndarray and formation.dtype == np.float64
+            and formation.shape == (N, 2)):
+        return formation.copy()
+    R = as_array(formation, "formation", ndim=2)
+    if R.shape != (N, 2):
+        check_formation(sheet, R)                  # raises the shape error
+    return np.ascontiguousarray(R)
+
+
+
+
+# -- cached solvers for the functional front end ------------------------------------------
+
+_SOLVERS: "weakref.WeakKeyDictionary[Sheet, dict[tuple[float, str], FKSolver]]" = (
+    weakref.WeakKeyDictionary())
+#: Solvers kept per sheet (distinct hold heights and methods) by ``cached_solver``.
+_PER_SHEET = 16
+
+
+def cached_solver(sheet: Sheet, hold_height: float, method: Method) -> FKSolver:
+    """The :class:`FKSolver` for ``(sheet, hold_height, method)``, built once and reused
+    (``sheet`` already a validated :class:`Sheet`; ``hold_height`` a validated float)."""
+    per = _SOLVERS.get(sheet)
+    if per is None:
+        per = _SOLVERS[sheet] = {}
+    key = (hold_height, method)
+    solver = per.get(key)
+    if solver is None:
+        if len(per) >= _PER_SHEET:
+            per.clear()
+        solver = per[key] = FKSolver(sheet, hold_height, method=method)
+    return solver

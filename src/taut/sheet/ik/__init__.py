@@ -1,0 +1,1 @@
+"""Inverse kinematics of sheet teams: the front end, the search, the proofs of infeasibility and the results."""

@@ -1,0 +1,226 @@
+"""Sweep files (YAML or JSON): what to compute, over which parameters, keeping what.
+
+```yaml
+task: fk_stability_map              # a name in taut.sweep.TASKS
+base: ../sheet/example2_r2_r4_353mm.yaml   # scenario/model file (relative to this file)
+                                    # or a cdpr preset name ("fastkit")
+mode: grid                          # grid (Cartesian product, default) or random
+seed: 0                             # random draws and per-point noise (>= 0)
+samples: 1000                       # number of points, random mode only
+chunk_size: 2048                    # points per task (optional; the task's default)
+parameters:
+  scale: {range: [0.6, 1.0], num: 41}       # num values, ends included
+  stretch_angle: {range: [0, 180], step: 5} # lo, lo + step, ... up to hi
+  stretch: 1.3                              # one value (also [1.1, 1.3]: a list)
+  jitter: {uniform: [0, 5]}                 # random mode: uniform, normal, integers, choice
+outputs: [n_stable, lowest_height]  # optional subset of the task's outputs
+options: {grid: [21, 1, 9]}         # task options that are not swept
+```
+
+Every mistake is a :class:`~taut.errors.SweepError` naming the key (``parameters.scale``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import SweepError
+from .spec import DISTRIBUTIONS, Parameter, SweepSpec
+from .tasks import TASKS
+from ..io.files import read_mapping, read_text
+
+__all__ = ["load_sweep", "sweep_from_mapping", "base_model"]
+
+_KEYS = {"task", "base", "mode", "seed", "samples", "chunk_size", "parameters", "outputs",
+         "options", "name"}
+#: Most points one sweep may hold (a grid's product or random samples).
+MAX_POINTS = 10**9
+#: Most values one grid axis may hold.
+MAX_AXIS = 10**7
+
+
+def _number(value: Any, field: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SweepError(field, f"must be a number, got {value!r}")
+    if not np.isfinite(value):
+        raise SweepError(field, "must be finite")
+    return float(value)
+
+
+def _count(value: Any, field: str, low: int, high: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise SweepError(field, f"must be an integer, got {value!r}")
+    if not low <= value <= high:
+        raise SweepError(field, f"must be in [{low}, {high}], got {value}")
+    return int(value)
+
+
+def _grid_values(value: Any, field: str) -> np.ndarray:
+    if isinstance(value, Mapping):
+        extra = set(value) - {"range", "num", "step", "values"}
+        if extra:
+            raise SweepError(f"{field}.{sorted(extra)[0]}", "unknown key")
+        if "values" in value:
+            return _grid_values(value["values"], f"{field}.values")
+        if "range" not in value:
+            raise SweepError(field, "needs range: [low, high] with num or step, or values")
+        rng = value["range"]
+        if not isinstance(rng, list) or len(rng) != 2:
+            raise SweepError(f"{field}.range", "must be [low, high]")
+        lo, hi = (_number(v, f"{field}.range") for v in rng)
+        if hi < lo:
+            raise SweepError(f"{field}.range", f"is empty: high {hi:g} < low {lo:g}")
+        if ("num" in value) == ("step" in value):
+            raise SweepError(field, "give exactly one of num and step with range")
+        if "num" in value:
+            num = _count(value["num"], f"{field}.num", 1, MAX_AXIS)
+            return np.linspace(lo, hi, num)
+        step = _number(value["step"], f"{field}.step")
+        if step <= 0:
+            raise SweepError(f"{field}.step", "must be > 0")
+        if (hi - lo) / step >= MAX_AXIS:
+            raise SweepError(f"{field}.step", f"makes more than {MAX_AXIS} values")
+        num = int(np.floor((hi - lo) / step * (1 + 1e-12))) + 1
+        return lo + step * np.arange(num)
+    if isinstance(value, list):
+        if not value:
+            raise SweepError(field, "is an empty list")
+        return np.array([_number(v, f"{field}[{i}]") for i, v in enumerate(value)])
+    return np.array([_number(value, field)])
+
+
+def _parameter(name: str, value: Any, mode: str) -> Parameter:
+    field = f"parameters.{name}"
+    if isinstance(value, Mapping) and set(value) & set(DISTRIBUTIONS):
+        if mode != "random":
+            raise SweepError(field, "random distributions need mode: random")
+        if len(value) != 1:
+            raise SweepError(field, "give one distribution")
+        (law, args), = value.items()
+        if not isinstance(args, list):
+            raise SweepError(f"{field}.{law}", "must be a list of numbers")
+        nums = [_number(v, f"{field}.{law}[{i}]") for i, v in enumerate(args)]
+        return Parameter(name, distribution=law, arguments=np.array(nums))
+    if mode == "random":
+        values = _grid_values(value, field)
+        if values.size != 1:
+            raise SweepError(field, "in random mode give a distribution or one value")
+        return Parameter(name, distribution="choice", arguments=values)
+    return Parameter(name, values=_grid_values(value, field))
+
+
+def _base(data: Mapping[str, Any], task: str, root: Path
+          ) -> tuple[str | None, dict[str, Any] | None]:
+    need = TASKS[task].needs_base
+    base = data.get("base")
+    if not need:
+        if base is not None:
+            raise SweepError("base", f"task {task} takes no base file")
+        return None, None
+    if not isinstance(base, str) or not base:
+        raise SweepError("base", f"required: the {need} to sweep (a file path)")
+    if need == "cdpr model" and "/" not in base and "." not in base:
+        return base, None                             # a preset name
+    path = (root / base).resolve()
+    mapping = read_mapping(path)
+    _BUILDERS[need](mapping)                          # validate now, on the client
+    return str(path), mapping
+
+
+def base_model(spec: SweepSpec) -> Any:
+    """The sweep's base scenario or model, built from the parsed file in the spec (or the
+    preset), so that a worker needs no access to the file."""
+    need = TASKS[spec.task].needs_base
+    if spec.base_data is None:
+        from ..io.cdpr_model import load_cdpr_model
+        return load_cdpr_model(str(spec.base))
+    return _BUILDERS[need](dict(spec.base_data))
+
+
+def _sheet(data: dict[str, Any]) -> Any:
+    from ..io.sheet_scenario import sheet_scenario_from_mapping
+    return sheet_scenario_from_mapping(data)
+
+
+def _plan(data: dict[str, Any]) -> Any:
+    from ..io.plan_scenario import plan_scenario_from_mapping
+    return plan_scenario_from_mapping(data)
+
+
+def _cdpr(data: dict[str, Any]) -> Any:
+    from ..io.cdpr_model import cdpr_model_from_mapping
+    return cdpr_model_from_mapping(data)
+
+
+_BUILDERS = {"sheet scenario": _sheet, "plan scenario": _plan, "cdpr model": _cdpr}
+
+
+def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".",
+                       source: str = "") -> SweepSpec:
+    """Validate a parsed sweep file; relative ``base`` paths are resolved from ``root``."""
+    unknown = set(data) - _KEYS
+    if unknown:
+        raise SweepError(sorted(unknown)[0], "unknown key")
+    task = data.get("task")
+    if task not in TASKS:
+        raise SweepError("task", f"unknown task {task!r}; expected one of "
+                         f"{', '.join(sorted(TASKS))}")
+    spec_task = TASKS[task]
+    mode = data.get("mode", "grid")
+    if mode not in ("grid", "random"):
+        raise SweepError("mode", f"must be grid or random, got {mode!r}")
+    seed = _count(data.get("seed", 0), "seed", 0, 2**63 - 1)
+    samples = 0
+    if mode == "random":
+        samples = _count(data.get("samples"), "samples", 1, MAX_POINTS) \
+            if "samples" in data else 0
+        if not samples:
+            raise SweepError("samples", "required in random mode: the number of points")
+    elif "samples" in data:
+        raise SweepError("samples", "only in random mode")
+    params_in = data.get("parameters")
+    if not isinstance(params_in, Mapping) or not params_in:
+        raise SweepError("parameters", "required: a mapping of parameter names to values")
+    params = []
+    for name, value in params_in.items():
+        if name not in spec_task.parameters:
+            raise SweepError(f"parameters.{name}", f"unknown parameter of {task}; expected "
+                             f"one of {', '.join(spec_task.parameters)}")
+        params.append(_parameter(str(name), value, mode))
+    outputs = data.get("outputs", [])
+    if not isinstance(outputs, list):
+        raise SweepError("outputs", "must be a list of output names")
+    for k, name in enumerate(outputs):
+        if name not in spec_task.outputs:
+            raise SweepError(f"outputs[{k}]", f"unknown output {name!r} of {task}; expected "
+                             f"one of {', '.join(spec_task.outputs)}")
+    chunk = _count(data.get("chunk_size", 0), "chunk_size", 0, 10**7)
+    options = data.get("options", {})
+    if not isinstance(options, Mapping):
+        raise SweepError("options", "must be a mapping")
+    base, base_data = _base(data, task, Path(root))
+    spec = SweepSpec(task=task, parameters=tuple(params), base=base, base_data=base_data,
+                     mode=mode, samples=samples, seed=seed, chunk_size=chunk,
+                     outputs=tuple(outputs), options=dict(options), source=source)
+    if spec.size > MAX_POINTS:
+        raise SweepError("parameters", f"make {spec.size} points, more than {MAX_POINTS}")
+    return spec
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Read and validate a sweep file (YAML or JSON).
+
+    Raises
+    ------
+    SweepError
+        Any invalid key or value, naming it.
+    ScenarioError
+        A missing, unreadable or malformed file.
+    """
+    p = Path(path)
+    data = read_mapping(p)
+    return sweep_from_mapping(data, p.parent, read_text(p))

@@ -1,0 +1,72 @@
+"""The batch kernel (``_batch_kernel``: one workspace for the whole batch) gives the rows
+of the per-formation kernel, and ``FKSolver.solve_batch`` the results of per-call
+``solve``, on random and degenerate teams."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from taut.sheet import FKSolver, Sheet
+from taut._jit import HAVE_NUMBA
+from taut.sheet import random_team
+
+pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
+
+
+def _batch(sheet, R, rng, kind):
+    """Feasible formations near ``R``: jittered, shrunk, or (degenerate) exact and
+    nearly exact similar copies of the sheet (all cables taut; the snapping path)."""
+    B = 12
+    if kind == "copies":
+        c = sheet.vertices.mean(axis=0)
+        s = rng.uniform(0.9, 1.0, B)[:, None, None]
+        forms = (sheet.vertices - c) * s + c
+        forms[::2] += rng.normal(scale=1e-9 * sheet.size, size=forms[::2].shape)
+        return forms
+    c = R.mean(axis=0)
+    shrink = rng.uniform(0.85, 1.0, B)[:, None, None]
+    forms = (R - c) * shrink + c
+    if kind == "jitter":
+        forms = forms + rng.normal(scale=0.003 * sheet.size, size=forms.shape) * shrink
+    return forms
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 12),
+       kind=st.sampled_from(["jitter", "shrink", "copies"]))
+def test_solve_batch_equals_per_call_solve(seed, n, kind):
+    from taut.sheet._kernels import batch as bk
+    from taut.sheet._kernels import small as sk
+    rng = np.random.default_rng(seed)
+    sheet, R = random_team(n, rng)
+    solver = FKSolver(sheet, float(rng.uniform(0.5, 2.0)) * sheet.size)
+    forms = _batch(sheet, R, rng, kind)
+    iu, ju = np.triu_indices(n, 1)
+    d = np.linalg.norm(forms[:, iu] - forms[:, ju], axis=2)
+    forms = np.ascontiguousarray(forms[np.all(d <= sheet.side_lengths()[iu, ju], axis=1)])
+    if not len(forms):
+        return
+    a = sk.solve_formations(forms, *solver._args)
+    b = bk.solve_formations_ws(forms, *solver._args)
+    assert a[2] == b[2]
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[1], b[1])
+    batch = solver.solve_batch(forms, mass=2.0)
+    for k in range(len(forms)):
+        one = solver.solve(forms[k], mass=2.0)
+        got = batch.result(k).equilibria
+        assert [(e.taut, e.status) for e in got] == [(e.taut, e.status) for e in one.equilibria]
+        for x, y in zip(got, one.equilibria):
+            np.testing.assert_allclose(x.object, y.object, rtol=0, atol=1e-12 * sheet.size)
+            np.testing.assert_allclose(x.weights, y.weights, rtol=0, atol=1e-12)
+
+
+def test_batch_with_a_torn_formation_names_it():
+    from taut.errors import InfeasibleFormationError
+    sheet = Sheet.regular(4, 1.0)
+    forms = np.stack([0.9 * sheet.vertices, 1.01 * sheet.vertices])
+    with pytest.raises(InfeasibleFormationError):
+        FKSolver(sheet, 1.0).solve_batch(forms)
