@@ -2,7 +2,7 @@
 
 Measures, in one run on this machine (interleaved repeats, median and min-max spread):
   * simulated seconds per wall second at a 1 kHz control rate for the velocity and torque
-    controllers, numba engine (the compiled loop) and numpy engine (the reference loop), for
+    controllers, numba backend (the compiled loop) and numpy backend (the reference loop), for
     the whole call (set-up: reference tensions, context, initial equilibrium) and the loop;
   * a batched Monte Carlo over 100 seeded 5 mm exit-error plants (one compiled loop over all
     plants) against 100 single runs extrapolated from 10, and its statistics.
@@ -46,7 +46,7 @@ def main() -> None:
     errs = ModelErrors(exit_offset=0.005, seed=0)
     ctls = {"velocity": VelocityController(), "torque": TorqueController()}
     for c in ctls.values():                                    # compile / warm up
-        simulate(robot, ref, c, model_errors=errs, engine="numba", duration=0.2)
+        simulate(robot, ref, c, model_errors=errs, backend="numba", duration=0.2)
     setup_t, loop_t = [], {name: [] for name in ctls}
     rates: dict[tuple[str, str], list[float]] = {}
     for _ in range(args.repeats):                              # interleaved
@@ -56,7 +56,7 @@ def main() -> None:
             setup_t.append(dt_s)
             loop_t[name].append(timed(lambda: _loop_numba(setup, c, 1, 1))[0])
             for eng in ("numba", "numpy"):
-                dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, engine=eng))
+                dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, backend=eng))
                 rates.setdefault((name, eng), []).append(sim_s / dt)
     print(f"FASTKIT pick-and-place, {ref.duration:.2f} s + 1 s pre-roll = {sim_s:.2f} s "
           "simulated at 1 kHz (median of", args.repeats, "interleaved runs)")
@@ -71,9 +71,9 @@ def main() -> None:
     # Monte Carlo
     seeds = [ModelErrors(exit_offset=0.005, seed=s) for s in range(args.runs)]
     for name, c in ctls.items():
-        dt_mc, mc = timed(lambda: monte_carlo(robot, ref, c, seeds, engine="numba"))
+        dt_mc, mc = timed(lambda: monte_carlo(robot, ref, c, seeds, backend="numba"))
         dt_one = statistics.median(timed(lambda: simulate(robot, ref, c, model_errors=s,
-                                                          engine="numba"))[0]
+                                                          backend="numba"))[0]
                                    for s in seeds[:10])
         print(f"  Monte Carlo {name}: {args.runs} plants batched in {dt_mc:.2f} s "
               f"({args.runs * sim_s / dt_mc:.0f} simulated s per wall s) vs "

@@ -58,7 +58,7 @@ def main() -> None:
                                for i, t in enumerate(T)])
     feas = np.mean([r.success for r in res])
     box = [[-2.5, -0.05, 0.2], [2.5, 0.05, 1.0]]
-    t_dep, dep = timed(lambda: plan_deployment(with_stabilisers(robot, True), box,
+    t_dep, dep = timed(lambda: plan_deployment(with_stabilisers(robot), box,
                                                required_twist=[1.0, 0, 0, 0, 0, 0],
                                                maxiter=3, popsize=5, grid=(6, 2, 3),
                                                verify_grid=(11, 3, 5)))

@@ -36,6 +36,7 @@ import numpy as np
 
 from taut.sheet import FKSolver, Sheet, forward_kinematics
 from taut.sheet import random_scattered_team, random_team
+from taut.sheet import SheetTeam
 
 try:
     import vvcm_rs
@@ -127,9 +128,10 @@ def latency(n, rng, repeats, target, budget, last_peer_time):
     """Interleaved per-call times (us) of every implementation at team size ``n``."""
     sheet, formation = mm_team(n, rng)
     hold = 2.0 * sheet.size
-    solver = FKSolver(sheet, hold)
+    team = SheetTeam(sheet, hold)
+    solver = FKSolver(team)
     impls = {"solve": (solver.solve, formation),
-             "forward_kinematics": (lambda R: forward_kinematics(sheet, R, hold), formation)}
+             "forward_kinematics": (lambda R: forward_kinematics(team, R), formation)}
     slow: set[str] = set()
     for peer in peers_for(sheet, hold):
         arg = peer.prepare(formation)
@@ -175,7 +177,7 @@ def throughput(n, batch, rng, repeats):
     sheet, formation = mm_team(n, rng)
     hold = 2.0 * sheet.size
     forms = feasible_perturbations(sheet, formation, batch, rng)
-    solver = FKSolver(sheet, hold)
+    solver = FKSolver(SheetTeam(sheet, hold))
     solver.solve_batch(forms[:2])
     peers = peers_for(sheet, hold)
     rows = {}
@@ -215,7 +217,7 @@ def agreement(teams, rng, scattered):
         n = 3 + k % 10
         sheet, formation = mm_team(n, rng, scattered)
         hold = rng.uniform(0.4, 2.0) * sheet.size
-        res = forward_kinematics(sheet, formation, hold)
+        res = forward_kinematics(SheetTeam(sheet, hold), formation)
         ours = [(e.taut, e.object) for e in res.stable]
         counts["teams"] += 1
         for peer in peers_for(sheet, hold):
@@ -223,7 +225,7 @@ def agreement(teams, rng, scattered):
             counts[peer.name] += same_stable(ours, theirs, sheet.size)
             counts["peer_below_floor"] += any(p[2] <= 0 for _, p in theirs)
         if n <= 10:
-            exh = forward_kinematics(sheet, formation, hold, method="exhaustive")
+            exh = forward_kinematics(SheetTeam(sheet, hold), formation, method="exhaustive")
             counts["exhaustive_teams"] += 1
             counts["exhaustive"] += same_stable(ours, [(e.taut, e.object) for e in exh.stable],
                                                 sheet.size, tol=1e-9)
@@ -271,7 +273,7 @@ def main(argv=None):
         report["latency"].append({"N": n, **{k: v for k, v in t.items()}})
     sheet, formation = mm_team(1000, rng)
     start, cpu = time.perf_counter(), time.process_time()
-    forward_kinematics(sheet, formation, 2.0 * sheet.size)
+    forward_kinematics(SheetTeam(sheet, 2.0 * sheet.size), formation)
     big, big_cpu = time.perf_counter() - start, time.process_time() - cpu
     print(f"N=1000: one forward_kinematics call {big_cpu:.2f} s CPU ({big:.2f} s wall)")
     report["n1000_s"] = {"cpu": big_cpu, "wall": big}

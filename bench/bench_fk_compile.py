@@ -25,13 +25,13 @@ t0 = time.perf_counter()
 import numpy as np
 import taut.sheet as ts
 t1 = time.perf_counter()
-sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
-solver = ts.FKSolver(sheet, 1.0)
+team = ts.SheetTeam(ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]]), 1.0)
+solver = ts.FKSolver(team)
 solver.solve([[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]]).equilibria
 t2 = time.perf_counter()
 solver.solve_batch(np.array([[[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]]] * 2))
 t3 = time.perf_counter()
-sim = ts.Simulator(sheet, 1.0, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], dt=0.1)
+sim = ts.Simulator(team, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], dt=0.1)
 sim.step(velocities=np.tile([0.01, 0.0], (4, 1)))
 t4 = time.perf_counter()
 print(json.dumps({"import_s": t1 - t0, "first_solve_s": t2 - t1, "first_batch_s": t3 - t2,

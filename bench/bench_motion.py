@@ -28,6 +28,7 @@ from taut.sheet import inverse_kinematics
 from taut.sheet.ik._certificate import verify_certificate
 from taut.sheet import random_team
 from taut.sheet import simulate
+from taut.sheet import SheetTeam
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def stable_team(n, rng, **kw):
     while True:
         sheet, R = random_team(n, rng, **kw)
-        fk = forward_kinematics(sheet, R, 1.0)
+        fk = forward_kinematics(SheetTeam(sheet, 1.0), R)
         if fk.stable:
             return sheet, R, fk
 
@@ -83,7 +84,7 @@ def _check_ik(sheet, p, vo, r, all_taut: bool = False) -> str:
     if all_taut and not r.success:
         return "WRONG:refused-own-formation"
     if r.success:
-        back = forward_kinematics(sheet, r.formation, 1.0)
+        back = forward_kinematics(SheetTeam(sheet, 1.0), r.formation)
         hit = any(q.stable and len(q.taut) == sheet.n
                   and np.linalg.norm(q.object - p) <= 1e-6 * sheet.size
                   for q in back.equilibria)
@@ -104,13 +105,14 @@ def bench_ik(count: int, seed: int = 2026) -> None:
     rng = np.random.default_rng(seed)
     print(f"\n## Inverse kinematics on {count} targets from stable FK states of random teams "
           "(N = 3..12)\n")
-    inverse_kinematics(Sheet.regular(4, 1.0), [0, 0, 0.5], 1.0)          # warm-up
+    inverse_kinematics(SheetTeam(Sheet.regular(4, 1.0), 1.0), [0, 0, 0.5])     # warm-up
     outcome: dict[str, list[float]] = {}
     per_n: dict[int, dict[str, int]] = {}
     worst = (0.0, "")
     for sheet, p, vo, all_taut in ik_targets(count, rng):
         t0 = time.perf_counter()
-        r = inverse_kinematics(sheet, p, 1.0, contact=vo, heading=rng.uniform(-np.pi, np.pi))
+        r = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo,
+                               heading=rng.uniform(-np.pi, np.pi))
         dt = time.perf_counter() - t0
         key = _check_ik(sheet, p, vo, r, all_taut)
         worst = max(worst, (dt, f"N = {sheet.n}, {key}"))
@@ -149,9 +151,10 @@ def bench_sim(T: int) -> None:
                 R = smooth(R0, T)
             else:
                 R = keyframes(sheet, R0, rng, 5, max(T // 5, 2))
-            simulate(sheet, R[:50], 1.0)                                    # warm-up
+            team = SheetTeam(sheet, 1.0)
+            simulate(team, R[:50])                                          # warm-up
             t0 = time.perf_counter()
-            res = simulate(sheet, R, 1.0)
+            res = simulate(team, R)
             dt = time.perf_counter() - t0
             print(f"| {n} | {kind} | {len(R)} | {len(res.events)} | {len(res.jumps)} | "
                   f"{len(R) / dt:,.0f} |")
@@ -171,7 +174,7 @@ def bench_vvcm(T: int) -> None:
     for n in (4, 5, 6, 8):
         sheet, R0, _ = stable_team(n, rng, slack=(0.6, 0.8))
         R = smooth(R0, T)
-        res = simulate(sheet, R, 1.0)
+        res = simulate(SheetTeam(sheet, 1.0), R)
         mm = 1000.0
         sim = vvcm_rs.VvcmManualSimulation(1000.0, np.ascontiguousarray(
             sheet.vertices * mm, dtype=np.float32))
@@ -193,7 +196,7 @@ def bench_vvcm(T: int) -> None:
     # The square-sheet jump: vvcm-rs picks the stable state closest to the last one.
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
     R = load_trajectory(ROOT / "examples/sheet/trajectories/square4_jump.csv").formations
-    res = simulate(sheet, R, 1.5)
+    res = simulate(SheetTeam(sheet, 1.5), R)
     sim = vvcm_rs.VvcmManualSimulation(1500.0, np.ascontiguousarray(sheet.vertices * 1000,
                                                                     dtype=np.float32))
     sim.init(np.ascontiguousarray(R[0] * 1000, dtype=np.float32),
@@ -243,7 +246,7 @@ def bench_step_rate(steps: dict[int, int], rounds: int) -> None:
         path = smooth(R0 * 1000.0, rounds * T + 1)
         vel = np.diff(path, axis=0) / dt                       # (rounds*T, N, 2) mm/s
         V32 = sheet.vertices.astype(np.float32)
-        ours = Simulator(sheet, 1000.0, path[0], dt=dt)
+        ours = Simulator(SheetTeam(sheet, 1000.0), path[0], dt=dt)
         ours.step(velocities=vel[0])                # warm-up: loads the compiled code
         ours.step(formation=path[0])
         peers = _peer_sims(n, V32, path[0].astype(np.float32), dt)

@@ -8,7 +8,7 @@ Measures, in one process on this machine:
 
 * per mesh spacing (``mesh`` = spacings across the sheet's widest vertex pair) on the FK
   paper's Example 1 (4 robots) and Example 2 (8 robots): nodes, tendons (with the corner
-  tendons), time to mesh and compile one state's model, wall time of ``check_equilibria`` over every state, and the largest height /
+  tendons), time to mesh and compile one state's model, wall time of ``replay_equilibria`` over every state, and the largest height /
   lateral differences physics vs taut (tied point load and released ball); the spacings
   are interleaved and repeated, medians and ranges quoted;
 * on random teams (``taut.sheet.random.random_team``, 3-8 robots, sheets about 2 units
@@ -29,10 +29,10 @@ from pathlib import Path
 import numpy as np
 
 from taut.io import load_sheet_scenario
-from taut.physics import check_equilibria
+from taut.physics import replay_equilibria
 from taut.physics._mesh import sheet_mesh
 from taut.physics._sheet_model import build_sheet_sim
-from taut.sheet import forward_kinematics
+from taut.sheet import SheetTeam, forward_kinematics
 from taut.sheet import random_team
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -46,11 +46,12 @@ def _lateral(d: np.ndarray) -> float:
 
 def _build_time(sc, mesh: int) -> tuple[float, int]:
     """Seconds to mesh and compile the model of the first state; its tendon count."""
-    eq = forward_kinematics(sc.sheet, sc.formation, sc.hold_height).equilibria[0]
-    D = float(np.max(sc.sheet.side_lengths()))
+    team = sc.team
+    eq = forward_kinematics(team, sc.formation).equilibria[0]
+    D = float(np.max(team.sheet.side_lengths()))
     t0 = time.perf_counter()
-    m = sheet_mesh(sc.sheet.vertices, mesh, contact=eq.contact)
-    sim = build_sheet_sim(m, sc.sheet.vertices, sc.formation, sc.hold_height,
+    m = sheet_mesh(team.sheet.vertices, mesh, contact=eq.contact)
+    sim = build_sheet_sim(m, team.sheet.vertices, sc.formation, team.hold_height,
                           ball_radius=0.05 * D / mesh, ball_start=None, tie=True,
                           corner_tendons=True)
     return time.perf_counter() - t0, int(sim.model.ntendon)
@@ -65,13 +66,13 @@ def spacing_table(meshes: list[int], repeats: int) -> list[dict]:
             for mesh in meshes:
                 builds.setdefault((name, mesh), []).append(_build_time(sc, mesh))
                 t0 = time.perf_counter()
-                r = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=mesh)
+                r = replay_equilibria(sc.team, sc.formation, mesh=mesh)
                 wall = time.perf_counter() - t0
                 rows.setdefault((name, mesh), []).append((wall, r))
     out = []
     for (name, mesh), runs in rows.items():
         sc = load_sheet_scenario(EXAMPLES[name])
-        m = sheet_mesh(sc.sheet.vertices, mesh)
+        m = sheet_mesh(sc.team.sheet.vertices, mesh)
         walls = np.array([w for w, _ in runs])
         r = runs[-1][1]
         stable = [s for s in r.states if s.status == "stable"]
@@ -98,7 +99,7 @@ def random_study(teams: int, seed: int) -> dict:
         sheet, R = random_team(n, rng)
         width = float(np.max(sheet.side_lengths()))
         t0 = time.perf_counter()
-        r = check_equilibria(sheet, R, 1.6)
+        r = replay_equilibria(SheetTeam(sheet, 1.6), R)
         walls.append((n, time.perf_counter() - t0, len(r.states)))
         for s in r.states:
             states.append({"team": k, "n": n, "status": s.status, "held": s.held,

@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from taut.io.plan_scenario import load_plan_scenario
-from taut.plan import generate_suite, plan, resample_motion, verify_motion
+from taut.plan import generate_suite, plan, plan_robustness, resample_motion, verify_motion
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -101,7 +101,7 @@ def row(sc, budget: dict, margin_study: bool, sigma: float | None, trials: int) 
         out["min_clearance"] = r.verification.min_clearance
         out["min_height_margin"] = r.verification.min_height_margin
         if sigma is not None:
-            rob = r.robustness(sigma, trials, seed=1)
+            rob = plan_robustness(r, sigma, trials, seed=1)
             out.update(tear=rob.tear_probability, drop=rob.drop_probability,
                        contact=rob.contact_probability, collision=rob.collision_probability,
                        unsafe=rob.unsafe_probability, failure=rob.failure_probability,

@@ -51,7 +51,7 @@ def api_seconds(spec, chunk: int) -> float:
     forms = transform_formations(sc.formation, params, point_seeds(spec, cols["point"]))
     t0 = time.perf_counter()
     for lo, hi in chunk_bounds(spec.size, chunk):
-        forward_kinematics_batch(sc.sheet, forms[lo:hi], sc.hold_height, mass=sc.mass)
+        forward_kinematics_batch(sc.team, forms[lo:hi])
     return time.perf_counter() - t0
 
 

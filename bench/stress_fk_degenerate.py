@@ -26,6 +26,7 @@ import numpy as np
 
 from taut.errors import TautError
 from taut.sheet import FKSolver, Sheet, forward_kinematics
+from taut.sheet import SheetTeam
 
 
 def main() -> None:
@@ -46,7 +47,7 @@ def main() -> None:
         noise = 10.0 ** rng.uniform(-13, -7)
         R = V * rng.uniform(0.3, 0.95) + rng.normal(scale=noise, size=V.shape)
         try:
-            res = forward_kinematics(Sheet(V), R, rng.uniform(2, 6))
+            res = forward_kinematics(SheetTeam(Sheet(V), rng.uniform(2, 6)), R)
         except TautError:
             continue
         kind = "ok" if res.stable else ("nostable" if res.equilibria else "none")
@@ -68,9 +69,9 @@ def main() -> None:
 def _compare(sheet: Sheet, R: np.ndarray, res, dec: int, counts: Counter,
              worst: Counter) -> None:
     """Count disagreements of "subsets" and of the numpy backend with ``res``."""
-    z = res.hold_height
-    other = {"methods": FKSolver(sheet, z, method="subsets").solve(R),
-             "backends": FKSolver(sheet, z, backend="numpy").solve(R)}
+    team = SheetTeam(sheet, res.hold_height)
+    other = {"methods": FKSolver(team, method="subsets").solve(R),
+             "backends": FKSolver(team, backend="numpy").solve(R)}
     for name, o in other.items():
         if [e.taut for e in o.stable] != [e.taut for e in res.stable]:
             counts[(dec, name)] += 1

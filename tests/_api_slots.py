@@ -27,7 +27,8 @@ NOT_CALLED: dict[str, str] = {
     **{name: "result container built by an analysis, not by users" for name in (
         "FKResult BatchFKResult Equilibrium Funnel IKResult IKConstraints SimulationResult "
         "SimulationEvent FormationMetrics IKCertificate SimulatorState PlanResult Formation "
-        "Leg Route Motion CrossingRecord Verification Certificate Robustness CableState "
+        "Leg Route Motion CrossingRecord Verification Certificate Robustness PlanProfile "
+        "CableState "
         "TensionResult TippingResult WorkspaceResult AvailableWrenchSet AxisCapacities "
         "AvailableTwistSet FirstOrderModel TwistCapacities RedundancyResult DeploymentResult "
         "LiftBound TallestWorkspace Mode HPolytopeBatch Interference CableFKResult "
@@ -43,8 +44,8 @@ NOT_CALLED: dict[str, str] = {
 #: Callables whose valid call runs a search or a simulation (seconds): only their model
 #: and array slots are fuzzed in the fast suite, every slot under ``-m slow``.
 HEAVY = frozenset(
-    "plan plan_baseline simulate monte_carlo settle check_equilibria check_tipping "
-    "check_tipping_grid run_sweep tallest_workspace plan_deployment lift_bound "
+    "plan plan_robustness simulate monte_carlo settle replay_equilibria replay_tipping "
+    "replay_tipping_grid run_sweep tallest_workspace plan_deployment lift_bound "
     "generate_suite find_route formation_library optimal_formation inverse_kinematics "
     "find_certificate motion_from_legs verify_motion Simulator cable_forward_kinematics "
     "evaluate_chunk plan_moving_deployment staged_lift_bound".split())
@@ -57,7 +58,8 @@ def fixtures() -> dict[str, Any]:
                            pick_and_place, resolve_mode, available_twist_set)
     from taut.io import load_cdpr_model, plan_scenario_to_mapping
     from taut.plan import generate_scenario, formation_library
-    from taut.sheet import Sheet
+    from taut.plan.result import failure
+    from taut.sheet import Sheet, SheetTeam
 
     robot = load_cdpr_model("fastkit")
     pose = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
@@ -65,13 +67,15 @@ def fixtures() -> dict[str, Any]:
     scenario = generate_scenario(0)
     nominal = formation_library(scenario)[0]
     sheet = Sheet.regular(4, 1.0)
+    sheet_team = SheetTeam(sheet, 1.0)
     formation = 0.8 * np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
     limits = fastkit_motion_limits()
     from taut.sweep.file import load_sweep
     spec = load_sweep(str(ROOT / "examples/sweeps/octagon_stability_small.yaml"))
     return dict(
         robot=robot, pose=pose, state=state, scenario=scenario, nominal=nominal,
-        sheet=sheet, formation=formation, limits=limits, spec=spec,
+        no_plan=failure(scenario, "no plan", "disc"),
+        sheet=sheet, sheet_team=sheet_team, formation=formation, limits=limits, spec=spec,
         tensions=distribute_tensions(robot, pose).tensions,
         mode=resolve_mode(robot), ats=available_twist_set(robot, pose),
         reference=pick_and_place(robot, [[0, 0, 1.0], [0.05, 0, 1.0]], rate=200.0),
@@ -103,6 +107,7 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         "model_errors": [], "friction": 0.5, "deployed": True, "stages": 2,
         "positions": np.zeros((1, len(f["robot"].bases), 3)), "fld": "footprint",
         "scenario": f["scenario"], "team": f["scenario"].team, "clearance": 0.05,
+        "carrier": f["sheet_team"],
         "robots": np.zeros((2, f["scenario"].team.sheet.n, 2)),
         "planned_object": np.zeros((2, 3)), "factor": 2, "seed": 0,
         "spec": f["spec"], "start": 0, "stop": 2, "out": "{tmp}/sweep", "path": str(ROOT / "src" / "taut" / "data" / "fastkit.yaml"),
@@ -119,11 +124,13 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.plan", "resample_motion"): {"robots": np.zeros((2, 4, 2)),
                                            "planned_object": np.zeros((2, 3))},
         ("taut.plan", "verify_motion"): {},
+        ("taut.plan", "plan_profile"): {"result": f["no_plan"]},
+        ("taut.plan", "plan_robustness"): {"result": f["no_plan"]},
         ("taut.plan", "generate_scenario"): {"seed": 0},
         ("taut.plan", "Obstacle"): {"id": "a", "height": 0.1, "center": (0.0, 0.0),
                                    "radius": 0.1},
         ("taut.plan", "World"): {"free_space": [[0, 0], [5, 0], [5, 5], [0, 5]]},
-        ("taut.plan", "Team"): {"sheet": f["sheet"], "hold_height": 1.0,
+        ("taut.plan", "Team"): {"carrier": f["sheet_team"],
                                "robot_radius": 0.05, "height_safety": 0.01,
                                "lateral_safety": 0.01, "speed": 0.1,
                                "rotation_speed": 0.1},
@@ -156,14 +163,19 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.cdpr", "footprint_overlap"): {"box": np.array([[-0.1, -0.1], [0.1, 0.1]])},
         ("taut.cdpr", "reference_from_samples"): {"times": [0.0, 0.1, 0.2],
                                                   "poses": [[0, 0, 1.0, 0, 0, 0]] * 3},
-        ("taut.physics", "check_tipping"): {"pose": f["pose"], "duration": 0.05,
-                                            "tensions": f["tensions"][0]},
-        ("taut.physics", "check_tipping_grid"): {"poses": f["pose"], "duration": 0.05},
+        ("taut.physics", "replay_tipping"): {"pose": f["pose"], "duration": 0.05,
+                                             "tensions": f["tensions"][0]},
+        ("taut.physics", "replay_tipping_grid"): {"poses": f["pose"], "duration": 0.05},
         ("taut.physics", "settle"): {"max_time": 0.05, "mesh": 4},
-        ("taut.physics", "check_equilibria"): {"mesh": 4},
+        ("taut.physics", "replay_equilibria"): {"mesh": 4},
         ("taut.sweep", "Parameter"): {"name": "hold_height", "values": np.array([1.0])},
         ("taut.sweep", "SweepSpec"): {"task": f["spec"].task, "parameters": f["spec"].parameters},
         ("taut.sweep", "run_sweep"): {"limit": 2},
+        ("taut.sweep", "load_sweep"): {
+            "path": str(ROOT / "examples/sweeps/octagon_stability_small.yaml")},
+        ("taut.sweep", "sweep_from_mapping"): {
+            "data": {"task": "plan_suite", "parameters": {"scenario_seed": [0, 1]}}},
+        ("taut.sweep", "read_results"): {"folder": "{tmp}"},
         ("taut.io", "validate_mapping"): {"model": _Point, "data": {"x": 1.0}},
         ("taut.io", "read_mapping"): {"path": str(ROOT / "examples/sheet/example1.yaml")},
         ("taut.io", "read_text"): {"path": "pyproject.toml"},
@@ -175,7 +187,6 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
                                                                "hold_height": 1.0}},
         ("taut.io", "cdpr_model_from_mapping"): {"data": None},
         ("taut.io", "plan_scenario_to_mapping"): {"scenario": f["scenario"]},
-        ("taut.sheet", "FKSolver"): {"sheet": f["sheet"]},
         ("taut.sheet", "random_convex_polygon"): {"n": 4, "rng": np.random.default_rng(0)},
         ("taut.sheet", "random_team"): {"n": 4, "rng": np.random.default_rng(0)},
         ("taut.sheet", "random_scattered_team"): {"n": 4, "rng": np.random.default_rng(0)},
@@ -187,6 +198,8 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         from importlib import resources
         text = resources.files("taut.data").joinpath("fastkit.yaml").read_text()
         return {"data": yaml.safe_load(text)}
+    if module == "taut.sheet":                  # a sheet analysis takes the sheet team
+        by_name["team"] = f["sheet_team"]
     func = getattr(importlib.import_module(module), name)
     extra = overrides.get((module, name), {})
     out: dict[str, Any] = {}

@@ -16,10 +16,12 @@ from taut.errors import TautError
 from taut.io import load_cdpr_model
 from taut.plan import generate_scenario
 from taut.sheet import Sheet, forward_kinematics, forward_kinematics_batch, inverse_kinematics
+from taut.sheet import SheetTeam
 from taut.cdpr import (available_wrench_set, axis_capacities, distribute_tensions,
                        wrench_feasible)
 
 SHEET = Sheet.regular(4, 1.0)
+TEAM = SheetTeam(SHEET, 1.0)
 FORMATION = 0.8 * np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
 ROBOT = load_cdpr_model("fastkit")
 
@@ -64,7 +66,7 @@ _FAST = settings(max_examples=40, deadline=None,
 @_FAST
 @given(formation=odd_arrays, hold=odd_scalars, mass=st.one_of(st.none(), odd_scalars))
 def test_forward_kinematics(formation, hold, mass):
-    r = _check(lambda: forward_kinematics(SHEET, formation, hold, mass=mass))
+    r = _check(lambda: forward_kinematics(SheetTeam(SHEET, hold, mass=mass), formation))
     if r is not None:
         for e in r.equilibria:
             _finite_or_absent(e.tensions)
@@ -74,20 +76,21 @@ def test_forward_kinematics(formation, hold, mass):
 @_FAST
 @given(formations=odd_arrays, hold=odd_scalars)
 def test_forward_kinematics_batch(formations, hold):
-    _check(lambda: forward_kinematics_batch(SHEET, formations, hold))
+    _check(lambda: forward_kinematics_batch(SheetTeam(SHEET, hold), formations))
 
 
 @_FAST
 @given(sheet=st.one_of(models, odd_arrays))
 def test_models_in_wrong_places(sheet):
-    _check(lambda: forward_kinematics(sheet, FORMATION, 1.0))
-    _check(lambda: inverse_kinematics(sheet, (0.0, 0.0, 0.3), 1.0))
+    _check(lambda: SheetTeam(sheet, 1.0))
+    _check(lambda: forward_kinematics(sheet, FORMATION))
+    _check(lambda: inverse_kinematics(sheet, (0.0, 0.0, 0.3)))
 
 
 @_FAST
 @given(target=odd_arrays, hold=odd_scalars)
 def test_inverse_kinematics(target, hold):
-    _check(lambda: inverse_kinematics(SHEET, target, hold))
+    _check(lambda: inverse_kinematics(SheetTeam(SHEET, hold), target))
 
 
 @_FAST
@@ -124,8 +127,8 @@ def test_generate_scenario(seed, n):
 
 def test_lists_tuples_ints_are_arrays():
     """Where arrays are documented, lists, tuples and ints give the same answer."""
-    a = forward_kinematics(SHEET, FORMATION, 1.0)
-    b = forward_kinematics(SHEET, tuple(map(tuple, FORMATION.tolist())), 1)
+    a = forward_kinematics(SheetTeam(SHEET, 1.0), FORMATION)
+    b = forward_kinematics(SheetTeam(SHEET, 1), tuple(map(tuple, FORMATION.tolist())))
     assert [e.taut for e in a.equilibria] == [e.taut for e in b.equilibria]
     np.testing.assert_allclose([e.object for e in a.equilibria],
                                [e.object for e in b.equilibria])
@@ -135,7 +138,7 @@ def test_lists_tuples_ints_are_arrays():
 
 
 @pytest.mark.parametrize("call, field", [
-    (lambda: forward_kinematics_batch(SHEET, np.empty((0, 4, 2)), 1.0), "formations"),
+    (lambda: forward_kinematics_batch(TEAM, np.empty((0, 4, 2))), "formations"),
     (lambda: distribute_tensions(None, [0, 0, 1]), "robot"),
     (lambda: distribute_tensions(ROBOT, np.empty((0, 6))), "pose"),
     (lambda: generate_scenario(0, 0), "n_robots"),

@@ -83,12 +83,12 @@ KNOWN_HEAVY_GAPS: frozenset[tuple[str, str]] = frozenset()
 #: given a wrong value, or the valid default ``None`` that the fixed wrong values include):
 #: known gaps, not run (each would cost ``BOUND_S`` of CI time to fail again).
 HEAVY_HANGS = frozenset({
-    ("plan_deployment", "disturbance"), ("plan_deployment", "limits"),
+    ("plan_deployment", "limits"),
     ("plan_deployment", "moving"), ("plan_deployment", "options"),
     ("plan_deployment", "required_twist"), ("plan_deployment", "robot"),
     ("plan_moving_deployment", "external_wrench"), ("plan_moving_deployment", "limits"),
     ("plan_moving_deployment", "moving"), ("plan_moving_deployment", "required_twist"),
-    ("plan_moving_deployment", "robot"), ("tallest_workspace", "disturbance"),
+    ("plan_moving_deployment", "robot"),
     ("tallest_workspace", "stages"), ("tallest_workspace", "warm_start"),
     ("tallest_workspace", "robot"),
     # refused with a TautError on an idle machine, past the bound on a loaded one

@@ -143,9 +143,10 @@ def test_sheet_single_and_batch_forms_agree():
 
     from taut.io.sheet_scenario import load_sheet_scenario
     sc = load_sheet_scenario(Path(__file__).parent.parent / "examples/sheet/example1.yaml")
-    s, R, z = sc.sheet, np.asarray(sc.formation, dtype=float), sc.hold_height
-    one = sheet_api.forward_kinematics(s, R, z)
-    many = sheet_api.forward_kinematics_batch(s, np.stack([R, R * 1.01]), z)
+    team, R = sc.team, np.asarray(sc.formation, dtype=float)
+    s = team.sheet
+    one = sheet_api.forward_kinematics(team, R)
+    many = sheet_api.forward_kinematics_batch(team, np.stack([R, R * 1.01]))
     assert many.count.shape == (2,)
     first = many.result(0)
     assert [e.taut for e in first.equilibria] == [e.taut for e in one.equilibria]
@@ -154,6 +155,6 @@ def test_sheet_single_and_batch_forms_agree():
     assert sheet_api.check_formation(s, R).shape == R.shape
     assert sheet_api.check_formations(s, R[None]).shape == (1,) + R.shape
     with pytest.raises(TautError):
-        sheet_api.forward_kinematics(s, np.stack([R, R]), z)    # a batch to the single form
+        sheet_api.forward_kinematics(team, np.stack([R, R]))    # a batch to the single form
     with pytest.raises(TautError):
-        sheet_api.forward_kinematics_batch(s, R, z)             # one formation to the batch
+        sheet_api.forward_kinematics_batch(team, R)             # one formation to the batch

@@ -14,12 +14,12 @@ import taut.sheet
 
 #: The outcome types that can answer "no" to a valid question (issue 10, "Done when").
 REQUIRED = {
-    "taut.sheet": ["IKResult", "SimulationResult"],
+    "taut.sheet": ["IKResult", "SimulationResult", "FKResult", "BatchFKResult"],
     "taut.plan": ["PlanResult"],
     "taut.cdpr": ["TensionResult", "RedundancyResult", "DeploymentResult"],
 }
 #: Public result types that only report facts and cannot fail (no success flag needed).
-FACTS_ONLY = {"FKResult", "BatchFKResult", "TippingResult", "WorkspaceResult"}
+FACTS_ONLY = {"TippingResult", "WorkspaceResult"}
 
 MODULES = {"taut.sheet": taut.sheet, "taut.plan": taut.plan, "taut.cdpr": taut.cdpr}
 
@@ -61,16 +61,16 @@ def test_outcome_has_success_status_message(modname, name, cls):
 
 @pytest.mark.parametrize("pkg", ["taut.sheet", "taut.plan", "taut.cdpr"])
 def test_one_public_import_path(pkg):
-    """Every name a public submodule's ``__all__`` lists is the package's own name (issue
-    10: one public import path per name); private modules start with an underscore."""
+    """Every name a public module's ``__all__`` lists, in any sub-folder, is the package's
+    own name (one public import path per name); private modules start with an underscore."""
     import importlib
     import pkgutil
 
     package = importlib.import_module(pkg)
-    for mod in pkgutil.iter_modules(package.__path__):
-        if mod.name.startswith("_"):
+    for mod in pkgutil.walk_packages(package.__path__, prefix=f"{pkg}."):
+        if any(part.startswith("_") for part in mod.name.split(".")):
             continue
-        m = importlib.import_module(f"{pkg}.{mod.name}")
+        m = importlib.import_module(mod.name)
         for name in getattr(m, "__all__", ()):
             assert name in package.__all__ and getattr(package, name) is getattr(m, name), \
-                f"{pkg}.{mod.name}.{name} is not re-exported by {pkg}"
+                f"{mod.name}.{name} is not re-exported by {pkg}"

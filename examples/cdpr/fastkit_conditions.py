@@ -82,7 +82,7 @@ def main() -> None:
                      "closure_check_%": pct(float(wrench_closure(robot, pts).mean())),
                      "inside_exits_box_%": pct(boxed.coverage_inside),
                      "sliding": {f"{'stabilisers' if stab else 'retracted'} mu={mu}":
-                                 coverage(with_friction(with_stabilisers(robot, stab), mu))
+                                 coverage(with_friction(with_stabilisers(robot, deployed=stab), mu))
                                  for stab in (False, True) for mu in (0.3, 0.6)}}
         light = robot.__class__(robot.bases, robot.platform, robot.cables,
                                 gravity=robot.gravity, desired_workspace=robot.desired_workspace,
@@ -96,7 +96,7 @@ def main() -> None:
     robot = load_cdpr_model("fastkit")
     sliding = {}
     for stab in (False, True):
-        base = with_stabilisers(robot, stab)
+        base = with_stabilisers(robot, deployed=stab)
         ref = coverage(base)["tipping_%"]
         for mu in MUS:
             c = coverage(with_friction(base, mu))

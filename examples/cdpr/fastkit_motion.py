@@ -106,14 +106,14 @@ def main() -> None:
                        "FASTKIT wrench capacity at (1, 0, 0.8) m (cf. Fig. 14)",
                        HERE / "fastkit_wrench_capacities.png")
     step("deployment of the 5 m x 0.8 m box")
-    dep = plan_deployment(with_stabilisers(robot, True), BOX, required_twist=TWIST,
+    dep = plan_deployment(with_stabilisers(robot), BOX, required_twist=TWIST,
                           maxiter=10, popsize=8, search=(1.5, 0.5, 0.6), grid=(6, 2, 4),
                           verify_grid=(21, 3, 9), seed=0)
     plot_deployment(dep, HERE / "fastkit_deployment.png",
                     title=f"FASTKIT deployment, 5 m x 0.1 m x 0.8 m box: worst capacity "
                           f"margin {dep.margin:.2f}")
     step("the paper's 5 m x 2 m box")
-    full = plan_deployment(with_stabilisers(robot, True), FULL, **PLAN)
+    full = plan_deployment(with_stabilisers(robot), FULL, **PLAN)
     high = raise_exits(robot, RAISE)
     out = {
         "pose": rnd(POSE),
@@ -135,10 +135,10 @@ def main() -> None:
                              "evaluations": full.evaluations,
                              "reason": "" if full.success else full.message,
                              "certificate": certificate(full.lift_bound)},
-        "tallest": tallest(with_stabilisers(robot, True)),
+        "tallest": tallest(with_stabilisers(robot)),
         "exits_raised_0.5m": {"exit_heights": sorted(set(rnd(high.exits_world[:, 2]))),
                               "certificate_5x2m": certificate(lift_bound(high, FULL)),
-                              "tallest": tallest(with_stabilisers(high, True))},
+                              "tallest": tallest(with_stabilisers(high))},
     }
     step("done")
     (HERE / "fastkit_motion.json").write_text(json.dumps(out, indent=1) + "\n")

@@ -37,7 +37,7 @@ def poses(d: dict) -> dict:
 
 
 def main() -> None:
-    robot = with_stabilisers(load_cdpr_model("fastkit"), True)
+    robot = with_stabilisers(load_cdpr_model("fastkit"))
     out: dict = {"stages": STAGES, "plan": {k: list(v) if isinstance(v, (list, tuple)) else v
                                             for k, v in PLAN.items()}}
     step(f"tallest box, {STAGES} stages (bisection, tol 0.05 m)")

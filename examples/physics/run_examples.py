@@ -19,7 +19,7 @@ import numpy as np
 from taut.cdpr import distribute_tensions
 from taut.io import load_sheet_scenario
 from taut.io.cdpr_model import load_cdpr_model
-from taut.physics import check_equilibria, check_tipping
+from taut.physics import replay_equilibria, replay_tipping
 from taut.viz.physics import plot_equilibria_check
 
 HERE = Path(__file__).resolve().parent
@@ -28,7 +28,7 @@ SHEET = HERE.parent / "sheet"
 
 def sheet_table(name: str, path: Path, figure: str) -> None:
     sc = load_sheet_scenario(path)
-    r = check_equilibria(sc.sheet, sc.formation, sc.hold_height)
+    r = replay_equilibria(sc.team, sc.formation)
     print(f"\n### {name}\n\n{r.message} (mesh {r.mesh}, ball radius {r.ball:.1f} mm)\n")
     print("| taut set | taut: z_o [mm] | taut says | physics | pull / mg | tied dx, dy, dz [mm] "
           "| released dx, dy, dz [mm] | s |")
@@ -39,7 +39,7 @@ def sheet_table(name: str, path: Path, figure: str) -> None:
         print(f"| {label} | {s.predicted[2]:.1f} | {s.status.replace('_', ' ')} | "
               f"{'held' if s.held else 'not held'} | {s.sliding:.3f} | "
               f"{fmt(s.tied_difference)} | {fmt(s.difference)} | {s.time:.1f} |")
-    fig = plot_equilibria_check(r, sc.formation, sc.hold_height, HERE / figure, units="mm",
+    fig = plot_equilibria_check(r, sc.formation, sc.team.hold_height, HERE / figure, units="mm",
                                 title=name)
     plt.close(fig)
 
@@ -53,7 +53,7 @@ def tipping_table() -> None:
     for x, z in ((-2.0, 0.2), (2.0, 0.2), (1.5, 1.0), (-1.0, 1.4), (0.0, 1.4)):
         pose = [x, 0.0, z, 0.0, 0.0, 0.0]
         t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions
-        c = check_tipping(robot, pose, t)
+        c = replay_tipping(robot, pose, t)
         print(f"| {x:+.1f}, {z:.1f} | {c.margin:+.1f} | "
               f"{'stays' if c.taut_stays else 'tips'} | {', '.join(c.verdicts)} | "
               f"{', '.join(f'{v:.1f}' for v in c.tilt)} | "

@@ -11,16 +11,13 @@ types, each analysis that can answer "no" to a valid question returns a frozen r
     One human line: what was found, or why not.
 
 Exceptions (subclasses of :class:`taut.errors.TautError`) are for invalid input only.
-Old attribute names (``reason``, ``feasible``, ``ok``, ``found``) stay as read-only
-deprecated aliases for one release via :func:`deprecated_alias`.
 """
 
 from __future__ import annotations
 
-import warnings
-from typing import Any, Literal
+from typing import Literal
 
-__all__ = ["Status", "STATUSES", "deprecated_alias", "check_status"]
+__all__ = ["Status", "STATUSES", "check_status"]
 
 #: Every status value used by a taut result.
 Status = Literal[
@@ -48,38 +45,3 @@ def check_status(status: str) -> str:
         raise ValueError(f"unknown status {status!r}; expected one of {STATUSES}")
     return status
 
-
-def deprecated_alias(new: str, old: str, *, transform: Any = None) -> property:
-    """A read-only property ``old`` that warns and returns ``getattr(self, new)``.
-
-    Parameters
-    ----------
-    new : str
-        Name of the attribute that replaces the old one.
-    old : str
-        The deprecated name (used in the warning only).
-    transform : callable, optional
-        Applied to the new attribute's value (e.g. ``message`` -> ``None`` on success
-        for the old ``reason`` field).
-
-    Examples
-    --------
-    >>> from dataclasses import dataclass
-    >>> @dataclass(frozen=True)
-    ... class R:
-    ...     message: str
-    ...     reason = deprecated_alias("message", "reason")
-    >>> import warnings
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore")
-    ...     R("no route").reason
-    'no route'
-    """
-
-    def getter(self: Any) -> Any:
-        warnings.warn(f"'{old}' is deprecated; use '{new}'", DeprecationWarning, stacklevel=2)
-        value = getattr(self, new)
-        return transform(self, value) if transform is not None else value
-
-    getter.__doc__ = f"Deprecated alias of ``{new}`` (kept for one release)."
-    return property(getter)

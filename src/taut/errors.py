@@ -15,7 +15,6 @@ __all__ = [
     "InvalidSheetError",
     "InfeasibleFormationError",
     "ScenarioError",
-    "UnreachableTargetError",
     "InvalidTrajectoryError",
     "InvalidModelError",
     "InfeasiblePoseError",
@@ -67,10 +66,6 @@ class InfeasibleFormationError(TautError):
 
 class ScenarioError(InvalidInputError):
     """A scenario or model file is missing, unreadable, malformed or has unknown keys."""
-
-
-class UnreachableTargetError(TautError):
-    """Inverse kinematics cannot place the object where asked; ``problem`` says why."""
 
 
 class InvalidTrajectoryError(InvalidInputError):

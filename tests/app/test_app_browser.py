@@ -88,13 +88,13 @@ def test_drag_robot_2_shows_the_fk_equilibria(page):
     f, rows = settled_sheet(d)
     assert np.linalg.norm(f[1] - sc.formation[1]) > 10.0          # robot 2 moved (mm)
     np.testing.assert_array_equal(np.delete(f, 1, 0), np.delete(sc.formation, 1, 0))
-    res = forward_kinematics(sc.sheet, f, sc.hold_height, mass=1.0)
+    res = forward_kinematics(sc.team, f)
     assert len(rows) == len(res.equilibria) > 0
     for row, e in zip(rows, res.equilibria):
         assert row[1] == "{" + ",".join(str(i + 1) for i in e.taut) + "}"
         shown = [float(v) for v in row[2:5]]
         np.testing.assert_allclose(shown, e.object, atol=0.0051)  # shown to 0.01 mm
-        assert row[5] == e.status
+        assert row[5] == e.kind
         if e.tensions is None:
             assert row[6] == "-"
         else:
@@ -113,7 +113,7 @@ def test_dragging_too_far_names_the_pair(page):
     f, rows = settled_sheet(d)
     sc = load_sheet_scenario(EX2)
     with pytest.raises(InfeasibleFormationError) as info:
-        forward_kinematics(sc.sheet, f, sc.hold_height)
+        forward_kinematics(sc.team, f)
     i, j = info.value.pair
     status = by_id(d, "sheet-status").text
     assert status.startswith(f"INFEASIBLE formation: robots {i + 1} and {j + 1} are too far apart")
@@ -181,7 +181,10 @@ def test_paper_corridor_plays_to_the_end(page):
     rows = d.execute_script("""return [...document.querySelectorAll('#plan-compare tr')].slice(1)
         .map(r => [...r.cells].map(c => c.textContent))""")
     assert rows[0][1] == "yes" and rows[0][4] == ", ".join(want.crossed)
-    assert rows[1][1] == "no" and rows[1][7].startswith("no route")
+    bypass = plan(load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml"),
+                  baseline="se2", time_budget=30.0)
+    assert rows[1][0].startswith("baseline (SE(2) bypass") and rows[1][1] == "yes"
+    assert rows[1][3] == f"{bypass.path_length:.3f}" and rows[1][4] == "-"
 
 
 def test_cable_robot_out_of_the_workspace_is_flagged(page):
@@ -197,10 +200,11 @@ def test_cable_robot_out_of_the_workspace_is_flagged(page):
     wait_for(d, "!CdprView.inflight && !CdprView.pending")
     pose = d.execute_script("return CdprView.st.pose")
     assert pose[2] > 1.9
-    assert not distribute_tensions(robot, pose, "qp_min_norm", tipping=True).success
+    want = distribute_tensions(robot, pose, "qp_min_norm", tipping=True)
+    assert not want.success
     flag = by_id(d, "cdpr-flag")
     assert flag.get_attribute("data-feasible") == "0"
-    assert flag.text.startswith("NOT wrench-feasible")
+    assert flag.text == want.message and flag.text.startswith("not wrench-feasible")
 
 
 def test_ik_click_moves_the_robots_to_the_library_formation(page):
@@ -217,7 +221,7 @@ def test_ik_click_moves_the_robots_to_the_library_formation(page):
     target = d.execute_script("return SheetView.lastTarget")
     sc = load_sheet_scenario(EX2)
     from taut.sheet import inverse_kinematics
-    want = inverse_kinematics(sc.sheet, target, sc.hold_height, reference=f0)
+    want = inverse_kinematics(sc.team, target, reference=f0)
     np.testing.assert_allclose(f, want.formation, atol=1e-9)
     assert target[2] == 420
     stable = [r for r in rows if r[5] == "stable"]
@@ -244,7 +248,7 @@ def test_simulate_plays_the_path_and_marks_the_jump(page):
     wait_for(d, "!SheetView.playing", timeout=60)
     d.execute_script("document.querySelector('input[value=drag]').click()")
     dense = np.array(d.execute_script("return SheetView.densePath()"))
-    want = simulate(load_sheet_scenario(traj / "square4.yaml").sheet, dense, 1.5, mass=0.5)
+    want = simulate(load_sheet_scenario(traj / "square4.yaml").team, dense)   # z_r 1.5, 0.5 kg
     assert want.jumps
     j = want.jumps[0]
     assert text.startswith(f"jump at step {j.step}/{len(dense) - 1}: taut "

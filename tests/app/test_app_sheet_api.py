@@ -16,6 +16,7 @@ from taut.io import load_sheet_scenario
 from taut.io.trajectory import load_trajectory
 from taut.sheet import forward_kinematics
 from taut.sheet import simulate
+from taut.sheet import SheetTeam
 
 ROOT = Path(__file__).parents[2]
 EX2 = ROOT / "examples" / "sheet" / "example2_r2_r4_353mm.yaml"
@@ -40,7 +41,7 @@ def assert_same_equilibria(got, res):
     assert got["feasible"] is True
     assert [tuple(e["taut"]) for e in got["equilibria"]] == [e.taut for e in res.equilibria]
     for g, e in zip(got["equilibria"], res.equilibria):
-        assert g["status"] == e.status
+        assert g["kind"] == e.kind
         np.testing.assert_allclose(g["object"], e.object, rtol=0, atol=1e-9)
         np.testing.assert_allclose(g["contact"], e.contact, rtol=0, atol=1e-9)
         if e.tensions is None:
@@ -54,16 +55,15 @@ def assert_same_equilibria(got, res):
 def test_example2_loads_as_the_cli_reads_it(ex2):
     sc = load_sheet_scenario(EX2)
     np.testing.assert_array_equal(ex2["formation"], sc.formation)
-    np.testing.assert_array_equal(ex2["sheet"], sc.sheet.vertices)
-    assert ex2["hold_height"] == sc.hold_height and ex2["mass"] == sc.mass
+    np.testing.assert_array_equal(ex2["sheet"], sc.team.sheet.vertices)
+    assert ex2["hold_height"] == sc.team.hold_height and ex2["mass"] == sc.team.mass
 
 
 def test_fk_of_example2_is_table_iii(api, ex2):
     got = api.fk(fk_body(ex2, ex2["formation"]))
     sc = load_sheet_scenario(EX2)
-    assert_same_equilibria(got, forward_kinematics(sc.sheet, sc.formation, sc.hold_height,
-                                                   mass=1.0))
-    stable = [e for e in got["equilibria"] if e["status"] == "stable"]
+    assert_same_equilibria(got, forward_kinematics(sc.team, sc.formation))      # mass 1 kg
+    stable = [e for e in got["equilibria"] if e["kind"] == "stable"]
     assert [e["taut"] for e in stable] == [[3, 4, 7]]         # Table III: {4, 5, 8}
     assert abs(stable[0]["object"][2] - 261.81) < 0.01
 
@@ -78,7 +78,7 @@ def test_dragging_robot_2_gives_the_library_answer(api, ex2, dx, dy):
     f[1] += (dx, dy)
     got = api.fk(fk_body(ex2, f))
     try:
-        res = forward_kinematics(sc.sheet, f, sc.hold_height, mass=1.0)
+        res = forward_kinematics(sc.team, f)
     except InfeasibleFormationError as exc:
         assert got["feasible"] is False and tuple(got["pair"]) == exc.pair
         assert got["message"] == str(exc)
@@ -115,7 +115,7 @@ def test_yaml_download_reads_back_and_runs(api, ex2, tmp_path, capsys):
     path.write_text(out["yaml"])
     back = load_sheet_scenario(path)
     np.testing.assert_array_equal(back.formation, moved)
-    assert back.mass == 2.5 and back.units == "mm"
+    assert back.team.mass == 2.5 and back.units == "mm"
     assert main(["fk", str(path), "--json"]) == 0
     assert yaml.safe_load(out["yaml"])["formation"] == moved.tolist()
 
@@ -125,7 +125,7 @@ def test_ik_formation_rests_the_object_at_the_target(api, ex2):
     ik = api.ik(dict(fk_body(ex2, ex2["formation"]), target=target,
                      reference=ex2["formation"]))["ik"]
     got = api.fk(fk_body(ex2, ik["formation"]))
-    stable = [e for e in got["equilibria"] if e["status"] == "stable"]
+    stable = [e for e in got["equilibria"] if e["kind"] == "stable"]
     assert any(np.allclose(e["object"], target, atol=1e-6) for e in stable)
 
 
@@ -135,8 +135,8 @@ def test_simulate_marks_the_jump_of_the_square_example(api):
     sc = sc["scenario"]
     traj = load_trajectory(base / "square4_jump.csv")
     got = api.simulate(dict(fk_body(sc, sc["formation"]), formations=traj.formations.tolist()))
-    want = simulate(load_sheet_scenario(base / "square4.yaml").sheet, traj.formations, 1.5,
-                    mass=1.0)
+    square = load_sheet_scenario(base / "square4.yaml").team.sheet
+    want = simulate(SheetTeam(square, 1.5, mass=1.0), traj.formations)
     kinds = [e["kind"] for e in got["simulation"]["events"]]
     assert kinds == [e.kind for e in want.events] and "jump" in kinds
     jump = next(e for e in got["simulation"]["events"] if e["kind"] == "jump")
@@ -157,3 +157,25 @@ def test_scenario_without_formation_gets_a_stable_one(api):
     sc = api.load({"text": text, "filename": "square4.yaml"})["scenario"]
     got = api.fk(fk_body(sc, sc["formation"]))
     assert got["stable_count"] >= 1
+
+
+SHEET_EXAMPLES = sorted((ROOT / "examples" / "sheet").glob("*.yaml"))
+
+
+@pytest.mark.parametrize("path", SHEET_EXAMPLES, ids=[p.stem for p in SHEET_EXAMPLES])
+def test_cli_app_and_library_give_the_same_states(api, capsys, path):
+    """On every shipped sheet example, `taut fk --json`, the app's FK endpoint and
+    `forward_kinematics` report the same states (taut sets, kinds, positions, tensions)."""
+    import json
+
+    sc = load_sheet_scenario(path)
+    res = forward_kinematics(sc.team, sc.formation)
+    assert main(["fk", str(path), "--json"]) == (0 if res.success else 1)
+    cli = json.loads(capsys.readouterr().out)
+    loaded = api.load({"example": path.name})["scenario"]
+    app = api.fk(fk_body(loaded, sc.formation, mass=sc.team.mass))
+    assert_same_equilibria(app, res)
+    assert [tuple(e["taut"]) for e in cli["equilibria"]] == [e.taut for e in res.equilibria]
+    for c, e in zip(cli["equilibria"], res.equilibria):
+        assert c["kind"] == e.kind
+        np.testing.assert_allclose(c["object"], e.object, rtol=1e-12, atol=1e-9)

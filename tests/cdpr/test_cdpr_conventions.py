@@ -1,10 +1,9 @@
 """The conventions every cable-robot analysis follows: one result convention (success,
-status, message; deprecated aliases), one default for `tipping`, one name for the extra
+status, message; no older names), one default for `tipping`, one name for the extra
 external wrench, one public import path, and the cable_state pose-index regression."""
 
 import dataclasses
 import inspect
-import warnings
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from taut.cdpr import (DeploymentResult, RedundancyResult, TensionResult, cable_
                        capacity_margin, distribute_tensions, external_wrench_box,
                        plan_deployment, resolve_redundancy, wrench_feasible,
                        wrench_feasible_workspace)
-from taut.errors import InfeasiblePoseError, InvalidInputError
+from taut.errors import InfeasiblePoseError
 
 OUTCOMES = (TensionResult, RedundancyResult, DeploymentResult)
 
@@ -24,26 +23,23 @@ OUTCOMES = (TensionResult, RedundancyResult, DeploymentResult)
 def test_outcome_types_have_success_status_message(cls):
     names = {f.name for f in dataclasses.fields(cls)}
     assert {"success", "status", "message"} <= names
-    assert isinstance(inspect.getattr_static(cls, "feasible"), property)
+    assert not hasattr(cls, "feasible") and not hasattr(cls, "reason")     # one name each
 
 
-def test_tension_outcome_and_alias(fastkit):
+def test_tension_outcome(fastkit):
     res = distribute_tensions(fastkit, [[0, 0, 0.6], [0, 0, 2.2]], "lp_min_sum")
     assert res.success.tolist() == [True, False]
     assert res.status.tolist() == ["ok", "infeasible"]
+    assert res.binding.tolist() == ["", "limits"]
     assert set(res.status) <= set(STATUSES)
     assert res.message == "1 of 2 poses balanced within the tension and tipping limits"
-    with pytest.warns(DeprecationWarning, match="'feasible' is deprecated"):
-        np.testing.assert_array_equal(res.feasible, res.success)
 
 
-def test_redundancy_outcome_and_aliases(fastkit):
+def test_redundancy_outcome(fastkit):
     ok = resolve_redundancy(fastkit, [0.3, 0, 1.0], [0.5, 0, 0, 0, 0, 0])
     bad = resolve_redundancy(fastkit, [0.3, 0, 1.0], [50.0, 0, 0, 0, 0, 0])
     assert (ok.success, ok.status) == (True, "ok")
-    assert (bad.success, bad.status) == (False, "infeasible")
-    with pytest.warns(DeprecationWarning):
-        assert ok.reason == "" and bad.reason == bad.message != ""
+    assert (bad.success, bad.status) == (False, "infeasible") and bad.message != ""
 
 
 def test_refuted_deployment_status(fastkit):
@@ -69,24 +65,16 @@ def test_tipping_is_on_by_default(fastkit):
     assert np.any(f.success & ~d.success)          # the default removes tipping poses
 
 
-def test_external_wrench_name_and_deprecated_disturbance(fastkit):
+def test_external_wrench_is_the_one_name(fastkit):
     P = [[0, 0, 0.6], [1.0, 0, 1.2]]
     D = external_wrench_box(fastkit, [3, 3, 3, 0.3, 0.3, 0.3])
     new = wrench_feasible(fastkit, P, external_wrench=D)
-    with pytest.warns(DeprecationWarning, match="'disturbance' is deprecated"):
-        old = wrench_feasible(fastkit, P, disturbance=D)
-    np.testing.assert_array_equal(new, old)
-    with pytest.warns(DeprecationWarning):
-        np.testing.assert_array_equal(capacity_margin(fastkit, P, disturbance=D),
-                                      capacity_margin(fastkit, P, external_wrench=D))
-    with pytest.warns(DeprecationWarning):
-        ws = wrench_feasible_workspace(fastkit, np.array(P), disturbance=D)
+    ws = wrench_feasible_workspace(fastkit, np.array(P), external_wrench=D)
     np.testing.assert_array_equal(ws.feasible_tipping, new)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        with pytest.raises(InvalidInputError, match="not both"):
-            wrench_feasible(fastkit, P, external_wrench=D, disturbance=D)
-    assert cdpr.disturbance_box is external_wrench_box
+    np.testing.assert_array_equal(capacity_margin(fastkit, P, external_wrench=D) > 0, new)
+    for f in (wrench_feasible, capacity_margin, wrench_feasible_workspace):
+        assert "disturbance" not in inspect.signature(f).parameters, f.__name__
+    assert not hasattr(cdpr, "disturbance_box")
 
 
 def test_cable_state_reports_the_offending_pose(point_mass):

@@ -61,7 +61,7 @@ def test_fk_figure():
     from taut.sheet import forward_kinematics
     from taut.viz.sheet import plot_fk
     sc = load_sheet_scenario(ROOT / "examples" / "sheet" / "example1.yaml")
-    r = forward_kinematics(sc.sheet, sc.formation, sc.hold_height)
+    r = forward_kinematics(sc.team, sc.formation)
     _check(plot_fk(r, units="mm"))
 
 

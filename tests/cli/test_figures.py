@@ -20,7 +20,7 @@ ROOT = Path(__file__).parents[2]
 
 def _fk(name):
     sc = load_sheet_scenario(ROOT / "examples" / "sheet" / name)
-    return sc, forward_kinematics(sc.sheet, sc.formation, sc.hold_height)
+    return sc, forward_kinematics(sc.team, sc.formation)
 
 
 def test_fk_figure_has_legend_units_and_counts_left_out_states():
@@ -45,7 +45,7 @@ def test_simulation_height_axis_shows_a_15_mm_jump():
     tdir = ROOT / "examples" / "sheet" / "trajectories"
     sc = load_sheet_scenario(tdir / "square4.yaml")
     traj = load_trajectory(tdir / "square4_jump.csv")
-    res = simulate(sc.sheet, traj.formations, sc.hold_height)
+    res = simulate(sc.team, traj.formations)
     drop = res.jumps[0].drop
     assert 0.01 < drop < 0.02                                     # the 15 mm jump (m)
     fig = plot_simulation(res, time=traj.time, units=sc.units)
@@ -53,5 +53,6 @@ def test_simulation_height_axis_shows_a_15_mm_jump():
     lo, hi = ax_h.get_ylim()
     assert drop / (hi - lo) > 0.3                                  # a third of the axis
     assert ax_h.get_xlabel() == "time [s]" and ax_h.get_ylabel().endswith("[m]")
-    assert str(sc.hold_height) in ax_h.get_title() or f"{sc.hold_height:g}" in ax_h.get_title()
+    z = sc.team.hold_height
+    assert str(z) in ax_h.get_title() or f"{z:g}" in ax_h.get_title()
     matplotlib.pyplot.close("all")

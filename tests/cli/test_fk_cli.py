@@ -38,7 +38,7 @@ def test_json_schema(capsys, examples_dir):
                              "height_feasible": 3, "force_closure": 3}
     e = doc["equilibria"][0]
     assert set(e) == {"taut", "object", "contact", "weights", "tensions", "cable_lengths",
-                      "status", "stable"}
+                      "kind", "stable"}
     assert e["taut"] == [0, 1, 2] and e["stable"] is True and len(e["tensions"]) == 3
 
 
@@ -118,3 +118,17 @@ def test_version(capsys):
     import taut
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.strip() == f"taut {taut.__version__}"
+
+
+def test_no_equilibrium_prints_the_library_reason(capsys, tmp_path):
+    """The reason is the library's (``FKResult.message``), in the table and in the JSON."""
+    from taut.sheet import Sheet, SheetTeam, forward_kinematics
+
+    path = write(tmp_path, GOOD.replace("hold_height: 1.0", "hold_height: 0.1"))
+    res = forward_kinematics(SheetTeam(Sheet([[0, 0], [1, 0], [1, 1], [0, 1]]), 0.1),
+                             [[0.2, 0.2], [0.8, 0.2], [0.8, 0.8], [0.2, 0.8]])
+    assert not res.success and res.message.startswith("no equilibrium: 1 state(s) discarded")
+    code, out, _ = run(capsys, "fk", path)
+    assert code == 1 and out.rstrip().endswith(res.message)
+    code, out, _ = run(capsys, "fk", path, "--json")
+    assert code == 1 and json.loads(out)["message"] == res.message

@@ -181,7 +181,7 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("cdpr tensions", ["cdpr", "tensions", "fastkit", *pose, "--method", "x"])]
     cases += [("cdpr wrench-set", ["cdpr", "wrench-set", "fastkit", *pose, "--plot", o])
               for o in outs]
-    cases += [("cdpr wrench-set", ["cdpr", "wrench-set", "fastkit", *pose, "--disturbance",
+    cases += [("cdpr wrench-set", ["cdpr", "wrench-set", "fastkit", *pose, "--external-wrench",
                                    v, "0", "0", "0", "0", "0"]) for v in BAD_NUMBERS]
     cases += [("cdpr twist-set", ["cdpr", "twist-set", "fastkit", *pose, opt, v])
               for opt in ("--base-speed", "--yaw-rate", "--cable-speed")

@@ -20,7 +20,7 @@ item   quoted case                                             test
 5      no numpy warning before the error line                  test_huge_numbers_refused
 6      exit codes 0/1/2 in ``--help``                          test_help_texts
 7      ``Sheet.regular(10**7, 1)``, ``generate_scenario(0, 0)``  test_api_quoted_cases
-7      ``forward_kinematics_batch(sheet, empty (0,4,2), h)``   test_api_quoted_cases
+7      ``forward_kinematics_batch(team, empty (0,4,2))``       test_api_quoted_cases
 7      None in place of a model (twist_capacities, ...)        test_none_in_place_of_model
 8      ``ik --help`` formation text, every option has help     test_help_texts
 8      ``plan --json`` a flag like every other ``--json``      test_plan_json_is_a_flag
@@ -139,12 +139,12 @@ def test_api_quoted_cases():
     from taut.cdpr import wrench_feasible
     from taut.io import load_cdpr_model
     from taut.plan import generate_scenario
-    from taut.sheet import Sheet, forward_kinematics_batch
-    sheet = Sheet.regular(4, 1.0)
+    from taut.sheet import Sheet, SheetTeam, forward_kinematics_batch
+    team = SheetTeam(Sheet.regular(4, 1.0), 1.0)
     for call, field in [
             (lambda: Sheet.regular(10**7, 1), "n"),
             (lambda: generate_scenario(0, 0), "n_robots"),
-            (lambda: forward_kinematics_batch(sheet, np.empty((0, 4, 2)), 1.0), "formations"),
+            (lambda: forward_kinematics_batch(team, np.empty((0, 4, 2))), "formations"),
             (lambda: wrench_feasible(load_cdpr_model("fastkit"), [[0, 0, 1]], chunk=-1),
              "chunk"),
             (lambda: Sheet([[1e308, 0], [0, 1], [1, 1]]), "sheet")]:

@@ -10,6 +10,7 @@ from taut.cli import main
 from taut.errors import InvalidTrajectoryError, ScenarioError
 from taut.io.trajectory import load_trajectory, parse_trajectory, save_trajectory
 from taut.sheet import Sheet, forward_kinematics
+from taut.sheet import SheetTeam
 from progress_lines import without_progress
 
 TRAJ = Path(__file__).parents[2] / "examples" / "sheet" / "trajectories"
@@ -37,8 +38,8 @@ def test_ik_json_round_trips_through_fk(capsys):
     doc = json.loads(out)
     assert set(doc) >= {"formation", "object", "contact", "weights", "tensions", "angles"}
     assert len(doc["formation"]) == 4 and len(doc["tensions"]) == 4      # mass in file
-    fk = forward_kinematics(Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]]),
-                            np.array(doc["formation"]), 1.5)
+    fk = forward_kinematics(SheetTeam(Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]]), 1.5),
+                            np.array(doc["formation"]))
     assert any(e.stable and len(e.taut) == 4
                and np.allclose(e.object, [-0.1, 0.2, 0.9], atol=1e-9) for e in fk.equilibria)
 

@@ -260,8 +260,10 @@ def test_tensions_infeasible_exits_1(capsys):
     code, out, _ = run(capsys, "cdpr", "tensions", "fastkit", "--pose", "0", "0", "2.35",
                        "--json")
     assert code == 1 and json.loads(out)["feasible"] is False
-    code, out, _ = run(capsys, "cdpr", "tensions", "fastkit", "--pose", "0", "0", "1.2")
+    code, out, _ = run(capsys, "cdpr", "tensions", "fastkit", "--pose", "0", "0", "0.6")
     assert code == 0 and "feasible: yes" in out
+    code, out, _ = run(capsys, "cdpr", "tensions", "fastkit", "--pose", "0", "0", "1.2")
+    assert code == 1 and "tip over" in out.splitlines()[-1]         # the bases tip
 
 
 def test_exit_codes_documented_in_help_and_readme(capsys):
@@ -330,4 +332,4 @@ def test_plan_json_is_a_flag_like_every_other(capsys, tmp_path):
     doc = json.loads(out)
     assert doc == json.loads(out_file.read_text())
     assert doc["success"] is False and doc["status"] == "no_route"
-    assert doc["reason"] == doc["message"] and doc["message"]
+    assert doc["message"] and "reason" not in doc

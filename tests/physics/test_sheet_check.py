@@ -13,21 +13,21 @@ import pytest
 
 from taut.errors import InvalidInputError
 from taut.io import load_sheet_scenario
-from taut.sheet import Sheet, forward_kinematics
+from taut.sheet import Sheet, SheetTeam, forward_kinematics
 
 mujoco = pytest.importorskip("mujoco")
 
-from taut.physics import check_equilibria, settle  # noqa: E402
+from taut.physics import replay_equilibria, settle  # noqa: E402
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "sheet"
 HEIGHT_TOL = 5.0          # mm
 LATERAL_FRACTION = 0.02   # of the sheet's width
 
 
-def _assert_agrees(sheet, R, z, *, heights_mm=True):
-    result = check_equilibria(sheet, R, z)
-    width = float(np.max(sheet.side_lengths()))
-    fk = forward_kinematics(sheet, R, z)
+def _assert_agrees(team, R, *, heights_mm=True):
+    result = replay_equilibria(team, R)
+    width = float(np.max(team.sheet.side_lengths()))
+    fk = forward_kinematics(team, R)
     assert [s.taut for s in result.states] == [e.taut for e in fk.equilibria]
     scale = 1.0 if heights_mm else width / 1000.0
     for s in result.states:
@@ -45,7 +45,7 @@ def _assert_agrees(sheet, R, z, *, heights_mm=True):
 def test_triangle_team():
     sheet = Sheet.regular(3, 600.0)
     R = 0.75 * sheet.vertices + [30.0, -20.0]
-    result = _assert_agrees(sheet, R, 700.0)
+    result = _assert_agrees(SheetTeam(sheet, 700.0), R)
     assert len(result.states) == 1
 
 
@@ -56,8 +56,9 @@ def test_free_drop_finds_the_triangle_state():
     # patch of coarse mesh it lands on, and the valley is flat; measured 32 mm here).
     sheet = Sheet.regular(3, 600.0)
     R = 0.75 * sheet.vertices + [30.0, -20.0]
-    eq = forward_kinematics(sheet, R, 700.0).equilibria[0]
-    r = settle(sheet, R, 700.0, trace=True)
+    team = SheetTeam(sheet, 700.0)
+    eq = forward_kinematics(team, R).equilibria[0]
+    r = settle(team, R, trace=True)
     assert r.success and r.converged
     assert abs(r.position[2] - eq.object[2]) <= HEIGHT_TOL
     assert np.hypot(*(r.position[:2] - eq.object[:2])) <= 0.05 * 1039.2
@@ -68,7 +69,7 @@ def test_free_drop_finds_the_triangle_state():
 @pytest.mark.slow
 def test_fk_paper_example1():
     sc = load_sheet_scenario(EXAMPLES / "example1.yaml")
-    result = _assert_agrees(sc.sheet, sc.formation, sc.hold_height)
+    result = _assert_agrees(sc.team, sc.formation)
     status = {s.taut: s.status for s in result.states}
     assert status == {(0, 1, 2): "stable", (0, 2, 3): "stable",
                       (0, 1, 2, 3): "not_equilibrium"}
@@ -77,20 +78,22 @@ def test_fk_paper_example1():
 @pytest.mark.slow
 def test_fk_paper_example2_eight_robots():
     sc = load_sheet_scenario(EXAMPLES / "example2_r2_r4_353mm.yaml")
-    result = _assert_agrees(sc.sheet, sc.formation, sc.hold_height)
+    result = _assert_agrees(sc.team, sc.formation)
     held = [s.taut for s in result.states if s.held]
     assert held == [(3, 4, 7)]                       # only {4,5,8} (1-based) is held
 
 
 def test_bad_options_are_typed_errors():
-    sheet = Sheet.regular(3, 600.0)
-    R = 0.75 * sheet.vertices
+    team = SheetTeam(Sheet.regular(3, 600.0), 700.0)
+    R = 0.75 * team.sheet.vertices
     with pytest.raises(InvalidInputError, match="mesh"):
-        check_equilibria(sheet, R, 700.0, mesh=2)
+        replay_equilibria(team, R, mesh=2)
     with pytest.raises(InvalidInputError, match="ball"):
-        settle(sheet, R, 700.0, ball=-1.0)
+        settle(team, R, ball=-1.0)
     with pytest.raises(InvalidInputError, match="start"):
-        settle(sheet, R, 700.0, start=[0.0, 0.0])
+        settle(team, R, start=[0.0, 0.0])
+    with pytest.raises(InvalidInputError, match="team"):
+        settle(team.sheet, R)                    # type: ignore[arg-type]
 
 
 @pytest.mark.slow
@@ -98,10 +101,10 @@ def test_units_and_placement_do_not_change_the_answer():
     # The same team in metres, moved by (3, -2) m: the same verdicts, and differences that
     # are the millimetre ones scaled by 1/1000 (the simulation is scaled to the sheet).
     sc = load_sheet_scenario(EXAMPLES / "example1.yaml")
-    mm = check_equilibria(sc.sheet, sc.formation, sc.hold_height)
+    mm = replay_equilibria(sc.team, sc.formation)
     shift = np.array([3.0, -2.0])
-    m = check_equilibria(Sheet(sc.sheet.vertices / 1000 + shift), sc.formation / 1000 + shift,
-                         sc.hold_height / 1000)
+    metres = SheetTeam(Sheet(sc.team.sheet.vertices / 1000 + shift), sc.team.hold_height / 1000)
+    m = replay_equilibria(metres, sc.formation / 1000 + shift)
     assert [s.held for s in m.states] == [s.held for s in mm.states]
     for a, b in zip(mm.states, m.states):
         np.testing.assert_allclose(b.tied_difference * 1000, a.tied_difference, atol=0.5)

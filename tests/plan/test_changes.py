@@ -6,8 +6,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from taut.plan import verify_motion
-from taut.plan.se2.motion import change_profile
+from taut.plan import plan_robustness, verify_motion
+from taut.plan.se2._motion import change_profile
 from taut.plan.formations.library import _library
 
 from .test_plan import corridor
@@ -74,7 +74,7 @@ def test_fragile_changes_are_refused_and_the_plan_survives_its_monte_carlo():
     assert r.success
     kinds = [f.kind for f in r.formations]
     assert not ("compact" in kinds and "squeezed" in kinds)
-    rob = r.robustness(0.005, 10, seed=4)
+    rob = plan_robustness(r, 0.005, 10, seed=4)
     assert rob.failure_probability == 0.0
 
 

@@ -12,16 +12,16 @@ from taut.io.plan_scenario import (load_plan_scenario, plan_scenario_from_mappin
                                    plan_scenario_to_mapping)
 from taut.plan import (Obstacle, Scenario, Team, World, crossing_pairs, generate_scenario,
                        offset_crossings, optimal_formation, plan, verify_motion)
-from taut.sheet import Sheet, forward_kinematics
+from taut.sheet import Sheet, SheetTeam, forward_kinematics
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "plan"
 
 
-def corridor_team(**kw):
-    args = dict(hold_height=0.5, robot_radius=0.15, height_safety=0.05, lateral_safety=0.05,
-                speed=0.1, rotation_speed=0.3)
+def corridor_team(hold_height=0.5, **kw):
+    args = dict(robot_radius=0.15, height_safety=0.05, lateral_safety=0.05, speed=0.1,
+                rotation_speed=0.3)
     args.update(kw)
-    return Team(Sheet.regular(3, 1 / np.sqrt(3)), **args)
+    return Team(SheetTeam(Sheet.regular(3, 1 / np.sqrt(3)), hold_height), **args)
 
 
 def corridor(obstacles, width=2.0, length=6.0, team=None):
@@ -90,8 +90,7 @@ def test_paper_corridor_disc_baseline_fails_with_reason(paper):
     assert not b.success and b.status == "no_route" and b.planner == "disc"
     assert "cannot pass" in b.message
     assert b.robots.shape == (0, 3, 2)
-    with pytest.warns(DeprecationWarning):
-        assert b.reason == b.message
+    assert not hasattr(b, "reason")                     # one name: message
 
 
 def test_returned_plan_passes_independent_verification(paper, paper_plan):
@@ -102,7 +101,7 @@ def test_returned_plan_passes_independent_verification(paper, paper_plan):
     assert check.min_clearance >= paper.team.clearance - 1e-9
     # FK on a sample mid-crossing finds the planned object as a stable all-taut state.
     t = int(np.argmin(np.linalg.norm(r.object[:, :2] - [4.0, 0.0], axis=1)))
-    fk = forward_kinematics(paper.team.sheet, r.robots[t], paper.team.hold_height)
+    fk = forward_kinematics(paper.team.carrier, r.robots[t])
     assert any(len(e.taut) == 3 and np.allclose(e.object, r.object[t], atol=1e-9)
                for e in fk.stable)
 
@@ -180,7 +179,7 @@ def test_crossing_pairs_turn_angles():
     tri = optimal_formation(team, kind="crossing", height=0.1, diameter=0.2)
     turns = {round(abs(p[2]), 6) for p in crossing_pairs(tri, 0.2)}
     assert turns == {round(np.pi / 3, 6)}
-    hexa = Team(Sheet.regular(6, 0.8), 0.5, 0.1, 0.05, 0.05, 0.1, 0.3)
+    hexa = Team(SheetTeam(Sheet.regular(6, 0.8), 0.5), 0.1, 0.05, 0.05, 0.1, 0.3)
     f = optimal_formation(hexa, kind="crossing", height=0.1, diameter=0.1)
     assert abs(crossing_pairs(f, 0.2)[0][2]) < 1e-6          # opposite sides: no turn
     assert crossing_pairs(f, 10.0) == []                     # nothing that wide fits
@@ -262,7 +261,7 @@ def test_non_positive_team_values(name):
 
 def test_team_that_cannot_hold_the_object():
     # Robots 0.4 m wide cannot stand at the corners of a 0.3 m sheet.
-    team = Team(Sheet.regular(3, 0.3 / np.sqrt(3)), 0.2, 0.2, 0.02, 0.02, 0.1, 0.3)
+    team = Team(SheetTeam(Sheet.regular(3, 0.3 / np.sqrt(3)), 0.2), 0.2, 0.02, 0.02, 0.1, 0.3)
     sc = Scenario(World([[0, -1], [6, -1], [6, 1], [0, 1]]), team, [1, 0], [5, 0])
     with pytest.raises(PlanningError) as e:
         plan(sc)
@@ -316,7 +315,7 @@ def test_cli_plan_json_and_figures(tmp_path, capsys):
                       "--plot", str(png)], standalone_mode=False)
     assert rc == 0 and png.stat().st_size > 10_000
     data = json.loads(out.read_text())
-    assert set(data) >= {"success", "reason", "times", "robots", "object", "taut", "crossed",
+    assert set(data) >= {"success", "message", "times", "robots", "object", "taut", "crossed",
                          "bypassed"}
     assert data["success"] is True and data["crossed"] == ["1", "2"]
     T = len(data["times"])
@@ -331,11 +330,11 @@ def test_cli_plan_json_and_figures(tmp_path, capsys):
 
 
 def test_failed_plan_json():
-    from taut.cli.plan import plan_to_dict
+    from taut.io.serialize import plan_to_dict
     r = plan(corridor([Obstacle("big", 0.9, center=[3.0, 0.0], radius=0.45)]), iterations=100)
     d = json.loads(json.dumps(plan_to_dict(r)))
-    assert d["success"] is False and d["reason"] and d["times"] == [] and d["robots"] == []
-    assert d["status"] == "budget_exhausted" and d["message"] == d["reason"]
+    assert d["success"] is False and d["message"] and d["times"] == [] and d["robots"] == []
+    assert d["status"] == "budget_exhausted" and "reason" not in d
     assert d["duration"] is None and d["bypassed"] == ["big"]
 
 

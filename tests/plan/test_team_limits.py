@@ -12,7 +12,7 @@ from taut.errors import InvalidInputError, PlanningError, ScenarioError
 from taut.io.plan_scenario import plan_scenario_from_mapping
 from taut.plan import Scenario, Team, World, plan
 from taut.plan.world import MAX_TEAM_ROBOTS
-from taut.sheet import Sheet
+from taut.sheet import Sheet, SheetTeam
 
 from .test_plan import EXAMPLES, corridor
 
@@ -38,9 +38,9 @@ def test_regular_team_too_large_is_refused_before_the_sheet_is_built(n, monkeypa
 def test_team_size_limit_in_the_api_and_just_below_it():
     big = Sheet.regular(MAX_TEAM_ROBOTS + 1, 1.0)
     with pytest.raises(InvalidInputError) as e:
-        Team(big, 0.5, 0.05, 0.02, 0.02, 0.1, 0.3)
-    assert e.value.field == "sheet"
-    ok = Team(Sheet.regular(MAX_TEAM_ROBOTS, 1.0), 0.5, 0.05, 0.02, 0.02, 0.1, 0.3)
+        Team(SheetTeam(big, 0.5), 0.05, 0.02, 0.02, 0.1, 0.3)
+    assert e.value.field == "carrier"
+    ok = Team(SheetTeam(Sheet.regular(MAX_TEAM_ROBOTS, 1.0), 0.5), 0.05, 0.02, 0.02, 0.1, 0.3)
     assert ok.n == MAX_TEAM_ROBOTS
 
 
@@ -64,8 +64,8 @@ def test_team_that_cannot_hold_fails_before_any_optimisation(n, monkeypatch):
         raise AssertionError("inverse kinematics run for a refutable team")
     monkeypatch.setattr(problem, "inverse_kinematics", no_ik)
     side = 0.3
-    team = Team(Sheet.regular(n, side / (2 * np.sin(np.pi / n))), 0.1, 0.2, 0.02, 0.02, 0.1,
-                0.3)
+    team = Team(SheetTeam(Sheet.regular(n, side / (2 * np.sin(np.pi / n))), 0.1), 0.2, 0.02,
+                0.02, 0.1, 0.3)
     sc = Scenario(World([[0, -1], [6, -1], [6, 1], [0, 1]]), team, [1, 0], [5, 0])
     with pytest.raises(PlanningError) as e:
         plan(sc)
@@ -76,7 +76,7 @@ def test_the_cheap_test_never_refutes_a_team_that_can_hold():
     # Cross-check of the necessary condition against the full optimisation: a team whose
     # pairs are all wider than two robot radii gets a formation.
     from taut.plan import optimal_formation
-    team = Team(Sheet.regular(4, 0.6), 0.5, 0.1, 0.04, 0.04, 0.2, 0.5)
+    team = Team(SheetTeam(Sheet.regular(4, 0.6), 0.5), 0.1, 0.04, 0.04, 0.2, 0.5)
     assert optimal_formation(team, kind="compact") is not None
 
 

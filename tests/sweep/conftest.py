@@ -3,7 +3,7 @@ import pytest
 
 pytest.importorskip("pyarrow")
 
-from taut.sweep.file import sweep_from_mapping  # noqa: E402
+from taut.sweep import sweep_from_mapping  # noqa: E402
 
 EXAMPLE2 = "examples/sheet/example2_r2_r4_353mm.yaml"
 

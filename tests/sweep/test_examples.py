@@ -2,8 +2,7 @@
 
 import pytest
 
-from taut.sweep.file import load_sweep
-from taut.sweep import TASKS
+from taut.sweep import TASKS, load_sweep
 
 
 @pytest.mark.parametrize("name", ["octagon_stability", "corridor_robustness",

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from taut.errors import SweepError
-from taut.sweep.results import read_results
-from taut.sweep import run_sweep
+from taut.sweep import read_results, run_sweep
 
 
 def _serial(spec, tmp_path, name="serial"):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from taut.errors import SweepError
-from taut.sweep.file import sweep_from_mapping
+from taut.sweep import sweep_from_mapping
 from taut.sweep.points import chunk_bounds, expand, point_seeds
 
 BASE = {"task": "plan_suite", "parameters": {"scenario_seed": [1, 2, 3]}}

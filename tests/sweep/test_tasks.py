@@ -20,7 +20,7 @@ def test_fk_rows_match_forward_kinematics_of_the_transformed_formation(fk_spec, 
         u = np.array([np.cos(a), np.sin(a)])
         m = rows["scale"][k] * (np.eye(2) + (rows["stretch"][k] - 1) * np.outer(u, u))
         form = c + (sc.formation - c) @ m.T
-        res = forward_kinematics(sc.sheet, form, sc.hold_height, mass=sc.mass)
+        res = forward_kinematics(sc.team, form)
         assert rows["n_stable"][k] == len(res.stable)
         assert rows["n_states"][k] == len(res.equilibria)
         low = res.lowest
@@ -61,7 +61,7 @@ def test_jitter_is_seeded_per_point(fk_spec):
 def test_cdpr_workspace_row_equals_the_workspace_analysis():
     from taut.cdpr import grid_points, wrench_feasible_workspace
     from taut.io import load_cdpr_model
-    from taut.sweep.file import sweep_from_mapping
+    from taut.sweep import sweep_from_mapping
 
     spec = sweep_from_mapping({"task": "cdpr_workspace", "base": "fastkit",
                                "options": {"grid": [6, 1, 4]},
@@ -76,7 +76,7 @@ def test_cdpr_workspace_row_equals_the_workspace_analysis():
 
 
 def test_cdpr_invalid_variant_is_a_row_with_its_reason():
-    from taut.sweep.file import sweep_from_mapping
+    from taut.sweep import sweep_from_mapping
 
     spec = sweep_from_mapping({"task": "cdpr_workspace", "base": "fastkit",
                                "options": {"grid": [3, 1, 2]},

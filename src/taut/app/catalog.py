@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import InvalidInputError, ScenarioError
 from ..io import read_mapping
 from ..io.cdpr_model import PRESETS, preset_path
-from ..sheet import Sheet, inverse_kinematics
+from ..sheet import Sheet, SheetTeam, inverse_kinematics
 
 __all__ = ["Catalog", "regular_team"]
 
@@ -86,7 +86,7 @@ def regular_team(n: int, *, radius: float = 1000.0, hold_height: float = 1000.0,
     sheet = Sheet.regular(n, radius)
     centre = np.zeros(2) + 0.05 * radius          # off the symmetry centre
     target = (*centre, 0.5 * hold_height)
-    ik = inverse_kinematics(sheet, target, hold_height)
+    ik = inverse_kinematics(SheetTeam(sheet, hold_height), target)
     if not ik.success:                 # regular teams are always reachable there; guard anyway
         raise InvalidInputError("n", f"no formation for a regular {n}-gon team: {ik.message}")
     rng = np.random.default_rng(seed)

@@ -3,14 +3,15 @@ platform pose (tensions against their limits, tipping margins of the mobile base
 wrench feasibility with and without tipping) and a slice of the wrench-feasible
 workspace.
 
-The statics are :func:`taut.cdpr.distribute_tensions` (tipping passed explicitly both
-ways), :func:`taut.cdpr.tipping_moments`, :func:`taut.cdpr.cable_state` and
-:func:`taut.cdpr.wrench_feasible_workspace`. SI units: m, rad, N, N m.
+Every verdict and message is a library result's: :func:`taut.cdpr.distribute_tensions`
+with the library's defaults (``feasible``, ``binding``, ``message``) and with the tension
+limits alone (``feasible_limits``), :func:`taut.cdpr.tipping_moments` (per-base margins),
+:func:`taut.cdpr.cable_state` and :func:`taut.cdpr.wrench_feasible_workspace`. SI units:
+m, rad, N, N m.
 """
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import numpy as np
@@ -19,31 +20,22 @@ import yaml
 from ..cdpr import (CableRobot, cable_state, distribute_tensions, grid_points,
                     tipping_moments, wrench_feasible_workspace, with_stabilisers)
 from ..cdpr import METHODS as TENSION_METHODS
+from .._validate import as_choice
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ..io import cdpr_model_from_mapping
+from ..io.serialize import json_ready
 from .catalog import Catalog
 from .payload import ModelCache, field, mapping_from_upload
 
-__all__ = ["CdprAPI", "succeeded"]
+__all__ = ["CdprAPI"]
 
 #: Most grid points of one workspace slice (keeps a slice under about a second).
 MAX_SLICE_POINTS = 4000
 
 
-def succeeded(result: Any) -> np.ndarray:
-    """The per-pose success flags of a tension or feasibility result (``success`` in the
-    result convention; ``feasible`` in results that predate it)."""
-    names = {f.name for f in dataclasses.fields(result)}
-    return np.asarray(result.success if "success" in names else result.feasible)
-
-
 def _build(key: dict[str, Any]) -> CableRobot:
     robot = cdpr_model_from_mapping(key["model"])
-    return with_stabilisers(robot, True) if key["stabilisers"] else robot
-
-
-def _finite(a: np.ndarray) -> list[float | None]:
-    return [float(x) if np.isfinite(x) else None for x in np.ravel(a)]
+    return with_stabilisers(robot) if key["stabilisers"] else robot
 
 
 def geometry(robot: CableRobot) -> dict[str, Any]:
@@ -91,11 +83,15 @@ class CdprAPI:
         return {"model": data, "geometry": geometry(robot)}
 
     def yaml(self, body: dict[str, Any]) -> dict[str, Any]:
-        """The model file, headed by the ``taut cdpr tensions`` command for the pose."""
+        """The model file, headed by the ``taut cdpr tensions`` command for the pose (the
+        same library defaults as :meth:`state`)."""
         robot = self._robot(body)
         pose = np.asarray(field(body, "pose", list), dtype=float)
         cmd = (f"taut cdpr tensions FILE --pose {pose[0]:g} {pose[1]:g} {pose[2]:g} "
-               f"--rpy {pose[3]:g} {pose[4]:g} {pose[5]:g} --tipping")
+               f"--rpy {pose[3]:g} {pose[4]:g} {pose[5]:g}")
+        method = field(body, "method", str, default=None)
+        if method is not None:
+            cmd += f" --method {method}"
         if field(body, "stabilisers", bool, default=False):
             cmd += " --stabilisers"
         text = (f"# cable-robot model '{robot.name}' saved by `taut app`; the pose shown:\n"
@@ -105,55 +101,49 @@ class CdprAPI:
 
     def state(self, body: dict[str, Any]) -> dict[str, Any]:
         """Statics at ``pose`` [x, y, z, roll, pitch, yaw]: tensions, limits, tipping
-        margins, feasibility; a pose outside the frame box is flagged, not an error."""
+        margins, feasibility; a pose outside the frame box is flagged, not an error.
+        ``method`` (optional) is passed on; omitted, the library's default is used."""
         robot = self._robot(body)
         pose = np.asarray(field(body, "pose", list), dtype=float)
         if pose.shape != (6,) or not np.all(np.isfinite(pose)):
             raise InvalidInputError("pose", "must be 6 finite numbers x y z roll pitch yaw")
-        method = field(body, "method", str, default="qp_min_norm")
+        method = field(body, "method", str, default=None)
         st = cable_state(robot, pose[None], validated=True)
         attach = (pose[:3] + st.r[0]).tolist()
         out: dict[str, Any] = {"pose": pose.tolist(), "attachments": attach,
                                "in_frame": True}
         try:
-            with_tip = distribute_tensions(robot, pose, method, tipping=True)
+            res = distribute_tensions(robot, pose, **({} if method is None else
+                                                      {"method": method}))
         except InfeasiblePoseError as exc:
             return dict(out, in_frame=False, feasible=False, feasible_limits=False,
                         message=str(exc), tensions=None, shown="none", margins=[])
-        limits = distribute_tensions(robot, pose, method, tipping=False)
-        ok_tip, ok_lim = bool(succeeded(with_tip)), bool(succeeded(limits))
-        shown, label = (with_tip, "with tipping") if ok_tip else (limits, "limits only")
-        if not ok_lim and not np.all(np.isfinite(limits.tensions)):
+        limits = distribute_tensions(robot, pose, res.method, tipping=False, sliding=False)
+        checked = ["limits"] + ["tipping"] * res.tipping + ["sliding"] * res.sliding
+        shown, label = ((res, "with " + " and ".join(checked)) if res.success else
+                        (limits, "limits only"))
+        if not limits.success and not np.all(np.isfinite(limits.tensions)):
             # No solution at all: show the closed form's best attempt and its violations.
-            shown = distribute_tensions(robot, pose, "closed_form", tipping=False)
+            shown = distribute_tensions(robot, pose, "closed_form", tipping=False,
+                                        sliding=False)
             label = "closed-form attempt (violates the limits)"
         t = shown.tensions
         margins = []
-        if robot.has_tipping and (ok_tip or ok_lim):   # margins of a valid distribution
+        if robot.has_tipping and (res.success or limits.success):   # a valid distribution
             tm = tipping_moments(robot, pose, t)
-            for k, b in enumerate(robot.bases):
-                sel = tm.edge_base == k
-                if np.any(sel):
-                    worst = float(tm.moments[sel].max())
-                    margins.append({"base": b.name, "margin": -worst,
-                                    "stable": worst <= 0.0 or bool(tm.stable)})
-        if ok_tip:
-            msg = "wrench-feasible: tensions within limits and no base tips"
-        elif ok_lim:
-            msg = "NOT wrench-feasible with tipping: a mobile base tips over"
-        else:
-            msg = "NOT wrench-feasible: no tensions within the cable limits hold the platform"
-        return dict(out, feasible=ok_tip, feasible_limits=ok_lim, message=msg,
-                    tensions=_finite(t), shown=label,
-                    margins=margins, method=method)
+            margins = [{"base": b.name, "margin": -float(tm.base_moment[k]),
+                        "stable": bool(tm.base_stable[k])}
+                       for k, b in enumerate(robot.bases) if np.isfinite(tm.base_moment[k])]
+        return dict(out, feasible=bool(res.success), feasible_limits=bool(limits.success),
+                    binding=str(res.binding), message=res.message,
+                    tensions=json_ready(np.ravel(t)), shown=label, margins=margins,
+                    method=res.method)
 
     def workspace(self, body: dict[str, Any]) -> dict[str, Any]:
         """Wrench-feasible slice: ``plane`` "xz" (at y = ``offset``) or "xy" (at z =
         ``offset``) over the frame box, ``n`` = [columns, rows], orientation ``rpy``."""
         robot = self._robot(body)
-        plane = field(body, "plane", str, default="xz")
-        if plane not in ("xz", "xy"):
-            raise InvalidInputError("plane", "must be xz or xy")
+        plane = as_choice(field(body, "plane", str, default="xz"), ("xz", "xy"), "plane")
         n = field(body, "n", list, default=[41, 21])
         if (len(n) != 2 or not all(isinstance(k, int) and k >= 2 for k in n)
                 or n[0] * n[1] > MAX_SLICE_POINTS):

@@ -1,14 +1,14 @@
-"""JSON endpoints of the planner viewer: load a planning scenario, run the planner and the
-bypass-only baseline in a background job (the page polls its progress), and return both
-plans with the series the page plots.
+"""JSON endpoints of the planner viewer: load a planning scenario, run the planner and its
+SE(2) bypass baseline (the same search with crossing disabled) in a background job (the
+page polls its progress), and return both plans with the series the page plots.
 
-Planning is :func:`taut.plan.plan` and :func:`taut.plan.plan_baseline`; this module only
-reshapes their results for drawing. Lengths m, times s.
+Planning is :func:`taut.plan.plan` (``baseline="se2"`` for the baseline) and the series
+are :func:`taut.plan.plan_profile`; this module computes nothing itself, it only reshapes
+their results for drawing. Lengths m, times s.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import threading
 import time
@@ -17,13 +17,12 @@ from dataclasses import dataclass, field as dc_field
 from typing import Any
 
 import numpy as np
-import shapely
 import yaml
 
-from ..io.serialize import plan_to_dict
+from ..io.serialize import json_ready, plan_to_dict
 from ..errors import ScenarioError, TautError
 from ..io import plan_scenario_from_mapping, plan_scenario_to_mapping
-from ..plan import PlanResult, Scenario, plan, plan_baseline
+from ..plan import PlanResult, Scenario, plan, plan_profile
 from .catalog import Catalog
 from .payload import field, mapping_from_upload
 
@@ -52,43 +51,20 @@ def world_to_dict(sc: Scenario) -> dict[str, Any]:
     }
 
 
-def plan_series(sc: Scenario, r: PlanResult) -> dict[str, list[float | None]]:
-    """Per-sample series of a plan for the viewer's plots.
-
-    ``beneath``: height of the tallest obstacle whose footprint meets the robots' convex
-    hull (0 when none), m. ``height_over_obstacle``: object height minus that (null when
-    no obstacle is beneath), m. ``sheet_margin``: the least slack of the sheet over robot
-    pairs, :math:`\\min_{i<j} (|\\mathbf{v}_i - \\mathbf{v}_j| - |\\mathbf{r}_i -
-    \\mathbf{r}_j|)` (>= 0 for a formation that does not tear the sheet), m.
-    """
-    T = len(r.times)
-    if T == 0:
-        return {"beneath": [], "height_over_obstacle": [], "sheet_margin": []}
-    hulls = shapely.convex_hull(shapely.multipoints(r.robots))
-    beneath = np.zeros(T)
-    for o in sc.world.obstacles:
-        beneath = np.where(shapely.intersects(hulls, o.geometry),
-                           np.maximum(beneath, o.height), beneath)
-    over = np.where(beneath > 0, r.object[:, 2] - beneath, np.nan)
-    V = sc.team.sheet.vertices
-    iu, ju = np.triu_indices(V.shape[0], 1)
-    slack = (np.linalg.norm(V[iu] - V[ju], axis=1)[None]
-             - np.linalg.norm(r.robots[:, iu] - r.robots[:, ju], axis=2))
-
-    def clean(a: np.ndarray) -> list[float | None]:
-        return [float(x) if np.isfinite(x) else None for x in a]
-
-    return {"beneath": clean(beneath), "height_over_obstacle": clean(over),
-            "sheet_margin": clean(slack.min(axis=1))}
+def plan_series(r: PlanResult) -> dict[str, list[float | None]]:
+    """Per-sample series of a plan for the viewer's plots: the fields of its
+    :func:`taut.plan.plan_profile` (null where not finite): ``beneath_height_m``,
+    ``height_over_obstacle_m`` and ``sheet_slack_m``."""
+    p = plan_profile(r)
+    return {"beneath_height_m": json_ready(p.beneath_height_m),
+            "height_over_obstacle_m": json_ready(p.height_over_obstacle_m),
+            "sheet_slack_m": json_ready(p.sheet_slack_m)}
 
 
-def _summary(sc: Scenario, r: PlanResult) -> dict[str, Any]:
+def _summary(r: PlanResult) -> dict[str, Any]:
     out = plan_to_dict(r)
-    names = {f.name for f in dataclasses.fields(r)}
-    why = getattr(r, "message") if "message" in names else r.reason   # convention, or older
-    out.update(plan_series(sc, r), planner=r.planner, message=why or "plan verified",
-               object_height=(None if r.formation is None
-                              else float(r.formation.object_height)))
+    out.update(plan_series(r), object_height=(None if r.formation is None
+                                              else float(r.formation.object_height)))
     return out
 
 
@@ -158,11 +134,11 @@ class PlanAPI:
     def _work(self, job: _Job) -> None:
         sc = job.scenario
         try:
-            job.stage, job.step = "bypass-only baseline", 1
-            base = plan_baseline(sc)
+            job.stage, job.step = "SE(2) bypass baseline", 1
+            base = plan(sc, baseline="se2", time_budget=PLAN_TIME_CAP_S)
             job.stage, job.step = "planner with obstacle crossing", 2
             best = plan(sc, time_budget=PLAN_TIME_CAP_S)
-            job.result = {"plan": _summary(sc, best), "baseline": _summary(sc, base),
+            job.result = {"plan": _summary(best), "baseline": _summary(base),
                           "world": world_to_dict(sc)}
         except TautError as exc:
             job.error = str(exc)

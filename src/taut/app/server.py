@@ -28,6 +28,7 @@ from starlette.routing import BaseRoute, Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from ..errors import InvalidInputError, TautError
+from ..io.serialize import json_ready
 from .catalog import Catalog
 from .cdpr_api import CdprAPI
 from .payload import kind_of_mapping
@@ -51,18 +52,8 @@ class _JSON(JSONResponse):
     """JSON without NaN (the page's JSON.parse rejects it): NaN/inf become null."""
 
     def render(self, content: Any) -> bytes:
-        return json.dumps(_no_nan(content), allow_nan=False,
+        return json.dumps(json_ready(content), allow_nan=False,
                           separators=(",", ":")).encode("utf-8")
-
-
-def _no_nan(x: Any) -> Any:
-    if isinstance(x, float):
-        return x if x == x and x not in (float("inf"), float("-inf")) else None
-    if isinstance(x, dict):
-        return {k: _no_nan(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_no_nan(v) for v in x]
-    return x
 
 
 def _endpoint(handler: Callable[[dict[str, Any]], dict[str, Any]]):

@@ -20,7 +20,7 @@ from ..io.serialize import ik_to_dict, simulation_to_dict
 from ..errors import InfeasibleFormationError, InvalidInputError
 from ..io import SheetScenario, sheet_scenario_from_mapping
 from ..io.serialize import equilibrium_to_dict
-from ..sheet import Sheet, forward_kinematics, inverse_kinematics
+from ..sheet import Sheet, SheetTeam, forward_kinematics, inverse_kinematics
 from ..sheet import simulate
 from .catalog import Catalog, regular_team
 from .payload import ModelCache, field, mapping_from_upload
@@ -38,10 +38,11 @@ def _points(a: np.ndarray) -> list[list[float]]:
 def _default_formation(sc: SheetScenario) -> np.ndarray:
     """A formation for a scenario that has none: inverse kinematics (all cables taut) for
     the object under the sheet's centroid at half the shortest cable's depth."""
-    vo = sc.sheet.vertices.mean(axis=0)
-    depth = min(0.5 * float(np.linalg.norm(sc.sheet.vertices - vo, axis=1).min()),
-                0.5 * sc.hold_height)
-    ik = inverse_kinematics(sc.sheet, (*vo, sc.hold_height - depth), sc.hold_height)
+    team = sc.team
+    vo = team.sheet.vertices.mean(axis=0)
+    depth = min(0.5 * float(np.linalg.norm(team.sheet.vertices - vo, axis=1).min()),
+                0.5 * team.hold_height)
+    ik = inverse_kinematics(team, (*vo, team.hold_height - depth))
     if not ik.success:
         raise InvalidInputError("formation", "missing, and no all-taut formation holds the "
                                 f"object under the sheet's centroid ({ik.message})")
@@ -52,8 +53,8 @@ def scenario_mapping(sc: SheetScenario) -> dict[str, Any]:
     """The file mapping of a validated scenario (inverse of
     :func:`taut.io.sheet_scenario_from_mapping`); a missing formation is filled in."""
     formation = sc.formation if sc.formation is not None else _default_formation(sc)
-    out = {"name": sc.name, "units": sc.units, "hold_height": float(sc.hold_height),
-           "mass": sc.mass, "sheet": _points(sc.sheet.vertices),
+    out = {"name": sc.name, "units": sc.units, "hold_height": float(sc.team.hold_height),
+           "mass": sc.team.mass, "sheet": _points(sc.team.sheet.vertices),
            "formation": _points(formation)}
     return {k: out[k] for k in _KEYS if out[k] is not None}
 
@@ -85,20 +86,20 @@ class SheetAPI:
             data = field(body, "scenario", dict)
         return {"scenario": scenario_mapping(sheet_scenario_from_mapping(data))}
 
-    def _inputs(self, body: dict[str, Any]) -> tuple[Sheet, float, float | None]:
+    def _team(self, body: dict[str, Any]) -> SheetTeam:
         sheet = self.sheets.get(field(body, "sheet", list))
         hold = field(body, "hold_height", (int, float))
         mass = field(body, "mass", (int, float), default=None)
-        return sheet, float(hold), None if mass is None else float(mass)
+        return SheetTeam(sheet, float(hold), None if mass is None else float(mass))
 
     def fk(self, body: dict[str, Any]) -> dict[str, Any]:
         """Every equilibrium of ``formation``; an infeasible formation is an answer
         (``feasible: false`` with the pair), not an error."""
-        sheet, hold, mass = self._inputs(body)
+        team = self._team(body)
         formation = field(body, "formation", list)
         t0 = time.perf_counter()
         try:
-            res = forward_kinematics(sheet, formation, hold, mass=mass)
+            res = forward_kinematics(team, formation)
         except InfeasibleFormationError as exc:
             return {"feasible": False, "pair": list(exc.pair), "message": str(exc),
                     "server_ms": 1e3 * (time.perf_counter() - t0)}
@@ -112,19 +113,17 @@ class SheetAPI:
     def ik(self, body: dict[str, Any]) -> dict[str, Any]:
         """Formation holding the object stably at ``target`` ([x, y, z]) with every cable
         taut, staying close to ``reference`` (the current formation) when given."""
-        sheet, hold, mass = self._inputs(body)
-        res = inverse_kinematics(sheet, field(body, "target", list), hold, mass=mass,
+        res = inverse_kinematics(self._team(body), field(body, "target", list),
                                  reference=field(body, "reference", list, default=None))
         return {"ik": ik_to_dict(res)}
 
     def simulate(self, body: dict[str, Any]) -> dict[str, Any]:
         """Quasi-static simulation along ``formations`` (T x N x 2, one row per step)."""
-        sheet, hold, mass = self._inputs(body)
+        team = self._team(body)
         formations = field(body, "formations", list)
         if len(formations) > 20000:
             raise InvalidInputError("formations", "at most 20000 steps")
-        res = simulate(sheet, formations, hold, mass=mass,
-                       start=field(body, "start", list, default=None))
+        res = simulate(team, formations, start=field(body, "start", list, default=None))
         return {"simulation": simulation_to_dict(res, np.arange(len(res), dtype=float))}
 
     def yaml(self, body: dict[str, Any]) -> dict[str, Any]:

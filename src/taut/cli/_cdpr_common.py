@@ -38,7 +38,13 @@ def load_robot(model: str, stabilisers: bool) -> CableRobot:
                                 f"the accepted range {MAX_MASS_KG:g} kg")
     if robot.bounds is not None:
         check_range(robot.bounds, "bounds", MAX_CDPR_LENGTH_M, "m")
-    return with_stabilisers(robot, True) if stabilisers else robot
+    return with_stabilisers(robot) if stabilisers else robot
+
+
+def given(**options: Any) -> dict[str, Any]:
+    """The options the user gave (not None): those left out take the library's defaults, so
+    the command line never decides a default of its own."""
+    return {k: v for k, v in options.items() if v is not None}
 
 
 def pose_vector(pose: Any, rpy: Any) -> np.ndarray:

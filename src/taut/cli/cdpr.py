@@ -7,17 +7,16 @@ as ``--pose X Y Z`` (m) and optionally ``--rpy ROLL PITCH YAW`` (rad).
 
 from __future__ import annotations
 
-from enum import Enum
 from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
 import typer
 
-from .._validate import MAX_CDPR_LENGTH_M, MAX_TENSION_N, as_box, as_count, check_range
+from .._validate import MAX_CDPR_LENGTH_M, MAX_TENSION_N, as_box, as_choice, as_count, check_range
 from ..errors import InvalidInputError
 from ..io.serialize import tensions_to_dict, to_json, workspace_to_dict, wrench_set_to_dict
-from ._cdpr_common import MODEL_HELP, Vec3, load_robot, pose_vector
+from ._cdpr_common import MODEL_HELP, Vec3, given, load_robot, pose_vector
 from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 from .cdpr_motion import add_commands
@@ -27,13 +26,6 @@ __all__ = ["register"]
 
 #: Largest workspace grid (points x orientations) one command evaluates.
 MAX_GRID_POINTS = 1_000_000
-
-
-class Method(str, Enum):
-    closed_form = "closed_form"
-    lp_min_sum = "lp_min_sum"
-    lp_min_max = "lp_min_max"
-    qp_min_norm = "qp_min_norm"
 
 
 _POSE_HELP = "Platform position X Y Z in m."
@@ -58,62 +50,65 @@ def _table(headers: list[str], rows: list[list[str]]) -> str:
     return "\n".join(out)
 
 
-def _tensions(model: str, pose: Any, rpy: Any, method: Method, tipping: bool,
-              stabilisers: bool, as_json: bool) -> int:
-    """Exit 0 when the pose is wrench-feasible, 1 when it is not."""
-    from ..cdpr import distribute_tensions
+def _tensions(model: str, pose: Any, rpy: Any, method: Optional[str],
+              tipping: Optional[bool], stabilisers: bool, as_json: bool) -> int:
+    """Exit 0 when the pose is wrench-feasible, 1 when it is not: the verdict, the binding
+    condition and the message are the library result's (options not given take the
+    library's defaults)."""
+    from ..cdpr import METHODS, distribute_tensions, tipping_moments
 
     P = pose_vector(pose, rpy)
     robot = load_robot(model, stabilisers)
-    res = distribute_tensions(robot, P, method.value, tipping=tipping)
-    doc = tensions_to_dict(robot, P, res)
-    code = 0 if doc["feasible"] else 1
-    t = res.tensions
-    names = [c.name for c in robot.cables]
+    if method is not None:
+        as_choice(method, METHODS, "--method")
+    res = distribute_tensions(robot, P, **given(method=method, tipping=tipping))
+    code = 0 if res.success else 1
     if as_json:
-        typer.echo(to_json(doc))
+        typer.echo(to_json(tensions_to_dict(robot, P, res)))
         return code
     note = "" if not res.tipping else (
-        "  (tipping checked)" if method == Method.closed_form else "  (tipping imposed)")
-    typer.echo(f"{robot.name}: pose {P.round(4).tolist()}  method {method.value}{note}")
+        "  (tipping checked)" if res.method == "closed_form" else "  (tipping imposed)")
+    typer.echo(f"{robot.name}: pose {P.round(4).tolist()}  method {res.method}{note}")
+    t = res.tensions
     if not np.all(np.isfinite(t)):
-        typer.echo("no tension distribution found: the pose is not wrench-feasible")
+        typer.echo(res.message)
         return code
-    rows = [[n, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if lo - 1e-6 <= v <= hi + 1e-6 else "!"]
-            for n, v, lo, hi in zip(names, t, robot.t_min, robot.t_max)]
+    rows = [[c.name, f"{v:.3f}", f"{lo:g}", f"{hi:g}", "ok" if inside else "!"]
+            for c, v, lo, hi, inside in zip(robot.cables, t, robot.t_min, robot.t_max,
+                                            res.within_limits)]
     typer.echo(_table(["cable", "tension [N]", "min", "max", ""], rows))
     typer.echo(f"feasible: {'yes' if res.success else 'no'}   "
                f"residual max|W t + w_e| = {res.residual:.2e}")
     if robot.has_tipping:
-        M = res.tipping_moments
+        tip = tipping_moments(robot, P, t)
         for k, base in enumerate(robot.bases):
-            sel = robot.edge_base == k
-            if np.any(sel):
-                typer.echo(f"base {base.name}: largest edge moment {M[sel].max():.2f} N m "
-                           f"({'stable' if M[sel].max() <= 1e-6 else 'TIPS'})")
+            if np.isfinite(tip.base_moment[k]):
+                typer.echo(f"base {base.name}: largest edge moment {tip.base_moment[k]:.2f} "
+                           f"N m ({'stable' if tip.base_stable[k] else 'TIPS'})")
+    typer.echo(res.message)
     return code
 
 
-def _wrench_set(model: str, pose: Any, rpy: Any, disturbance: Any, stabilisers: bool,
+def _wrench_set(model: str, pose: Any, rpy: Any, external_wrench: Any, stabilisers: bool,
                 as_json: bool, plot: Optional[Path] = None) -> None:
-    from ..cdpr import available_wrench_set, axis_capacities, capacity_margin, disturbance_box
+    from ..cdpr import (available_wrench_set, axis_capacities, capacity_margin,
+                        external_wrench_box, wrench_feasible)
 
     P = pose_vector(pose, rpy)
     robot = load_robot(model, stabilisers)
     D = None
-    if disturbance is not None:
+    if external_wrench is not None:
         hw = np.zeros(robot.dof)
-        vals = check_range(disturbance, "disturbance", MAX_TENSION_N, "N or N m")
+        vals = check_range(external_wrench, "--external-wrench", MAX_TENSION_N, "N or N m")
         hw[:min(len(vals), robot.dof)] = vals[:robot.dof]
-        D = disturbance_box(robot, hw)
+        D = external_wrench_box(robot, hw)
     modes: dict[str, dict[str, Any]] = {}
     for tip in ([False, True] if robot.has_tipping else [False]):
-        aws = available_wrench_set(robot, P, tipping=tip)
         modes["with_tipping" if tip else "tension_limits_only"] = {
             "capacities": axis_capacities(robot, P, tipping=tip),
-            "halfspaces": aws.facets(),
+            "halfspaces": available_wrench_set(robot, P, tipping=tip).facets(),
             "margin": float(capacity_margin(robot, P, D, tipping=tip)),
-            "gravity_feasible": bool(aws.contains(-aws.gravity_wrench))}
+            "gravity_feasible": bool(wrench_feasible(robot, P, tipping=tip))}
     out = wrench_set_to_dict(robot, P, modes)
     caps = {key: m["capacities"] for key, m in modes.items()}
     if plot is not None:
@@ -164,7 +159,7 @@ def _orientations(rpy: Any, sweep: float) -> np.ndarray:
 
 def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
                stabilisers: bool, as_json: bool, sweep: float = 0.0,
-               closure: bool = False) -> None:
+               closure: Optional[bool] = None) -> None:
     from ..cdpr import grid_points, wrench_feasible_workspace
 
     nx, ny, nz = (as_count(n, "grid", minimum=1) for n in grid)
@@ -180,7 +175,7 @@ def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
     pts, shape = grid_points(region, (nx, ny, nz))
     with working("cdpr workspace") as update:
         ws = wrench_feasible_workspace(robot, pts, orientations=ori, shape=shape,
-                                       chunk=2048, progress=update, closure=closure)
+                                       progress=update, **given(closure=closure))
     if plot is not None:
         from ..viz.cdpr import plot_workspace
         from ..viz.cdpr_binding import plot_binding
@@ -231,16 +226,21 @@ def register(app: typer.Typer) -> None:
         model: str = _MODEL_ARG,
         pose: Vec3 = _POSE_OPT,
         rpy: Vec3 = _RPY_OPT,
-        method: Method = typer.Option(Method.closed_form, "--method",
-                                      help="Tension distribution method."),
-        tipping: bool = typer.Option(False, "--tipping", help="Impose the tipping "
-                                     "constraints of the mobile bases (LP/QP methods)."),
+        method: Optional[str] = typer.Option(
+            None, "--method", help="Tension distribution method: closed_form, lp_min_sum, "
+                                   "lp_min_max or qp_min_norm (default: the library's, "
+                                   "taut.cdpr.distribute_tensions)."),
+        tipping: Optional[bool] = typer.Option(
+            None, "--tipping/--no-tipping", help="Consider the tipping of the mobile bases "
+                                                 "(FASTKIT eqs. 21-23; imposed by LP/QP, "
+                                                 "checked by closed_form) or not (default: "
+                                                 "the library's, considered)."),
         stabilisers: bool = _STAB_OPT,
         as_json: bool = _JSON_OPT,
     ) -> int:
-        """Cable tensions holding platform and payload at a pose (FASTKIT eqs. 17-20).
-        Exit 0 when a distribution within the limits exists, 1 when the pose is not
-        wrench-feasible, 2 on bad input."""
+        """Cable tensions holding platform and payload at a pose (FASTKIT eqs. 17-23).
+        Exit 0 when the pose is wrench-feasible (tensions within the limits, no mobile base
+        tips or slides), 1 when it is not (the last line says why), 2 on bad input."""
         return _tensions(model, pose, rpy, method, tipping, stabilisers, as_json)
 
     @sub.command("wrench-set")
@@ -248,9 +248,10 @@ def register(app: typer.Typer) -> None:
         model: str = _MODEL_ARG,
         pose: Vec3 = _POSE_OPT,
         rpy: Vec3 = _RPY_OPT,
-        disturbance: Optional[tuple[float, float, float, float, float, float]] = typer.Option(
-            None, "--disturbance", help="Half-widths FX FY FZ MX MY MZ (N, N m) of an extra "
-                                        "wrench box for the capacity margin."),
+        external_wrench: Optional[tuple[float, float, float, float, float, float]] = \
+            typer.Option(None, "--external-wrench", help="Half-widths FX FY FZ (N) MX MY MZ "
+                                                         "(N m) of a box of extra external "
+                                                         "wrenches for the capacity margin."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write a bar chart of the "
                                             "axis capacities (like FASTKIT Fig. 14; .png, "
                                             ".pdf, .svg)."),
@@ -259,7 +260,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Available wrench set at a pose: axis capacities, margin, half-spaces (eq. 24)."""
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
-        _wrench_set(model, pose, rpy, disturbance, stabilisers, as_json, plot)
+        _wrench_set(model, pose, rpy, external_wrench, stabilisers, as_json, plot)
 
     @sub.command("workspace")
     def workspace_cmd(
@@ -277,9 +278,10 @@ def register(app: typer.Typer) -> None:
                                             ".pdf, .svg)."),
         stabilisers: bool = _STAB_OPT,
         as_json: bool = _JSON_OPT,
-        closure: bool = typer.Option(False, "--closure", help="Also compute the "
-                                     "wrench-closure workspace (positive tensions, no "
-                                     "limits; exact LP per pose)."),
+        closure: Optional[bool] = typer.Option(
+            None, "--closure/--no-closure", help="Also compute the wrench-closure workspace "
+                                                 "(positive tensions, no limits; exact LP "
+                                                 "per pose; default: the library's, not)."),
     ) -> None:
         """Wrench-feasible workspace with and without tipping; coverage of the desired one."""
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)

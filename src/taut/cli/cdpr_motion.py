@@ -18,12 +18,12 @@ import typer
 from .._validate import MAX_TENSION_N, as_box, as_count, check_range
 from ..errors import InvalidInputError
 from ..io.serialize import deployment_to_dict, to_json, twist_set_to_dict
-from ._cdpr_common import MODEL_HELP, Vec3, Vec6, load_robot, pose_vector, speeds
+from ._cdpr_common import MODEL_HELP, Vec3, Vec6, given, load_robot, pose_vector, speeds
 from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 
 if TYPE_CHECKING:
-    from ..cdpr import ModeName
+    from ..cdpr import ModeName, MotionLimits
 
 __all__ = ["add_commands"]
 
@@ -31,27 +31,46 @@ __all__ = ["add_commands"]
 MAX_DEPLOY_ITERATIONS = 1000
 
 
-def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, base_speed: float,
-               yaw_rate: float, cable_speed: float, stabilisers: bool, as_json: bool,
-               plot: Optional[Path]) -> None:
-    from ..cdpr import MotionLimits, available_twist_set, twist_capacities
+def _limits(base_speed: Optional[float], yaw_rate: Optional[float],
+            cable_speed: Optional[float]) -> MotionLimits:
+    """FASTKIT's joint velocity limits (the library's) with the speeds given overridden."""
+    from ..cdpr import MotionLimits, fastkit_motion_limits
 
-    P = pose_vector(pose, rpy)
     for field, value in (("--base-speed", base_speed), ("--yaw-rate", yaw_rate),
                          ("--cable-speed", cable_speed)):   # name the option, not the model
-        if value <= 0:
-            raise InvalidInputError(field, f"speed limits must be positive, got {value:g}")
-        speeds(value, field)
+        if value is not None:
+            if value <= 0:
+                raise InvalidInputError(field, f"speed limits must be positive, got {value:g}")
+            speeds(value, field)
+    lim = fastkit_motion_limits()
+    lo, hi = np.array(lim.base_min, float), np.array(lim.base_max, float)
+    if yaw_rate is not None:
+        lo[0], hi[0] = -yaw_rate, yaw_rate
+    if base_speed is not None:
+        lo[1:], hi[1:] = -base_speed, base_speed
+    if cable_speed is None:
+        return MotionLimits(lo, hi, lim.cable_min, lim.cable_max)
+    return MotionLimits(lo, hi, -cable_speed, cable_speed)
+
+
+def _twist_set(model: str, pose: Any, rpy: Any, mode: Optional[str], moving: Any,
+               base_speed: Optional[float], yaw_rate: Optional[float],
+               cable_speed: Optional[float], stabilisers: bool, as_json: bool,
+               plot: Optional[Path]) -> None:
+    from ..cdpr import available_twist_set, twist_capacities
+
+    P = pose_vector(pose, rpy)
+    lim = _limits(base_speed, yaw_rate, cable_speed)
     robot = load_robot(model, stabilisers)
-    lim = MotionLimits((-yaw_rate, -base_speed, -base_speed), (yaw_rate, base_speed, base_speed),
-                       -cable_speed, cable_speed)
-    mv = None if not moving else tuple(moving)
+    choice = given(mode=mode, moving=None if not moving else tuple(moving))
     with working("cdpr twist-set"):
-        caps = twist_capacities(robot, P, lim, mode, mv)
-        fixed = twist_capacities(robot, P, lim, "task", ()) if mode == "task" else None
-        ats = available_twist_set(robot, P, lim, mode, mv)
-    out = twist_set_to_dict(robot, P, mode, caps, fixed, int(np.isfinite(ats.h).sum()))
-    series = {f"{mode}: {', '.join(caps.mode.names) or 'none'} moving": caps.positive}
+        caps = twist_capacities(robot, P, lim, **choice)
+        task = caps.mode.kind == "task"
+        fixed = twist_capacities(robot, P, lim, "task", ()) if task else None
+        ats = available_twist_set(robot, P, lim, **choice)
+    kind: ModeName = "task" if task else "navigation"
+    out = twist_set_to_dict(robot, P, kind, caps, fixed, int(np.isfinite(ats.h).sum()))
+    series = {f"{kind}: {', '.join(caps.mode.names) or 'none'} moving": caps.positive}
     if fixed is not None:
         series["bases fixed"] = fixed.positive
     if plot is not None:
@@ -64,7 +83,7 @@ def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, bas
     if as_json:
         typer.echo(to_json(out))
         return
-    typer.echo(f"{robot.name}: available twist set at {np.round(P, 3).tolist()} ({mode} mode, "
+    typer.echo(f"{robot.name}: available twist set at {np.round(P, 3).tolist()} ({kind} mode, "
                f"moving: {', '.join(caps.mode.names) or 'none'}; {out['facets']} facets)")
     typer.echo("axis   +max      -max" + ("    fixed +max" if fixed is not None else ""))
     for k, lab in enumerate(caps.labels):
@@ -74,26 +93,30 @@ def _twist_set(model: str, pose: Any, rpy: Any, mode: ModeName, moving: Any, bas
         typer.echo(row)
 
 
-def _deploy(model: str, ws: Any, disturbance: Any, twist: Any, stabilisers: bool, seed: int,
-            maxiter: int, plot: Optional[Path], as_json: bool) -> int:
-    from ..cdpr import disturbance_box, plan_deployment
+def _deploy(model: str, ws: Any, external_wrench: Any, twist: Any, stabilisers: bool,
+            seed: Optional[int], maxiter: Optional[int], plot: Optional[Path],
+            as_json: bool) -> int:
+    from ..cdpr import external_wrench_box, plan_deployment
 
     box = as_box(ws, "workspace", allow_flat=False)
     if box[0, 2] < 0:
         raise InvalidInputError("workspace", f"zmin {box[0, 2]:g} m is below the floor "
                                 "(z = 0); the platform cannot go there")
-    if disturbance is not None:
-        check_range(disturbance, "disturbance", MAX_TENSION_N, "N or N m")
+    if external_wrench is not None:
+        check_range(external_wrench, "--external-wrench", MAX_TENSION_N, "N or N m")
     if twist is not None:
         speeds(twist, "twist")
-    as_count(seed, "seed", minimum=0)
-    as_count(maxiter, "maxiter", minimum=0, maximum=MAX_DEPLOY_ITERATIONS)
+    if seed is not None:
+        as_count(seed, "seed", minimum=0)
+    if maxiter is not None:
+        as_count(maxiter, "maxiter", minimum=0, maximum=MAX_DEPLOY_ITERATIONS)
     robot = load_robot(model, stabilisers)
-    D = None if disturbance is None else disturbance_box(robot, disturbance[:robot.dof])
+    D = None if external_wrench is None else \
+        external_wrench_box(robot, external_wrench[:robot.dof])
     with working("cdpr deploy"):
         res = plan_deployment(robot, box, external_wrench=D,
                               required_twist=None if twist is None else twist[:robot.dof],
-                              seed=seed, maxiter=maxiter)
+                              **given(seed=seed, maxiter=maxiter))
     out = deployment_to_dict(robot, res)
     note = None
     if plot is not None:
@@ -137,13 +160,18 @@ def add_commands(sub: typer.Typer) -> None:
         pose: Vec3 = typer.Option(..., "--pose", help="Platform position X Y Z in m."),
         rpy: Vec3 = typer.Option((0.0, 0.0, 0.0), "--rpy",
                                  help="Platform orientation ROLL PITCH YAW in rad."),
-        mode: str = typer.Option("task", "--mode", help="task or navigation."),
+        mode: Optional[str] = typer.Option(None, "--mode", help="task or navigation "
+                                           "(default: the library's, task)."),
         moving: Optional[list[str]] = typer.Option(
             None, "--moving", help="Base moving in task mode / driver in navigation mode "
                                    "(repeatable; default the first mobile base)."),
-        base_speed: float = typer.Option(0.2, "--base-speed", help="Base speed limit, m/s."),
-        yaw_rate: float = typer.Option(0.2, "--yaw-rate", help="Base yaw-rate limit, rad/s."),
-        cable_speed: float = typer.Option(2.0, "--cable-speed", help="Cable speed limit, m/s."),
+        base_speed: Optional[float] = typer.Option(
+            None, "--base-speed", help="Base speed limit, m/s (default: FASTKIT's, "
+                                       "taut.cdpr.fastkit_motion_limits)."),
+        yaw_rate: Optional[float] = typer.Option(
+            None, "--yaw-rate", help="Base yaw-rate limit, rad/s (default: FASTKIT's)."),
+        cable_speed: Optional[float] = typer.Option(
+            None, "--cable-speed", help="Cable speed limit, m/s (default: FASTKIT's)."),
         stabilisers: bool = typer.Option(False, "--stabilisers",
                                          help="Deploy the stabilisers of mobile bases first "
                                               "(wider footprints against tipping)."),
@@ -154,11 +182,9 @@ def add_commands(sub: typer.Typer) -> None:
     ) -> None:
         """Available twist set of the platform (FASTKIT §3.2, Fig. 13): axis capacities with
         the mode's bases moving, and (task mode) with all bases fixed."""
-        if mode not in ("task", "navigation"):
-            raise InvalidInputError("mode", f"must be task or navigation, got {mode!r}")
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
-        _twist_set(model, pose, rpy, "task" if mode == "task" else "navigation", moving,
-                   base_speed, yaw_rate, cable_speed, stabilisers, as_json, plot)
+        _twist_set(model, pose, rpy, mode, moving, base_speed, yaw_rate, cable_speed,
+                   stabilisers, as_json, plot)
 
     @sub.command("deploy")
     def deploy_cmd(
@@ -166,16 +192,20 @@ def add_commands(sub: typer.Typer) -> None:
         workspace: Vec6 = typer.Option(..., "--workspace",
                                        help="XMIN XMAX YMIN YMAX ZMIN ZMAX in m (the order "
                                             "of `workspace --box`)."),
-        disturbance: Optional[Vec6] = typer.Option(
-            None, "--disturbance", help="Half-widths FX FY FZ MX MY MZ (N, N m) of an extra "
-                                        "wrench box to resist everywhere."),
+        external_wrench: Optional[Vec6] = typer.Option(
+            None, "--external-wrench", help="Half-widths FX FY FZ (N) MX MY MZ (N m) of a box "
+                                            "of extra external wrenches to resist "
+                                            "everywhere."),
         twist: Optional[Vec6] = typer.Option(
             None, "--twist", help="Required twist VX VY VZ WX WY WZ (m/s, rad/s)."),
         stabilisers: bool = typer.Option(False, "--stabilisers",
                                          help="Deploy the stabilisers first."),
-        seed: int = typer.Option(0, "--seed", help="Seed of the differential-evolution "
-                                 "search (>= 0; the same seed gives the same placement)."),
-        maxiter: int = typer.Option(8, "--maxiter", help="Differential-evolution iterations."),
+        seed: Optional[int] = typer.Option(
+            None, "--seed", help="Seed of the differential-evolution search (>= 0; the same "
+                                 "seed gives the same placement; default: the library's)."),
+        maxiter: Optional[int] = typer.Option(
+            None, "--maxiter", help="Differential-evolution iterations (default: the "
+                                    "library's, taut.cdpr.DeploymentOptions)."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Top view (.png, .pdf, "
                                             ".svg)."),
         as_json: bool = typer.Option(False, "--json", help="Print machine-readable JSON "
@@ -186,5 +216,5 @@ def add_commands(sub: typer.Typer) -> None:
         boxes impossible without a search. Exit 0 with a verified placement, 1 without, 2 on
         bad input."""
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
-        return _deploy(model, workspace, disturbance, twist, stabilisers, seed, maxiter, plot,
-                       as_json)
+        return _deploy(model, workspace, external_wrench, twist, stabilisers, seed, maxiter,
+                       plot, as_json)

@@ -9,7 +9,6 @@ line on stderr says so); 2 bad input.
 from __future__ import annotations
 
 import sys
-from enum import Enum
 from pathlib import Path
 from typing import Optional
 
@@ -17,20 +16,12 @@ import numpy as np
 import typer
 
 from ..errors import InvalidInputError
-from ._cdpr_common import load_robot
+from .._validate import as_choice
+from ._cdpr_common import given, load_robot
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
 
-#: Controllers the command offers (taut.cdpr.control.controllers.CONTROLLERS, without importing it).
-_CONTROLLERS = ("velocity", "torque")
-
 __all__ = ["add_simulate"]
-
-
-class Profile(str, Enum):
-    quintic = "quintic"
-    trapezoidal = "trapezoidal"
-
 
 def _waypoints(text: str) -> np.ndarray:
     """``"x,y,z; x,y,z; ..."`` -> (W, 3)."""
@@ -58,15 +49,24 @@ def add_simulate(sub: typer.Typer) -> None:
             None, "--waypoints", help="Pick-and-place waypoints 'x,y,z; x,y,z; ...' (m)."),
         reference: Optional[Path] = typer.Option(
             None, "--reference", help="CSV reference: time,x,y,z,roll,pitch,yaw (s, m, rad)."),
-        controller: str = typer.Option("torque", "--controller", help="velocity or torque."),
-        exit_error: float = typer.Option(0.0, "--exit-error",
-                                         help="Std. dev. of seeded exit-point errors, mm."),
-        seed: int = typer.Option(0, "--seed", help="Seed of the model errors."),
-        speed: float = typer.Option(1.0, "--speed", help="Pick-and-place speed, m/s."),
-        profile: Profile = typer.Option(Profile.quintic, "--profile", help="Velocity "
-                                        "profile of each segment: quintic or trapezoidal."),
-        dwell: float = typer.Option(0.5, "--dwell", help="Rest at each waypoint, s."),
-        control_rate: float = typer.Option(1000.0, "--control-rate", help="Hz."),
+        controller: str = typer.Option("torque", "--controller", help="velocity or torque "
+                                       "(taut.cdpr.CONTROLLERS)."),
+        exit_error: Optional[float] = typer.Option(
+            None, "--exit-error", help="Std. dev. of seeded exit-point errors, mm (default: "
+                                       "the library's, none)."),
+        seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the model errors "
+                                           "(default: the library's)."),
+        speed: Optional[float] = typer.Option(
+            None, "--speed", help="Pick-and-place peak speed, m/s (default: the library's, "
+                                  "taut.cdpr.pick_and_place)."),
+        profile: Optional[str] = typer.Option(
+            None, "--profile", help="Velocity profile of each segment: quintic or "
+                                    "trapezoidal (default: the library's)."),
+        dwell: Optional[float] = typer.Option(
+            None, "--dwell", help="Rest at each waypoint, s (default: the library's)."),
+        control_rate: Optional[float] = typer.Option(
+            None, "--control-rate", help="Controller rate, Hz (default: the library's, "
+                                         "taut.cdpr.simulate)."),
         stabilisers: bool = typer.Option(False, "--stabilisers",
                                          help="Deploy the stabilisers of mobile bases."),
         as_json: bool = typer.Option(False, "--json", help="Print the result as JSON "
@@ -77,19 +77,16 @@ def add_simulate(sub: typer.Typer) -> None:
         animate: Optional[Path] = typer.Option(None, "--animate", help="3D animation (GIF)."),
     ) -> None:
         """Simulate velocity or torque control of the cable robot (FASTKIT §2.2)."""
-        if controller not in _CONTROLLERS:
-            raise InvalidInputError("--controller", f"unknown controller {controller!r}; "
-                                                    "choose velocity or torque")
         if (waypoints is None) == (reference is None):
             raise InvalidInputError("--waypoints", "give exactly one of --waypoints and "
                                                    "--reference")
-        if not (np.isfinite(exit_error) and 0 <= exit_error <= 1000):
+        if exit_error is not None and not (np.isfinite(exit_error) and 0 <= exit_error <= 1000):
             raise InvalidInputError("--exit-error", "must be a number of mm in [0, 1000]")
         output_path(json_out, "--out", JSON_SUFFIXES)
         output_path(plot, "--plot", FIGURE_SUFFIXES)
         output_path(animate, "--animate", ANIMATION_SUFFIXES)
-        from ..cdpr import ModelErrors, pick_and_place
-        from ..cdpr.control.controllers import CONTROLLERS
+        from ..cdpr import CONTROLLERS, ModelErrors, pick_and_place
+        as_choice(controller, CONTROLLERS, "--controller")
         from ..io.cdpr_dynamics import load_cdpr_dynamics
         from ..io.cdpr_reference import read_reference_csv
         from ..io.files import write_json
@@ -99,11 +96,12 @@ def add_simulate(sub: typer.Typer) -> None:
         robot = load_robot(model, stabilisers)
         dyn = load_cdpr_dynamics(model)
         if waypoints is not None:
-            ref = pick_and_place(robot, _waypoints(waypoints), speed, profile=profile.value,
-                                 dwell=dwell)
+            ref = pick_and_place(robot, _waypoints(waypoints),
+                                 **given(speed=speed, profile=profile, dwell=dwell))
         else:
             ref = read_reference_csv(robot, reference)  # type: ignore[arg-type]
-        errs = ModelErrors(exit_offset=exit_error * 1e-3, seed=seed)
+        errs = ModelErrors(**given(exit_offset=None if exit_error is None else exit_error * 1e-3,
+                                   seed=seed))
         ctl = CONTROLLERS[controller]()
         run = _run(robot, ref, ctl, errs, control_rate, dyn)
         if json_out is not None:
@@ -128,8 +126,8 @@ def _run(robot, ref, ctl, errs, rate, dyn):
     from ..cdpr import simulate
 
     with working(f"cdpr simulate ({ctl.name} control)") as update:
-        return simulate(robot, ref, ctl, model_errors=errs, control_rate=rate, dynamics=dyn,
-                        progress=update)
+        return simulate(robot, ref, ctl, model_errors=errs, dynamics=dyn, progress=update,
+                        **given(control_rate=rate))
 
 
 def _report(run, json_out, plot, animate) -> None:

@@ -41,12 +41,12 @@ def format_table(result: FKResult, *, name: str | None, units: str | None) -> st
     lines.append(f"N = {result.sheet.n} robots, hold height {result.hold_height:g}{u}, "
                  f"method {result.method}: {len(result.equilibria)} solution(s), "
                  f"{len(result.stable)} stable")
-    rows = [("#", "taut", f"x_o", "y_o", "z_o", "contact (u, v)", "status", "weights",
+    rows = [("#", "taut", f"x_o", "y_o", "z_o", "contact (u, v)", "kind", "weights",
              "tensions [N]")]
     for k, e in enumerate(result.equilibria, 1):
         rows.append((str(k), "{" + ",".join(str(i + 1) for i in e.taut) + "}",
                      f"{e.object[0]:.2f}", f"{e.object[1]:.2f}", f"{e.object[2]:.2f}",
-                     f"({e.contact[0]:.2f}, {e.contact[1]:.2f})", e.status,
+                     f"({e.contact[0]:.2f}, {e.contact[1]:.2f})", e.kind,
                      _fmt(e.weights, 3), "-" if e.tensions is None else _fmt(e.tensions, 4)))
     if len(rows) == 1:
         rows = []
@@ -56,39 +56,13 @@ def format_table(result: FKResult, *, name: str | None, units: str | None) -> st
         lines.append("  ".join(cell.rjust(w) if c in right else cell.ljust(w)
                                for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
     if not result.equilibria:
-        lines.append("no equilibrium: " + explain_no_equilibrium(result))
+        lines.append(result.message)            # why: worked out by the library
     f = result.funnel
     if f is not None:
         lines.append(f"Algorithm 1 funnel: {f.combinations} taut sets tried, {f.form_closure} "
                      f"form closure, {f.cqp_feasible} CQP feasible, {f.height_feasible} "
                      f"height feasible, {f.force_closure} force closure")
     return "\n".join(lines)
-
-
-def explain_no_equilibrium(result: FKResult) -> str:
-    """Why forward kinematics found nothing: the rest states the object would reach if the
-    floor were not there (solving the same team with holding points raised by the sheet's
-    diameter, an upper bound of every cable length; the depth below the holding points
-    does not depend on the hold height, FK paper eq. 15 only discards z_o <= 0)."""
-    from ..errors import TautError
-    from ..sheet import forward_kinematics
-
-    v = result.sheet.vertices
-    diameter = float(max(((v[:, None] - v[None]) ** 2).sum(-1).max() ** 0.5, 1.0))
-    try:
-        raised = forward_kinematics(result.sheet, result.formation,
-                                    result.hold_height + diameter, method="fast")
-    except TautError:                       # the raised height is out of the accepted range
-        return "no state of this team has the object above the floor (0 < z_o < z_r)"
-    below = [e for e in raised.equilibria if e.object[2] - diameter <= 0]
-    if not below:
-        return "no state of this team passes the paper's Algorithm 1"
-    parts = ", ".join("{" + ",".join(str(i + 1) for i in e.taut) + "}"
-                      f" at z_o = {e.object[2] - diameter:.4g}" for e in below[:5])
-    more = f" and {len(below) - 5} more" if len(below) > 5 else ""
-    return (f"{len(below)} state(s) discarded because the object would hang at or below the "
-            f"floor (z_o <= 0, FK paper eq. 15): {parts}{more}; raise the hold height or "
-            "spread the robots apart (a tighter sheet holds the object higher)")
 
 
 def register(app: typer.Typer) -> None:
@@ -111,6 +85,8 @@ def register(app: typer.Typer) -> None:
         """Forward kinematics: every place the object can rest, which are stable, and
         each robot's cable tension. Exit 0 with at least one equilibrium, 1 when there is
         none (the reason is printed), 2 on bad input."""
+        from dataclasses import replace
+
         from ..io.sheet_scenario import load_sheet_scenario
         from ..sheet import forward_kinematics
 
@@ -120,17 +96,16 @@ def register(app: typer.Typer) -> None:
         if sc.formation is None:
             raise ScenarioError("formation", "required key is missing (taut fk needs the "
                                 "robots' positions)")
+        team = sc.team if m is None else replace(sc.team, mass=m)
         if method == FKMethod.subsets:
-            as_count(sc.sheet.n, "sheet", maximum=SUBSETS_MAX_ROBOTS)
-        as_count(sc.sheet.n, "sheet", maximum=MAX_ROBOTS)
+            as_count(team.n, "sheet", maximum=SUBSETS_MAX_ROBOTS)
+        as_count(team.n, "sheet", maximum=MAX_ROBOTS)
         with working(f"fk ({method.value})"):
-            result = forward_kinematics(sc.sheet, sc.formation, sc.hold_height,
-                                        mass=m if m is not None else sc.mass,
-                                        method=method.value)
+            result = forward_kinematics(team, sc.formation, method=method.value)
         if as_json:
             doc = fk_result_to_dict(result)
             if not result.equilibria:
-                doc["message"] = "no equilibrium: " + explain_no_equilibrium(result)
+                doc["message"] = result.message
             typer.echo(to_json(doc))
         else:
             typer.echo(format_table(result, name=sc.name, units=sc.units))

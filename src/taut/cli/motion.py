@@ -75,6 +75,8 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Inverse kinematics: where the robots must stand so that the object rests
         stably at the target with every cable taut."""
+        from dataclasses import replace
+
         from ..io.sheet_scenario import load_sheet_scenario
         from ..sheet.ik.inverse import inverse_kinematics
 
@@ -84,9 +86,9 @@ def register(app: typer.Typer) -> None:
         check_range(heading, "--heading", 1e6, "degrees")
         m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
-        r = inverse_kinematics(sc.sheet, object_position, sc.hold_height,
-                               contact=contact, heading=np.radians(heading),
-                               mass=m if m is not None else sc.mass)
+        team = sc.team if m is None else replace(sc.team, mass=m)
+        r = inverse_kinematics(team, object_position, contact=contact,
+                               heading=np.radians(heading))
         if not r.success:                      # a valid question answered "no": exit 1
             typer.echo(f"taut: {r.status}: {r.message}", err=True)
             raise typer.Exit(1)
@@ -107,6 +109,8 @@ def register(app: typer.Typer) -> None:
                                             "height with events; top view of all paths)."),
     ) -> None:
         """Quasi-static simulation of the object while the robots follow a trajectory."""
+        from dataclasses import replace
+
         from ..io.sheet_scenario import load_sheet_scenario
         from ..io.trajectory import load_trajectory
         from ..sheet.sim.simulate import simulate
@@ -114,13 +118,13 @@ def register(app: typer.Typer) -> None:
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
         m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
+        team = sc.team if m is None else replace(sc.team, mass=m)
         traj = load_trajectory(trajectory)
-        if traj.n_robots != sc.sheet.n:
+        if traj.n_robots != team.n:
             raise InvalidInputError(str(trajectory), f"has {traj.n_robots} robots but the "
-                                    f"sheet has {sc.sheet.n} vertices")
+                                    f"sheet has {team.n} vertices")
         with working("simulate"):
-            r = simulate(sc.sheet, traj.formations, sc.hold_height,
-                         mass=m if m is not None else sc.mass)
+            r = simulate(team, traj.formations)
         if as_json:
             typer.echo(to_json(simulation_to_dict(r, traj.time), indent=None))
         else:

@@ -59,7 +59,7 @@ def register(app: typer.Typer) -> None:
             raise ScenarioError("formation", "required key is missing (taut physics needs "
                                 "the robots' positions)")
         try:
-            from ..physics import DEFAULT_MESH, check_equilibria, settle
+            from ..physics import DEFAULT_MESH, replay_equilibria, settle
             import mujoco  # noqa: F401
         except ImportError:
             raise InvalidInputError("physics", "needs MuJoCo: pip install 'taut[physics]'"
@@ -69,11 +69,11 @@ def register(app: typer.Typer) -> None:
             from rich.progress import Progress
             with Progress(transient=True) as bar:
                 task = bar.add_task("settling each state", total=None)
-                check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=div,
-                                         progress=lambda d, t: bar.update(task, completed=d,
-                                                                          total=t))
+                check = replay_equilibria(sc.team, sc.formation, mesh=div,
+                                          progress=lambda d, t: bar.update(task, completed=d,
+                                                                           total=t))
         else:
-            check = check_equilibria(sc.sheet, sc.formation, sc.hold_height, mesh=div)
+            check = replay_equilibria(sc.team, sc.formation, mesh=div)
         if as_json:
             typer.echo(to_json(equilibria_check_to_dict(check)))
         else:
@@ -81,14 +81,14 @@ def register(app: typer.Typer) -> None:
         if plot is not None:
             import matplotlib.pyplot as plt
             from ..viz.physics import plot_equilibria_check
-            plt.close(plot_equilibria_check(check, sc.formation, sc.hold_height, plot,
+            plt.close(plot_equilibria_check(check, sc.formation, sc.team.hold_height, plot,
                                             units=sc.units, title=sc.name))
             if not as_json:
                 typer.echo(f"figure written to {plot}")
         if video is not None:
             from ..viz.physics import animate_settle
-            drop = settle(sc.sheet, sc.formation, sc.hold_height, trace=True, mesh=div)
-            animate_settle(drop, sc.formation, sc.hold_height, video)
+            drop = settle(sc.team, sc.formation, trace=True, mesh=div)
+            animate_settle(drop, sc.formation, sc.team.hold_height, video)
             if not as_json:
                 typer.echo(f"animation written to {video}")
         if not check.success:

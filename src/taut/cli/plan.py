@@ -2,25 +2,23 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
 import typer
 
-from .._validate import as_count
 from ..errors import InvalidInputError
 from ..io.serialize import plan_to_dict, robustness_to_dict, to_json
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
 
-__all__ = ["register", "plan_to_dict", "plan_command"]
+__all__ = ["register", "plan_command"]
 
-#: Largest search budget the command accepts, s (one hour).
-MAX_BUDGET_S = 3600.0
-#: Largest iteration budget the command accepts (a few minutes of search per run).
-MAX_ITERATIONS = 200_000
-#: Most Monte Carlo trials of --robustness (each replays the whole plan).
-MAX_TRIALS = 100_000
+#: The command-line option of each library keyword whose name differs (the others are
+#: ``--`` and the keyword with dashes).
+_OPTION_OF = {"time_budget": "--budget", "sigma": "--robustness"}
 
 
 def plan_command(
@@ -68,24 +66,32 @@ def plan_command(
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
     input."""
     from ..io.plan_scenario import load_plan_scenario
-    from ..plan.planner import plan
+    from ..plan.checks.robustness import monte_carlo
+    from ..plan._options import plan_options, robustness_options
+    from ..plan.planner import run_plan
 
     out = output_path(out, "--out", JSON_SUFFIXES)
     plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
-    _check_options(budget, sheet_margin, seed, iterations, search, spacing,
-                   baseline and disc_baseline, robustness, trials)
+    if baseline and disc_baseline:
+        raise InvalidInputError("--baseline", "give at most one of --baseline and "
+                                "--disc-baseline")
+    with _named_as_options():                 # the library's validation, before any work
+        options = plan_options(
+            method="algorithm2" if algorithm2 else "se2",
+            baseline="disc" if disc_baseline else "se2" if baseline else None,
+            time_budget=budget, iterations=iterations, sheet_margin=sheet_margin, seed=seed,
+            search=search, spacing=spacing)
+        replays = robustness_options(0.0 if robustness is None else robustness, trials,
+                                     seed=seed)
     sc = load_plan_scenario(scenario)
     with working("plan"):
-        result = plan(sc, baseline="disc" if disc_baseline else baseline,
-                      method="algorithm2" if algorithm2 else "se2", time_budget=budget,
-                      iterations=iterations, sheet_margin=sheet_margin, seed=seed,
-                      search=search, spacing=spacing)  # type: ignore[arg-type]  # checked
+        result = run_plan(sc, options)
     doc = plan_to_dict(result)
     rob = None
     if robustness is not None and result.success:
         with working("robustness"):
-            rob = result.robustness(robustness, trials, seed=seed)
+            rob = monte_carlo(result, replays)
         doc["robustness"] = robustness_to_dict(rob)
     if out is not None:
         out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")
@@ -97,6 +103,17 @@ def plan_command(
             animate_plan(sc, result, animate)
     _report(result, rob, doc, as_json, plot, animate)
     return 0 if result.success else 1
+
+
+@contextmanager
+def _named_as_options() -> Iterator[None]:
+    """The library's option errors (:mod:`taut.plan._options`) with the field named as the
+    command-line option (``sheet_margin`` -> ``--sheet-margin``)."""
+    try:
+        yield
+    except InvalidInputError as exc:
+        name = _OPTION_OF.get(exc.field, "--" + exc.field.replace("_", "-"))
+        raise InvalidInputError(name, exc.problem) from None
 
 
 def _report(result, rob, doc: dict, as_json: bool, plot: Optional[Path],
@@ -123,36 +140,6 @@ def _report(result, rob, doc: dict, as_json: bool, plot: Optional[Path],
             if path is not None:
                 typer.echo(f"taut: {name}: {path} not written: there is no plan to draw",
                            err=True)
-
-
-def _check_options(budget: float | None, sheet_margin: float, seed: int, iterations: int,
-                   search: str, spacing: float, both_baselines: bool,
-                   robustness: float | None, trials: int) -> None:
-    """Every option's range, before any work (one line naming the option)."""
-    if budget is not None and not 0 < budget <= MAX_BUDGET_S:
-        raise InvalidInputError("--budget", f"must be in (0, {MAX_BUDGET_S:g}] s, got {budget:g}")
-    if not 0 <= sheet_margin <= 1.0:
-        raise InvalidInputError("--sheet-margin", f"must be in [0, 1] m, got {sheet_margin:g}")
-    as_count(seed, "--seed", minimum=0)
-    as_count(iterations, "--iterations", minimum=1, maximum=MAX_ITERATIONS)
-    _check_search(search)
-    if not 0.005 <= spacing <= 1.0:
-        raise InvalidInputError("--spacing", f"must be in [0.005, 1] m, got {spacing:g}")
-    if both_baselines:
-        raise InvalidInputError("--baseline", "give at most one of --baseline and "
-                                "--disc-baseline")
-    if robustness is not None and not 0 <= robustness <= 1.0:
-        raise InvalidInputError("--robustness", f"must be in [0, 1] m, got {robustness:g}")
-    as_count(trials, "--trials", minimum=1, maximum=MAX_TRIALS)
-
-
-def _check_search(search: str) -> None:
-    """``--search`` names a known search whose library is installed."""
-    from ..plan.se2._ompl import engine
-    try:
-        engine(search)
-    except InvalidInputError as exc:
-        raise InvalidInputError("--search", exc.problem) from None
 
 
 def register(app: typer.Typer) -> None:

@@ -91,8 +91,7 @@ def run_command(
                                 "sweep in DIR, skipping finished chunks."),
     limit: Optional[int] = typer.Option(None, "--limit", help="Only the first K points."),
 ) -> int:
-    from ..sweep.file import load_sweep
-    from ..sweep import run_sweep
+    from ..sweep import load_sweep, run_sweep
 
     if workers is not None and workers < 0:
         raise InvalidInputError("--workers", f"must be >= 0, got {workers}")
@@ -120,7 +119,7 @@ def plot_command(
     out: Optional[Path] = typer.Option(None, "--out", help="Figure file (.png, .pdf, .svg; "
                                        "default DIR/<value>.png)."),
 ) -> int:
-    from ..sweep.results import read_results
+    from ..sweep import read_results
 
     columns, meta = read_results(folder)
     target = output_path(out if out is not None else folder / f"{value}.png", "--out",

@@ -16,10 +16,8 @@ __all__ = ["register"]
 def _validated(path: Path) -> dict:
     """Read and validate SCENARIO with the loader of its kind, before serving."""
     from ..app.payload import kind_of_mapping
-    from ..io import cdpr_model_from_mapping, plan_scenario_from_mapping, \
-        sheet_scenario_from_mapping
-
-    from ..io import read_mapping
+    from ..io import (cdpr_model_from_mapping, plan_scenario_from_mapping, read_mapping,
+                      sheet_scenario_from_mapping)
 
     data = read_mapping(path)
     load = {"sheet": sheet_scenario_from_mapping, "plan": plan_scenario_from_mapping,

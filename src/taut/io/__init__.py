@@ -1,13 +1,34 @@
 """Scenario and model files: load, validate, save. Solvers never import this package.
 
-The names below are imported on first use (PEP 562), so ``import taut.io.serialize`` (the
+Files
+    :func:`read_mapping` parses a YAML or JSON file whose top level is a mapping,
+    :func:`read_text` reads one, :func:`validate_mapping` checks a parsed mapping against a
+    pydantic model (errors naming the dotted key), :func:`write_json` writes JSON.
+Sheet scenarios
+    :func:`load_sheet_scenario` and :func:`sheet_scenario_from_mapping` build a
+    :class:`SheetScenario` (the team, its formation, the length unit).
+Plan scenarios
+    :func:`load_plan_scenario` and :func:`plan_scenario_from_mapping` build a
+    :class:`taut.plan.Scenario`; :func:`plan_scenario_to_mapping` writes one back.
+Cable-robot models
+    :func:`load_cdpr_model` (a file or a preset name) and :func:`cdpr_model_from_mapping`
+    build a :class:`taut.cdpr.CableRobot`.
+
+Other file formats have their own modules: :mod:`taut.io.trajectory` (formation time
+series, CSV), :mod:`taut.io.cdpr_reference` (platform reference poses, CSV),
+:mod:`taut.io.cdpr_dynamics` (a model's dynamics section), :mod:`taut.io.caspr` (CASPR
+models), and :mod:`taut.io.serialize` (the JSON forms of results, through
+:func:`taut.io.serialize.json_ready`). Sweep files belong to :mod:`taut.sweep`.
+
+The names above are imported on first use (PEP 562), so ``import taut.io.serialize`` (the
 CLI's ``--help``) does not pull in scipy through the model loaders.
 """
 
 from __future__ import annotations
 
-from importlib import import_module
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
 
 if TYPE_CHECKING:                   # the real names, for type checkers
     from .cdpr_model import cdpr_model_from_mapping, load_cdpr_model
@@ -26,19 +47,16 @@ _HOME = {
     "sheet_scenario_from_mapping": "sheet_scenario",
 }
 
-__all__ = ["read_mapping", "read_text", "validate_mapping", "write_json", "SheetScenario",
-           "load_cdpr_model", "cdpr_model_from_mapping",
-           "load_sheet_scenario", "sheet_scenario_from_mapping",
-           "load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]
+__all__ = [
+    # files
+    "read_mapping", "read_text", "validate_mapping", "write_json",
+    # sheet scenarios
+    "load_sheet_scenario", "sheet_scenario_from_mapping", "SheetScenario",
+    # plan scenarios
+    "load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping",
+    # cable-robot models
+    "load_cdpr_model", "cdpr_model_from_mapping",
+]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _HOME:
-        value = getattr(import_module(f"{__name__}.{_HOME[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_names(__name__, _HOME, globals())

@@ -25,6 +25,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from .._units import GRAVITY
 from ..cdpr.model.robot import Base, Cable, CableRobot, Payload, Platform
 from ..errors import InvalidModelError, ScenarioError, TautError
 from .files import read_mapping, validate_mapping
@@ -86,7 +87,7 @@ class _Box(_Strict):
 
 class _ModelFile(_Strict):
     name: str = "cable robot"
-    gravity: Vec3 = (0.0, 0.0, -9.81)
+    gravity: Vec3 = (0.0, 0.0, -GRAVITY)
     bases: list[_Base] = Field(min_length=1)
     platform: _Platform
     payload: _Payload = _Payload()

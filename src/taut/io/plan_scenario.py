@@ -30,7 +30,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..errors import ScenarioError, TautError
 from ..plan.world import MAX_TEAM_ROBOTS, Obstacle, Scenario, Team, World
-from ..sheet import Sheet
+from ..sheet import Sheet, SheetTeam
 from .files import read_mapping, validate_mapping
 from .._validate import require_instance
 
@@ -122,8 +122,12 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
     if sheet.n > MAX_TEAM_ROBOTS:
         raise ScenarioError("team.sheet", f"a planning team has at most {MAX_TEAM_ROBOTS} "
                             f"robots, got {sheet.n}")
-    team = Team(sheet, t.hold_height, t.robot_radius, t.height_safety, t.lateral_safety,
-                t.speed, t.rotation_speed, t.mass)
+    try:
+        carrier = SheetTeam(sheet, t.hold_height, t.mass)
+    except TautError as exc:
+        raise ScenarioError(f"team.{exc.field}", exc.problem) from None
+    team = Team(carrier, t.robot_radius, t.height_safety, t.lateral_safety, t.speed,
+                t.rotation_speed)
     obstacles = []
     for k, o in enumerate(raw.obstacles):
         try:

@@ -23,26 +23,17 @@ if TYPE_CHECKING:                                  # imported lazily: keep `taut
     from ..cdpr.statics.tension import TensionResult
     from ..cdpr.sets.twist import TwistCapacities
     from ..cdpr.workspace.wrench_feasible import WorkspaceResult
-    from ..plan.result import PlanResult, Robustness
+    from ..plan.checks.robustness import Robustness
+    from ..plan.result import PlanResult
     from ..sheet.ik.inverse import IKResult
     from ..sheet.fk.results import Equilibrium, FKResult
     from ..sheet.sim.simulate import SimulationResult
 
-__all__ = ["to_json", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dict",
+__all__ = ["to_json", "json_ready", "finite_or_none", "equilibrium_to_dict", "fk_result_to_dict",
            "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",
            "wrench_set_to_dict", "workspace_to_dict", "twist_set_to_dict",
            "deployment_to_dict", "equilibria_check_to_dict", "control_result_to_dict",
            "monte_carlo_to_dict", "robustness_to_dict"]
-
-_MISSING = object()
-
-
-def _attr(obj: Any, new: str, old: str) -> Any:
-    """``obj.new`` when the result already follows the success/status/message convention,
-    else the old name (so no deprecated alias is ever touched)."""
-    value = getattr(obj, new, _MISSING)
-    return getattr(obj, old) if value is _MISSING else value
-
 
 def finite_or_none(x: Any, digits: int | None = None) -> float | None:
     """``float(x)`` (rounded to ``digits`` when given), or ``None`` when not finite.
@@ -60,14 +51,25 @@ def finite_or_none(x: Any, digits: int | None = None) -> float | None:
     return round(v, digits) if digits is not None else v
 
 
-def _clean(obj: Any) -> Any:
-    """Recursively: arrays to lists, numpy scalars to Python, non-finite floats to None."""
+def json_ready(obj: Any) -> Any:
+    """``obj`` as plain JSON data, recursively: arrays and tuples to lists, mapping keys to
+    str, numpy scalars to Python, and numbers that are not finite (NaN, inf) to ``None``.
+
+    The one NaN -> ``null`` conversion of taut: the CLI's ``--json`` output, the web app's
+    responses and the sweep's tables all go through it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> json_ready({"t": np.array([1.0, np.nan]), "n": np.int64(2)})
+    {'t': [1.0, None], 'n': 2}
+    """
     if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
+        return {str(k): json_ready(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
+        return [json_ready(v) for v in obj]
     if isinstance(obj, np.ndarray):
-        return _clean(obj.tolist())
+        return json_ready(obj.tolist())
     if isinstance(obj, (bool, np.bool_)):
         return bool(obj)
     if isinstance(obj, (int, np.integer)):
@@ -85,11 +87,12 @@ def to_json(obj: Any, *, indent: int | None = 2) -> str:
     >>> to_json({"t": [1.0, float("nan")]}, indent=None)
     '{"t": [1.0, null]}'
     """
-    return json.dumps(_clean(obj), indent=indent, allow_nan=False)
+    return json.dumps(json_ready(obj), indent=indent, allow_nan=False)
 
 
 def _floats(a: Any) -> list[float | None] | None:
-    return None if a is None else [finite_or_none(x) for x in np.asarray(a, float).ravel()]
+    """A float array, flattened, NaN as None (None stays None)."""
+    return None if a is None else json_ready(np.asarray(a, float).ravel())
 
 
 # --- sheet-carrying teams -------------------------------------------------------------------
@@ -103,7 +106,7 @@ def equilibrium_to_dict(e: Equilibrium) -> dict[str, Any]:
         "weights": _floats(e.weights),
         "tensions": _floats(e.tensions),
         "cable_lengths": _floats(e.cable_lengths),
-        "status": e.status,
+        "kind": e.kind,
         "stable": e.stable,
     }
 
@@ -134,7 +137,7 @@ def ik_to_dict(r: IKResult) -> dict[str, Any]:
 
 
 def _rows(a: np.ndarray) -> list[list[float | None]]:
-    return [[finite_or_none(v) for v in row] for row in np.asarray(a, float)]
+    return json_ready(np.asarray(a, float))
 
 
 def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
@@ -156,18 +159,15 @@ def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
 
 
 def plan_to_dict(r: PlanResult) -> dict[str, Any]:
-    """JSON form of a plan: ``success``, ``status``, ``message``, ``reason`` (deprecated:
-    ``message`` on failure, null on success), ``planner``, ``times`` [T], ``robots``
-    [T][N][2], ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``, ``bypassed``,
-    plus ``path_length`` (m) and ``duration`` (s) (null on failure) and ``search`` (who
-    found an SE(2) plan, null otherwise)."""
-    message = _attr(r, "message", "reason")
+    """JSON form of a plan: ``success``, ``status``, ``message``, ``planner``, ``times``
+    [T], ``robots`` [T][N][2], ``object`` [T][3], ``taut`` [T][k] (0-based), ``crossed``,
+    ``bypassed``, plus ``path_length`` (m) and ``duration`` (s) (null on failure) and
+    ``search`` (who found an SE(2) plan, null otherwise)."""
     return {
         "success": bool(r.success),
-        "status": getattr(r, "status", "ok" if r.success else "no_route"),
-        "message": message or "",
-        "reason": message if not r.success else None,
-        "planner": getattr(r, "planner", None),
+        "status": r.status,
+        "message": r.message,
+        "planner": r.planner,
         "times": [float(t) for t in r.times],
         "robots": np.asarray(r.robots, dtype=float).tolist(),
         "object": np.asarray(r.object, dtype=float).tolist(),
@@ -176,9 +176,9 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
         "bypassed": list(r.bypassed),
         "path_length": finite_or_none(r.path_length),
         "duration": finite_or_none(r.duration),
-        "search": getattr(r, "search", None),
-        "sheet_margin": finite_or_none(getattr(r, "sheet_margin", None)),
-        "formations": [f.kind for f in getattr(r, "formations", ())],
+        "search": r.search,
+        "sheet_margin": finite_or_none(r.sheet_margin),
+        "formations": [f.kind for f in r.formations],
         "margins": _plan_margins(r),
     }
 
@@ -186,7 +186,7 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
 def _plan_margins(r: PlanResult) -> dict[str, Any] | None:
     """The worst margins of a verified plan (m): object height above what is beneath it,
     robot-centre clearance, sheet slack of the tightest pair; null without a plan."""
-    v = getattr(r, "verification", None)
+    v = r.verification
     if v is None or not r.success:
         return None
     return {"height": finite_or_none(v.min_height_margin),
@@ -213,12 +213,14 @@ def robustness_to_dict(rob: Robustness) -> dict[str, Any]:
 
 def tensions_to_dict(robot: CableRobot, pose: np.ndarray, res: TensionResult) -> dict[str, Any]:
     """One pose of a tension distribution (``res`` of one pose; tensions keyed by cable
-    name, N)."""
+    name, N): ``feasible`` is the result's ``success``, ``message`` its one line,
+    ``binding`` the condition that fails (``""`` when feasible)."""
     names = [c.name for c in robot.cables]
     M = res.tipping_moments
     return {
         "model": robot.name, "pose": _floats(pose), "method": res.method,
-        "tipping": res.tipping, "feasible": bool(_attr(res, "success", "feasible")),
+        "tipping": res.tipping, "sliding": res.sliding, "feasible": bool(res.success),
+        "binding": str(res.binding), "message": res.message,
         "residual": finite_or_none(res.residual),
         "tensions": {n: finite_or_none(v) for n, v in zip(names, res.tensions)},
         "tipping_moments": None if not np.all(np.isfinite(M)) else [float(x) for x in M],
@@ -288,18 +290,16 @@ def deployment_to_dict(robot: CableRobot, res: DeploymentResult) -> dict[str, An
     """A deployment search: base poses (m, m, rad), margins, the lift certificate."""
     lb = res.lift_bound
     r4 = lambda x: finite_or_none(x, 4)  # noqa: E731
-    ok = bool(_attr(res, "success", "feasible"))
-    message = str(_attr(res, "message", "reason") or "")
+    ok = bool(res.success)
     return {
         "model": robot.name, "workspace": np.asarray(res.workspace).tolist(),
-        "success": ok, "status": getattr(res, "status", "ok" if ok else "infeasible"),
-        "message": message, "feasible": ok,
+        "success": ok, "status": res.status, "message": res.message, "feasible": ok,
         "refuted": bool(res.refuted),
         "base_poses": {k: [round(float(x), 4) for x in v] for k, v in res.base_poses.items()},
         "margin": r4(res.margin),
         "twist_margin": None if res.twist_margin is None else r4(res.twist_margin),
         "points": int(len(res.points)), "feasible_points": int(res.point_feasible.sum()),
-        "evaluations": res.evaluations, "reason": "" if ok else message,
+        "evaluations": res.evaluations,
         "lift_bound": None if lb is None else {
             "height": r4(lb.height), "bound": r4(lb.bound), "required": r4(lb.required),
             "weight": r4(lb.weight), "refutes": lb.refutes,

@@ -15,9 +15,10 @@ from pathlib import Path
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from .._validate import MAX_MASS_KG, MAX_ROBOTS, MAX_SHEET_LENGTH, check_range
+from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, check_range
 from ..errors import ScenarioError, TautError
-from ..sheet.model import Sheet, check_formation, check_hold_height
+from ..sheet.model import Sheet, check_formation
+from ..sheet.team import SheetTeam
 from .files import read_mapping, validate_mapping
 
 __all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"]
@@ -42,21 +43,18 @@ class SheetScenario:
 
     Attributes
     ----------
-    sheet : Sheet
-    hold_height : float
-        :math:`z_r`, in ``units``.
+    team : SheetTeam
+        The sheet, the holding height :math:`z_r` (in ``units``) and the object mass (kg,
+        or None).
     formation : ndarray, shape (N, 2), or None
-    mass : float or None
-        Object mass, kg.
+        Robot positions, in ``units``.
     units : str or None
         Length unit label (not interpreted).
     name : str or None
     """
 
-    sheet: Sheet
-    hold_height: float
+    team: SheetTeam
     formation: np.ndarray | None
-    mass: float | None
     units: str | None
     name: str | None
 
@@ -72,9 +70,7 @@ def sheet_scenario_from_mapping(data: dict) -> SheetScenario:
     try:
         for field, value, limit, unit in (
                 ("sheet", raw.sheet, MAX_SHEET_LENGTH, "scenario units"),
-                ("formation", raw.formation, MAX_SHEET_LENGTH, "scenario units"),
-                ("hold_height", raw.hold_height, MAX_SHEET_LENGTH, "scenario units"),
-                ("mass", raw.mass, MAX_MASS_KG, "kg")):
+                ("formation", raw.formation, MAX_SHEET_LENGTH, "scenario units")):
             if value is not None:
                 check_range(value, field, limit, unit)
     except TautError as exc:
@@ -87,18 +83,16 @@ def sheet_scenario_from_mapping(data: dict) -> SheetScenario:
     except TautError as exc:
         raise _rename(exc, "sheet") from None
     try:
-        hold = check_hold_height(raw.hold_height)
+        team = SheetTeam(sheet, raw.hold_height, raw.mass)
     except TautError as exc:
-        raise ScenarioError("hold_height", exc.problem) from None
-    if raw.mass is not None and not raw.mass > 0:
-        raise ScenarioError("mass", f"must be positive, got {raw.mass:g}")
+        raise ScenarioError(exc.field, exc.problem) from None
     formation = None
     if raw.formation is not None:
         try:
             formation = check_formation(sheet, np.array(raw.formation, dtype=float))
         except TautError as exc:
             raise ScenarioError("formation", exc.problem) from None
-    return SheetScenario(sheet, hold, formation, raw.mass, raw.units, raw.name)
+    return SheetScenario(team, formation, raw.units, raw.name)
 
 
 def load_sheet_scenario(path: str | Path) -> SheetScenario:

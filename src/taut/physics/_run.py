@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._units import GRAVITY
 from . import _tol
 from ._sheet_model import SheetSim
 from ._surface import clearance_lift, surface_below
@@ -34,7 +35,7 @@ def ramp(sim: SheetSim) -> None:
         s = s * s * (3 - 2 * s)            # smooth start and stop
         d.mocap_pos[sim.corner_mocap] = (1 - s) * sim.corner_start + s * sim.corner_goal
         mujoco.mj_step(m, d)
-    m.opt.gravity[:] = (0.0, 0.0, -9.81)
+    m.opt.gravity[:] = (0.0, 0.0, -GRAVITY)
 
 
 def _speeds(sim: SheetSim) -> tuple[float, float]:

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._units import GRAVITY
 from . import _tol
 from ._mesh import SheetMesh
 
@@ -127,7 +128,7 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     opt.timestep = timestep
     opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     opt.solver = mujoco.mjtSolver.mjSOL_NEWTON
-    opt.gravity = [0.0, 0.0, -9.81]
+    opt.gravity = [0.0, 0.0, -GRAVITY]
     opt.iterations = 50
     opt.ls_iterations = 20
     names = _add_nodes(spec, pos, set(corners), timestep)

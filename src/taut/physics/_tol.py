@@ -65,7 +65,7 @@ RELEASE_TIME = 3.0
 #: not-an-equilibrium state; see the 20-team table in examples/physics/README.md.
 HOLD_FRACTION = 0.05
 
-# --- mobile cable robot (taut.physics.check_tipping) ---
+# --- mobile cable robot (taut.physics.replay_tipping) ---
 #: Time step of the cable-robot simulation, s.
 CDPR_TIMESTEP = 0.002
 #: Simulated time after which the bases are judged, s (a base tips within a fraction of

@@ -25,7 +25,7 @@ from ..cdpr.kinematics.cables import as_poses
 from ..errors import InvalidInputError
 from . import _tol
 
-__all__ = ["TippingCheck", "TippingGridCheck", "check_tipping", "check_tipping_grid"]
+__all__ = ["TippingCheck", "TippingGridCheck", "replay_tipping", "replay_tipping_grid"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,7 +66,7 @@ class TippingCheck:
 
 @dataclass(frozen=True, eq=False)
 class TippingGridCheck:
-    """:func:`check_tipping` over a batch of poses, as arrays.
+    """:func:`replay_tipping` over a batch of poses, as arrays.
 
     ``verdicts`` (B, n_bases) of str, ``margin`` (B,), ``taut_stays`` / ``physics_stays``
     / ``feasible`` (B,) bool (``feasible``: tensions were found; other rows are NaN/False),
@@ -188,9 +188,9 @@ def _judge(model: Any, data: Any, robot: CableRobot, mobile: list[int]
     return tuple(verdicts), tilt, slip
 
 
-def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
-                  friction: float = _tol.FLOOR_FRICTION,
-                  duration: float = _tol.CDPR_DURATION) -> TippingCheck:
+def replay_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
+                   friction: float = _tol.FLOOR_FRICTION,
+                   duration: float = _tol.CDPR_DURATION) -> TippingCheck:
     """Simulate the robot at one pose under constant cable tensions and compare the bases'
     behaviour with taut's tipping moments (FASTKIT eqs. 21-23).
 
@@ -217,7 +217,7 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
     >>> robot = load_cdpr_model("fastkit")
     >>> pose = [-2.0, 0.0, 0.2, 0.0, 0.0, 0.0]
     >>> t = distribute_tensions(robot, pose, "lp_min_sum", tipping=False).tensions
-    >>> r = check_tipping(robot, pose, t)
+    >>> r = replay_tipping(robot, pose, t)
     >>> r.verdicts, r.taut_stays, bool(r.success)
     (('stays', 'stays'), True, True)
     """
@@ -225,7 +225,7 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
 
     P = as_poses(robot, pose)
     if P.shape[0] != 1:
-        raise InvalidInputError("pose", "one pose; use check_tipping_grid for a batch")
+        raise InvalidInputError("pose", "one pose; use replay_tipping_grid for a batch")
     t = as_array(tensions, "tensions", shape=(len(robot.cables),))
     if np.any(t < 0):
         raise InvalidInputError("tensions", "cables cannot push: every tension must be >= 0")
@@ -250,13 +250,13 @@ def check_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
                         check_status("ok" if ok else "unverified"), msg)
 
 
-def check_tipping_grid(robot: CableRobot, poses: Any, *,
-                       method: TensionMethod = "lp_min_sum",
-                       tipping: bool = False, friction: float = _tol.FLOOR_FRICTION,
-                       duration: float = _tol.CDPR_DURATION,
-                       progress: Callable[[int, int], None] | None = None
-                       ) -> TippingGridCheck:
-    """:func:`check_tipping` at every pose of a batch (e.g. a workspace grid from
+def replay_tipping_grid(robot: CableRobot, poses: Any, *,
+                        method: TensionMethod = "lp_min_sum",
+                        tipping: bool = False, friction: float = _tol.FLOOR_FRICTION,
+                        duration: float = _tol.CDPR_DURATION,
+                        progress: Callable[[int, int], None] | None = None
+                        ) -> TippingGridCheck:
+    """:func:`replay_tipping` at every pose of a batch (e.g. a workspace grid from
     :func:`taut.cdpr.grid_points`), with tensions from
     :func:`taut.cdpr.distribute_tensions` (``method``, ``tipping`` passed explicitly).
 
@@ -276,7 +276,7 @@ def check_tipping_grid(robot: CableRobot, poses: Any, *,
     status = np.full(B, "infeasible", dtype=object)
     for b in range(B):
         if dist.success[b]:
-            r = check_tipping(robot, P[b], dist.tensions[b], friction=friction,
+            r = replay_tipping(robot, P[b], dist.tensions[b], friction=friction,
                               duration=duration)
             verdicts[b] = r.verdicts
             margin[b], taut_stays[b], phys[b] = r.margin, r.taut_stays, r.physics_stays

@@ -14,15 +14,16 @@ from typing import Callable
 import numpy as np
 
 from .._outcome import check_status
+from .._units import GRAVITY
 from .._validate import as_array, as_flag, as_positive
 from ..errors import InvalidInputError
-from ..sheet import Equilibrium, Sheet, check_formation, forward_kinematics
-from ..sheet.model import check_hold_height
+from ..sheet import Equilibrium, Sheet, SheetTeam, check_formation, forward_kinematics
+from ..sheet.team import require_team
 from . import _run, _tol
 from ._mesh import sheet_mesh
 from ._sheet_model import build_sheet_sim
 
-__all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "check_equilibria",
+__all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "replay_equilibria",
            "DEFAULT_MESH"]
 
 #: Default mesh: spacings across the sheet's widest vertex pair (about 156 mm on the FK
@@ -142,12 +143,10 @@ class EquilibriaCheck:
     message: str
 
 
-def _check_inputs(sheet: Sheet, formation: object, hold_height: float, mesh: int,
-                  ball: float | None) -> tuple[np.ndarray, float, int, float]:
-    if not isinstance(sheet, Sheet):
-        raise InvalidInputError("sheet", "must be a taut.sheet.Sheet")
+def _check_inputs(team: SheetTeam, formation: object, mesh: int, ball: float | None
+                  ) -> tuple[np.ndarray, int, float]:
+    sheet = require_team(team).sheet
     R = check_formation(sheet, as_array(formation, "formation", ndim=2))
-    z = check_hold_height(hold_height)
     if not isinstance(mesh, (int, np.integer)) or not 4 <= mesh <= 60:
         raise InvalidInputError("mesh", f"must be an integer from 4 to 60 (spacings across "
                                         f"the sheet), got {mesh!r}")
@@ -155,21 +154,21 @@ def _check_inputs(sheet: Sheet, formation: object, hold_height: float, mesh: int
     r = (_tol.BALL_RADIUS * D / mesh) if ball is None else as_positive(ball, "ball")
     if r > 0.2 * D:
         raise InvalidInputError("ball", f"radius {r:g} is too large for a sheet {D:g} across")
-    return R, z, int(mesh), r
+    return R, int(mesh), r
 
 
-def settle(sheet: Sheet, formation: object, hold_height: float, *,
-           start: object = None, mesh: int = DEFAULT_MESH, ball: float | None = None,
+def settle(team: SheetTeam, formation: object, *, start: object = None,
+           mesh: int = DEFAULT_MESH, ball: float | None = None,
            max_time: float = _tol.MAX_SETTLE_TIME, trace: bool = False) -> SettleResult:
     """Drop the object on the simulated sheet and return where it comes to rest.
 
     Parameters
     ----------
-    sheet : Sheet
+    team : SheetTeam
+        The sheet and the holding height :math:`z_r`, scenario units (its mass is not
+        used: the simulation drops a 1 kg ball).
     formation : array_like, shape (N, 2)
         Robot positions :math:`\\mathbf{r}_i`, scenario units.
-    hold_height : float
-        :math:`z_r`.
     start : array_like, shape (3,), optional
         Initial ball centre; default above the robots' centroid, just over the hold height.
     mesh : int
@@ -188,14 +187,15 @@ def settle(sheet: Sheet, formation: object, hold_height: float, *,
     Examples
     --------
     >>> import numpy as np
-    >>> from taut.sheet import Sheet
+    >>> from taut.sheet import Sheet, SheetTeam
     >>> sheet = Sheet.regular(3, 500.0)
-    >>> r = settle(sheet, 0.8 * sheet.vertices, 800.0, mesh=8)
+    >>> r = settle(SheetTeam(sheet, 800.0), 0.8 * sheet.vertices, mesh=8)
     >>> bool(r.converged), bool(0 < r.position[2] < 800)
     (True, True)
     """
     trace = as_flag(trace, "trace")
-    R, z, div, radius = _check_inputs(sheet, formation, hold_height, mesh, ball)
+    R, div, radius = _check_inputs(team, formation, mesh, ball)
+    sheet, z = team.sheet, team.hold_height
     p0 = None if start is None else as_array(start, "start", shape=(3,))
     max_t = as_positive(max_time, "max_time")
     m = sheet_mesh(sheet.vertices, div)
@@ -221,8 +221,8 @@ def settle(sheet: Sheet, formation: object, hold_height: float, *,
                         check_status(status), msg)
 
 
-def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
-                 tol: float, corner_tendons: bool) -> StateCheck:
+def _replay_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
+                  tol: float, *, corner_tendons: bool) -> StateCheck:
     import time
 
     t0 = time.perf_counter()
@@ -235,24 +235,24 @@ def _check_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: in
     assert tied_at is not None                                         # tied: always on
     tied = tied_at[0]
     nodes = _run.node_positions(sim) / sim.scale
-    sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * 9.81))
+    sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * GRAVITY))
     _run.release(sim)
     _run.settle_phase(sim, _tol.RELEASE_TIME)
     found = _run.object_on_sheet(sim)
     settled = found[0] if found is not None else _run.ball_position(sim) / sim.scale
     held = sliding <= tol
     pred = np.asarray(eq.object, dtype=float)
-    status = str(eq.status)
+    status = str(eq.kind)
     agrees = status == "saddle" or held == (status == "stable")
     return StateCheck(tuple(eq.taut), status, pred, tied, settled, held,
                       sliding, settled - pred, float(np.linalg.norm(settled - tied)),
                       tied - pred, agrees, time.perf_counter() - t0, nodes, m.triangles)
 
 
-def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
-                     mesh: int = DEFAULT_MESH, ball: float | None = None,
-                     hold_tolerance: float | None = None, corner_tendons: bool = True,
-                     progress: Callable[[int, int], None] | None = None) -> EquilibriaCheck:
+def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT_MESH,
+                      ball: float | None = None, hold_tolerance: float | None = None,
+                      corner_tendons: bool = True,
+                      progress: Callable[[int, int], None] | None = None) -> EquilibriaCheck:
     """Check every rest state taut reports for a formation in MuJoCo.
 
     For each state of :func:`taut.sheet.forward_kinematics`: the object is tied to the
@@ -262,8 +262,9 @@ def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
 
     Parameters
     ----------
-    sheet, formation, hold_height
-        As for :func:`taut.sheet.forward_kinematics` (scenario units).
+    team, formation
+        As for :func:`taut.sheet.forward_kinematics` (scenario units; the team's mass is
+        not used).
     mesh : int
         Mesh spacings across the sheet's widest vertex pair.
     ball : float, optional
@@ -282,13 +283,15 @@ def check_equilibria(sheet: Sheet, formation: object, hold_height: float, *,
     EquilibriaCheck
     """
     corner_tendons = as_flag(corner_tendons, "corner_tendons")
-    R, z, div, radius = _check_inputs(sheet, formation, hold_height, mesh, ball)
+    R, div, radius = _check_inputs(team, formation, mesh, ball)
+    sheet, z = team.sheet, team.hold_height
     tol = _tol.HOLD_FRACTION if hold_tolerance is None else as_positive(
         hold_tolerance, "hold_tolerance")
-    fk = forward_kinematics(sheet, R, z)
+    fk = forward_kinematics(team, R)
     states = []
     for k, eq in enumerate(fk.equilibria):
-        states.append(_check_state(sheet, R, z, eq, div, radius, tol, corner_tendons))
+        states.append(_replay_state(sheet, R, z, eq, div, radius, tol,
+                                     corner_tendons=corner_tendons))
         if progress is not None:
             progress(k + 1, len(fk.equilibria))
     bad = [s for s in states if not s.agrees]

@@ -94,7 +94,7 @@ PROOF_DEPTH = 16
 #: (~40 us a pose). A plan keeping 1 mm of slack needs about 20 poses per 2 cm interval
 #: where it keeps so little; one needing more keeps micrometres over a long stretch.
 MAX_PROOF_POSES = 50_000
-#: Squeezed formations (:mod:`taut.plan.formations.squeezed`): the object rests at least this much
+#: Squeezed formations (:mod:`taut.plan.formations._squeezed`): the object rests at least this much
 #: above the ground safety height ``team.height_safety``, m, so that the robots' position
 #: error (``POSITION_ACCURACY``) does not lower it under the safety height at once.
 SQUEEZE_HEIGHT_MARGIN = 5e-3
@@ -143,3 +143,29 @@ SQUEEZED_WEIGHT = 1.5
 #: robustness check; with 0.05 every seed-2024 scenario needing a squeezed formation gets
 #: one that passes it (0.01 and 0.2 leave some without).
 SQUEEZE_MIN_CURVATURE = 0.05
+
+# ---------------------------------------------------------------- accepted ranges
+# Each option's accepted range, defined once (validated by :mod:`taut.plan._options`, and
+# for ``sheet_margin`` by every function taking one).
+
+#: Largest ``sheet_margin``, m: a margin is an allowance for the robots' position error
+#: (millimetres to centimetres); a metre is far beyond any robot's.
+MAX_SHEET_MARGIN_M = 1.0
+#: Largest ``time_budget`` (the optional wall-clock cap of each search), s: one hour.
+MAX_TIME_BUDGET_S = 3600.0
+#: Largest ``iterations`` (samples per RRT-Connect run; the whole search draws
+#: ``taut.plan.se2._search.TOTAL_RUNS`` times this): a few minutes of search per run.
+MAX_ITERATIONS = 200_000
+#: Accepted lattice ``spacing``, m: finer than the robots' position accuracy
+#: (``_tol.POSITION_ACCURACY``) buys nothing, and the lattice is bounded by its node count.
+MIN_SPACING_M = 0.005
+#: Coarser than a metre, the lattice misses every passage a team of metre-sized sheets
+#: could use.
+MAX_SPACING_M = 1.0
+#: Largest robot position error ``sigma`` of the robustness analysis, m.
+MAX_POSITION_ERROR_M = 1.0
+#: Most Monte Carlo trials of the robustness analysis (each replays the whole plan).
+MAX_TRIALS = 100_000
+#: Largest ``correlation`` time of the robustness analysis's position error, s (one hour:
+#: longer than any plan, so the error is then constant along it).
+MAX_CORRELATION_S = 3600.0

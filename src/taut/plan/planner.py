@@ -9,7 +9,7 @@ Methods (one private module each):
     too narrow for all of them). The lattice search (:mod:`taut.plan.se2._lattice`) searches
     every formation at once with any number of in-place formation changes; where it finds
     nothing, a seeded RRT-Connect searches each formation and pairs with one change
-    (:mod:`taut.plan.se2.search`), or OMPL does (``search=``). Low obstacles pass under the sheet
+    (:mod:`taut.plan.se2._search`), or OMPL does (``search=``). Low obstacles pass under the sheet
     between any two robots at any heading. When no SE(2) candidate verifies, the
     disc-model roadmap plan and the SE(2) bypass baseline are tried too, so the planner
     succeeds wherever either baseline does. Failures carry a certificate (status
@@ -20,38 +20,41 @@ Methods (one private module each):
 ``"algorithm2"``
     The same roadmap with the paper's Algorithm 2 only (paper-faithful mode).
 
-Baselines (``baseline=``): ``"se2"`` (or True) the same SE(2) search with crossing
-disabled (same library, searches and budget); ``"disc"`` the disc-model bypass.
+Baselines (``baseline=``): ``"se2"`` the same SE(2) search with crossing disabled (same
+library, searches and budget); ``"disc"`` the disc-model bypass (the formation is a disc
+covering every heading, routed on the visibility roadmap; the baseline of issue 4). Both
+use the same timing and verification as the crossing planner.
+
+:func:`plan` validates its options once (:func:`taut.plan._options.plan_options`) and
+:func:`run_plan` dispatches them to the engines; everything below calls engines, never a
+public entry that validates again.
 """
 
 from __future__ import annotations
 
 import functools
 from dataclasses import replace
-from typing import Literal
 
 import numpy as np
 
-from .._validate import as_count
-from ..errors import InvalidInputError
 from . import _tol
 from .se2._ompl import Search, engine
 from .se2._lattice import MAX_NODES, lattice_search
-from .se2.search import SE2Search, SearchBudget, search_se2
-from .se2.space import PoseChecker
-from .se2.motion import Piece, sample_pieces
-from .checks.certificate import find_certificate
+from .se2._search import SE2Search, SearchBudget, search_se2
+from .se2._space import PoseChecker
+from .se2._motion import Piece, sample_pieces
+from .checks.certificate import _find_certificate
 from .formations.optimal import Formation
-from .formations.library import Library, _diagnosis, _with_squeezed, formation_library, library
+from .formations.library import Library, _diagnosis, _with_squeezed, library
+from ._options import Baseline, Method, PlanOptions, plan_options
 from .result import PlanResult, _summary, attempt, failure, relabel
 from .roadmap.route import crossable
-from .checks.verify import verify_motion
+from .checks.verify import _verify_motion
 from .world import Scenario
-from .._validate import MAX_DURATION_S, MAX_SHEET_LENGTH, as_bounded, require_instance
+from .._validate import require_instance
 
-__all__ = ["plan", "formation_library"]   # formation_library: re-exported from .library
+__all__ = ["plan"]
 
-Method = Literal["se2", "roadmap", "algorithm2"]
 
 def _roadmap(scenario: Scenario, straight: bool, sheet_margin: float, planner: str,
              library: Library) -> PlanResult:
@@ -99,7 +102,7 @@ def _finish_se2(scenario: Scenario, pieces: list[Piece], planner: str, sheet_mar
     m = sample_pieces(scenario, pieces)
     if m.message is not None:
         return failure(scenario, f"plan rejected: {m.message}", planner, "unverified")
-    check = verify_motion(scenario, m.robots, m.object, sheet_margin=sheet_margin)
+    check = _verify_motion(scenario, m.robots, m.object, sheet_margin)
     if not check.success:
         return failure(scenario, f"plan rejected by verification: {check.message}", planner,
                        "unverified")
@@ -165,7 +168,7 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
     if good:
         who = "rrtconnect" if search == "auto" else search
         return replace(min(good, key=lambda r: r.duration), search=who)
-    cert = find_certificate(scenario)
+    cert = _find_certificate(scenario)
     if cert is not None:
         return failure(scenario, cert.message, planner, "refuted", cert)
     rejected = list(dict.fromkeys(r.message for r in results))
@@ -191,31 +194,8 @@ def _se2(scenario: Scenario, *, allow_crossing: bool, sheet_margin: float,
                    planner, "budget_exhausted")
 
 
-def _checked_options(scenario: Scenario, method: str, baseline: object, sheet_margin: float,
-                     time_budget: float | None, iterations: int, seed: int, spacing: float
-                     ) -> SearchBudget:
-    """Validate :func:`plan`'s options (typed errors naming the field); the budget."""
-    if not isinstance(scenario, Scenario):
-        raise InvalidInputError("scenario", "must be a taut.plan.Scenario")
-    if not isinstance(method, str) or method not in ("se2", "roadmap",
-                                                     "algorithm2"):
-        raise InvalidInputError("method", f"must be 'se2', 'roadmap' or 'algorithm2', got "
-                                          f"{method!r}")
-    if (not isinstance(baseline, (bool, np.bool_, str))
-            or baseline not in (False, True, "se2", "disc")):
-        raise InvalidInputError("baseline", "must be False, True, 'se2' or 'disc'")
-    if not (np.isfinite(sheet_margin) and sheet_margin >= 0):
-        raise InvalidInputError("sheet_margin", "must be a finite length >= 0")
-    if time_budget is not None and not (time_budget > 0):
-        raise InvalidInputError("time_budget", "must be a positive time in s, or None")
-    return SearchBudget(iterations=as_count(iterations, "iterations", minimum=1),
-                        seed=as_count(seed, "seed", minimum=0),
-                        time_budget=None if time_budget is None else float(time_budget),
-                        spacing=as_bounded(spacing, "spacing", MAX_SHEET_LENGTH, "m"))
-
-
 def plan(scenario: Scenario, *, method: Method = "se2",
-         baseline: bool | Literal["se2", "disc"] = False, straight_crossings: bool = True,
+         baseline: Baseline | None = None, straight_crossings: bool = True,
          sheet_margin: float = _tol.SHEET_MARGIN, time_budget: float | None = None,
          iterations: int = 3000, seed: int = 0, search: Search = "auto",
          spacing: float = 0.05) -> PlanResult:
@@ -226,23 +206,26 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     scenario : Scenario
     method : {"se2", "roadmap", "algorithm2"}
         See the module docstring.
-    baseline : bool or {"se2", "disc"}
-        Plan with a bypass-only baseline instead (True: ``"se2"``).
+    baseline : {"se2", "disc"}, optional
+        Plan with a bypass-only baseline instead (module docstring); ``method`` and
+        ``straight_crossings`` are then unused.
     straight_crossings : bool
         ``method="roadmap"`` only: also allow straight offset crossings.
     sheet_margin : float
-        Every robot pair stays this far inside its sheet distance, m (default 0.01 m:
-        robots off by at most 5 mm each never tear the sheet).
+        Every robot pair stays this far inside its sheet distance, m, in [0, 1] (default
+        0.01 m: robots off by at most 5 mm each never tear the sheet).
     time_budget : float or None
-        Optional wall-clock safety cap of each sampling search, s (default None: no cap).
-        What decides success is the lattice (its spacing) and ``iterations``, so the
-        answer does not depend on the machine's load; a cap that stops a search is
-        reported in the message, and then the answer may depend on the load. The lattice
-        search is not interrupted: it is bounded by its node count (``MAX_NODES``).
+        Optional wall-clock safety cap of each sampling search, s, at most 3600 (default
+        None: no cap). What decides success is the lattice (its spacing) and
+        ``iterations``, so the answer does not depend on the machine's load; a cap that
+        stops a search is reported in the message, and then the answer may depend on the
+        load. The lattice search is not interrupted: it is bounded by its node count
+        (``MAX_NODES``).
     iterations : int
-        Samples per RRT-Connect run of the sampling search (its deterministic budget).
+        Samples per RRT-Connect run of the sampling search (its deterministic budget),
+        1 to 200000.
     seed : int
-        Seed of the SE(2) search: plans are reproducible for a given seed and
+        Seed of the SE(2) search (>= 0): plans are reproducible for a given seed and
         ``iterations`` (unless the optional time cap stops a search).
     search : {"auto", "lattice", "rrtconnect", "ompl-rrtconnect", "ompl-rrtstar", "ompl-prm"}
         Who searches SE(2) (``method="se2"`` and ``baseline="se2"``). ``"lattice"``: A*
@@ -255,8 +238,11 @@ def plan(scenario: Scenario, *, method: Method = "se2",
         RRT-Connect, on the same validity checker, formations, bounds and verification
         (optional extra ``plan-ompl``; seeding in :mod:`taut.plan.se2._ompl`).
     spacing : float
-        Lattice spacing, m (the headings are spaced so that a heading step moves the
-        farthest robot about as far).
+        Lattice spacing, m, in [0.005, 1] (the headings are spaced so that a heading step
+        moves the farthest robot about as far).
+
+    The accepted ranges are defined once, in :mod:`taut.plan._tol`, and validated by
+    :func:`taut.plan._options.plan_options`.
 
     Returns
     -------
@@ -265,6 +251,8 @@ def plan(scenario: Scenario, *, method: Method = "se2",
 
     Raises
     ------
+    InvalidInputError
+        An option out of its range or an unknown choice.
     PlanningError
         The team cannot hold the object at all.
 
@@ -276,30 +264,33 @@ def plan(scenario: Scenario, *, method: Method = "se2",
     (True, 'ok', ('1', '2'))
     """
     require_instance(scenario, Scenario, "scenario")
-    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
-    if time_budget is not None:
-        as_bounded(time_budget, "time_budget", MAX_DURATION_S, "s")
-    as_count(iterations, "iterations", minimum=1, maximum=10_000_000)
-    budget = _checked_options(scenario, method, baseline, sheet_margin, time_budget,
-                              iterations, seed, spacing)
-    engine(search)                      # validates the name and that OMPL is installed
-    margin = float(sheet_margin)
-    r = _dispatch(scenario, method, baseline, straight_crossings, margin, budget, search)
+    return run_plan(scenario, plan_options(
+        method=method, baseline=baseline, straight_crossings=straight_crossings,
+        sheet_margin=sheet_margin, time_budget=time_budget, iterations=iterations,
+        seed=seed, search=search, spacing=spacing))
+
+
+def run_plan(scenario: Scenario, options: PlanOptions) -> PlanResult:
+    """:func:`plan` on options validated by :func:`~taut.plan._options.plan_options` (for
+    front ends that validate before loading the scenario, such as ``taut plan``):
+    dispatches to the engine of the method or baseline."""
+    margin = options.sheet_margin
+    r = _dispatch(scenario, options)
     return r if r.success else replace(r, sheet_margin=margin)
 
 
-def _dispatch(scenario: Scenario, method: str, baseline: object, straight_crossings: bool,
-              margin: float, budget: SearchBudget, search: Search) -> PlanResult:
-    """:func:`plan` after its options are checked."""
+def _dispatch(scenario: Scenario, options: PlanOptions) -> PlanResult:
+    """The engine of ``options.baseline`` or ``options.method``."""
+    margin, budget, search = options.sheet_margin, options.budget, options.search
     lib = library(scenario, margin)
-    if baseline == "disc":
+    if options.baseline == "disc":
         return attempt(scenario, lib[0], allow_crossing=False, planner="disc",
                        sheet_margin=margin)
-    if baseline:
+    if options.baseline == "se2":
         return _bypass(scenario, margin, budget, search)
-    if method != "se2":
-        return _roadmap(scenario, method == "roadmap" and straight_crossings, margin, method,
-                        lib)
+    if options.method != "se2":
+        return _roadmap(scenario, options.method == "roadmap" and options.straight_crossings,
+                        margin, options.method, lib)
     full = budget                 # the SE(2) bypass fallback runs exactly as the baseline
     first = budget if budget.time_budget is None else replace(
         budget, time_budget=0.7 * budget.time_budget)

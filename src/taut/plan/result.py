@@ -8,68 +8,16 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._outcome import check_status, deprecated_alias
+from .._outcome import check_status
 from ..errors import PlanningError
-from . import _tol
 from .checks.certificate import Certificate
-from .roadmap.crossing import CrossingRecord, motion_from_legs
-from .formations.optimal import Formation, optimal_formation
-from .roadmap.route import find_route
-from .checks.verify import Verification, verify_motion
+from .roadmap.crossing import CrossingRecord, _motion_from_legs
+from .formations.optimal import Formation, _optimal_formation
+from .roadmap.route import _find_route
+from .checks.verify import Verification, _verify_motion
 from .world import Scenario
 
-__all__ = ["PlanResult", "Robustness"]
-
-
-@dataclass(frozen=True, eq=False)
-class Robustness:
-    """Seeded Monte Carlo of a plan under robot position error (:meth:`PlanResult.robustness`).
-
-    Attributes
-    ----------
-    sigma : float
-        Position error, m (radius of the disc, or the standard deviation per axis).
-    noise : {"disc", "gaussian"}
-        Every robot displaced uniformly within a disc of radius ``sigma``, or by a normal
-        error of standard deviation ``sigma`` per axis, drawn independently per robot
-        every ``correlation`` seconds and linear in time in between.
-    trials : int
-    tear_probability : float
-        Fraction of trials in which some robot pair was beyond its sheet distance.
-    drop_probability : float
-        Fraction of trials in which the object's rest state ended in the quasi-static
-        replay and it fell by more than 5 mm (``MAX_OBJECT_STEP``) or reached the ground.
-    worst_extension : float
-        Largest (robot distance - sheet distance) seen, m (negative: never taut).
-    contact_probability : float
-        Fraction of trials in which the object touched an obstacle beneath the sheet or
-        the ground.
-    unsafe_probability : float
-        Fraction of trials in which the object came closer than the height safety to
-        them somewhere (the planner's rule; not by itself a failure).
-    collision_probability : float
-        Fraction of trials in which a robot's footprint touched a wall or an obstacle.
-    failure_probability : float
-        Fraction of trials with a tear, a drop, a contact or a collision.
-    worst_height_margin : float
-        Least object height above the obstacle beneath (or the ground) over the replays
-        that were not torn, m.
-    worst_clearance : float
-        Least robot-centre distance to a wall or obstacle over all trials, m.
-    """
-
-    sigma: float
-    noise: str
-    trials: int
-    tear_probability: float
-    drop_probability: float
-    worst_extension: float
-    contact_probability: float = 0.0
-    unsafe_probability: float = 0.0
-    collision_probability: float = 0.0
-    failure_probability: float = 0.0
-    worst_height_margin: float = float("nan")
-    worst_clearance: float = float("nan")
+__all__ = ["PlanResult"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,6 +65,9 @@ class PlanResult:
         Why no plan exists, when that is proved.
     sheet_margin : float
         The margin every robot pair keeps inside its sheet distance, m.
+    scenario : Scenario or None
+        The problem planned (what :func:`~taut.plan.checks.profile.plan_profile` and
+        :func:`~taut.plan.checks.robustness.plan_robustness` analyse the plan in).
     search : str or None
         Who found an SE(2) plan (``plan(..., search=...)``: ``"rrtconnect"`` or an OMPL
         planner); None for the roadmap planners and failures.
@@ -147,37 +98,6 @@ class PlanResult:
     def __post_init__(self) -> None:
         check_status(self.status)
 
-    reason = deprecated_alias("message", "reason",
-                              transform=lambda self, m: None if self.success else m)
-
-    def robustness(self, sigma: float = _tol.POSITION_ACCURACY, trials: int = 200, *,
-                   noise: str = "disc", seed: int = 0, correlation: float = 1.0
-                   ) -> Robustness:
-        """Probability of failure under robot position error (seeded Monte Carlo through
-        the quasi-static simulation, :mod:`taut.plan.checks.robustness`).
-
-        Parameters
-        ----------
-        sigma : float
-            Position error, m.
-        trials : int
-        noise : {"disc", "gaussian"}
-            See :class:`Robustness`.
-        seed : int
-        correlation : float
-            Each robot's error is drawn every ``correlation`` seconds and interpolated
-            linearly in between, s.
-
-        Returns
-        -------
-        Robustness
-        """
-        from .checks.robustness import monte_carlo
-        if not self.success or self.scenario is None:
-            raise PlanningError("plan", "robustness needs a successful plan")
-        return monte_carlo(self.scenario, self, sigma, trials, noise=noise, seed=seed,
-                           correlation=correlation)
-
 
 def failure(scenario: Scenario, message: str, planner: str, status: str = "no_route",
             certificate: Certificate | None = None) -> PlanResult:
@@ -199,8 +119,8 @@ def compact_formation(scenario: Scenario, sheet_margin: float = 0.0) -> Formatio
         ``team``: no formation can hold the object at all.
     """
     team = scenario.team
-    f = optimal_formation(team, kind="compact", width=scenario.world.width,
-                          sheet_margin=sheet_margin)
+    f = _optimal_formation(team, "compact", width=scenario.world.width,
+                           sheet_margin=sheet_margin)
     if f is None:
         raise PlanningError("team", "cannot hold the object: no formation keeps every cable "
                             f"taut and the object stable at least {team.height_safety:g} m "
@@ -214,12 +134,13 @@ def attempt(scenario: Scenario, formation: Formation | Sequence[Formation], *,
             sheet_margin: float = 0.0) -> PlanResult:
     """Route ``formation`` (or several, changing between them) on the disc-model roadmap,
     time the route and verify it; a failed plan carries the reason."""
-    route = find_route(scenario, formation, allow_crossing=allow_crossing,
-                       straight_crossings=straight_crossings)
+    given = [formation] if isinstance(formation, Formation) else list(formation)
+    route = _find_route(scenario, given, allow_crossing=allow_crossing,
+                        straight_crossings=straight_crossings)
     if not route.success:
         return failure(scenario, route.message, planner)
-    motion = motion_from_legs(scenario, route)
-    check = verify_motion(scenario, motion.robots, motion.object, sheet_margin=sheet_margin)
+    motion = _motion_from_legs(scenario, route.formations, route.legs, route.first)
+    check = _verify_motion(scenario, motion.robots, motion.object, sheet_margin)
     if not check.success:
         return failure(scenario, f"plan rejected by verification: {check.message}", planner,
                        "unverified")

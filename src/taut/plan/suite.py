@@ -15,8 +15,8 @@ import numpy as np
 from shapely.geometry import Point, Polygon
 
 from .._validate import as_count
-from ..sheet import Sheet
-from .formations.optimal import optimal_formation
+from ..sheet import Sheet, SheetTeam
+from .formations.optimal import _optimal_formation
 from .world import Obstacle, Scenario, Team, World
 
 #: Crossable obstacles are at most this fraction of the holding height tall.
@@ -29,18 +29,18 @@ def _team(rng: np.random.Generator, n: int) -> Team:
     side = rng.uniform(0.6, 0.8)
     circ = side / (2 * np.sin(np.pi / n))
     sheet = Sheet.regular(n, circ, phase=rng.uniform(0, 2 * np.pi / n))
-    return Team(sheet, hold_height=rng.uniform(0.55, 0.75) * circ, robot_radius=0.1,
+    return Team(SheetTeam(sheet, rng.uniform(0.55, 0.75) * circ), robot_radius=0.1,
                 height_safety=0.04, lateral_safety=0.04, speed=0.2, rotation_speed=0.5)
 
 
 def _reaches(team: Team) -> tuple[float, float]:
     """Reach (m) of the compact formation and of a formation crossing obstacles up to
     ``CROSS_FRACTION`` of the holding height (falls back to the compact one)."""
-    compact = optimal_formation(team, kind="compact")
+    compact = _optimal_formation(team, "compact")
     if compact is None:
         raise RuntimeError("suite team cannot hold the object")  # pragma: no cover
-    cross = optimal_formation(team, kind="crossing", height=CROSS_FRACTION * team.hold_height,
-                              diameter=0.2)
+    cross = _optimal_formation(team, "crossing", height=CROSS_FRACTION * team.hold_height,
+                               diameter=0.2)
     return compact.reach, (cross or compact).reach
 
 
@@ -72,9 +72,16 @@ def generate_scenario(seed: int, n_robots: int | None = None) -> Scenario:
     -------
     Scenario
     """
-    rng = np.random.default_rng(as_count(seed, "seed", minimum=0))
-    n = as_count(n_robots, "n_robots", minimum=3, maximum=8) if n_robots is not None \
-        else int(rng.integers(3, 9))
+    seed = as_count(seed, "seed", minimum=0)
+    if n_robots is not None:
+        n_robots = as_count(n_robots, "n_robots", minimum=3, maximum=8)
+    return _generate_scenario(seed, n_robots)
+
+
+def _generate_scenario(seed: int, n_robots: int | None) -> Scenario:
+    """:func:`generate_scenario` on validated inputs."""
+    rng = np.random.default_rng(seed)
+    n = n_robots if n_robots is not None else int(rng.integers(3, 9))
     team = _team(rng, n)
     low, high = _reaches(team)
     width = rng.uniform(2.05 * low + 0.1, 2.05 * max(high, low) + 0.8)
@@ -128,4 +135,4 @@ def generate_suite(count: int = 50, seed: int = 2024) -> list[Scenario]:
     """``count`` scenarios, robot counts cycling through 3..8, seeds ``seed + i``."""
     count = as_count(count, "count", minimum=0, maximum=100_000)
     seed = as_count(seed, "seed", minimum=0, maximum=2**63 - 1 - count)
-    return [generate_scenario(seed + i, 3 + i % 6) for i in range(count)]
+    return [_generate_scenario(seed + i, 3 + i % 6) for i in range(count)]

@@ -18,7 +18,8 @@ from shapely.geometry import Point, Polygon
 from .._validate import as_array, as_nonnegative, as_points, as_positive
 from .._validate import require_instances
 from ..errors import InvalidInputError, PlanningError
-from ..sheet.model import Sheet, check_hold_height
+from ..sheet.model import Sheet
+from ..sheet.team import SheetTeam
 from ._tol import INSCRIBED_CIRCLE_RTOL
 
 __all__ = ["Obstacle", "World", "Team", "Scenario", "UnknownObstacleError"]
@@ -204,10 +205,9 @@ class Team:
 
     Parameters
     ----------
-    sheet : Sheet
-        The sheet; robot ``i`` holds vertex ``i`` (metres).
-    hold_height : float
-        Holding height :math:`z_r`, m (> 0).
+    carrier : SheetTeam
+        The sheet (robot ``i`` holds vertex ``i``; metres), the holding height
+        :math:`z_r` (m) and the object mass (kg, only for reporting tensions).
     robot_radius : float
         Radius of each robot's footprint, m (> 0).
     height_safety : float
@@ -221,46 +221,60 @@ class Team:
         Constant translational speed of the formation, m/s (> 0).
     rotation_speed : float
         Constant rotation speed of the formation about the object, rad/s (> 0).
-    mass : float, optional
-        Object mass, kg (only for reporting tensions).
+
+    Attributes
+    ----------
+    sheet : Sheet
+        ``carrier.sheet``.
+    hold_height : float
+        ``carrier.hold_height``, m.
+    mass : float or None
+        ``carrier.mass``, kg.
     """
 
-    sheet: Sheet
-    hold_height: float
+    carrier: SheetTeam
     robot_radius: float
     height_safety: float
     lateral_safety: float
     speed: float
     rotation_speed: float
-    mass: float | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.sheet, Sheet):
-            raise InvalidInputError("sheet", "must be a taut.sheet.Sheet")
-        if self.sheet.n > MAX_TEAM_ROBOTS:
-            raise InvalidInputError("sheet", f"a planning team has at most {MAX_TEAM_ROBOTS} "
-                                             f"robots, got {self.sheet.n}")
-        object.__setattr__(self, "hold_height", check_hold_height(self.hold_height))
+        if not isinstance(self.carrier, SheetTeam):
+            raise InvalidInputError("carrier", "must be a taut.sheet.SheetTeam")
+        if self.carrier.n > MAX_TEAM_ROBOTS:
+            raise InvalidInputError("carrier", f"a planning team has at most "
+                                               f"{MAX_TEAM_ROBOTS} robots, got {self.carrier.n}")
         for name in ("robot_radius", "speed", "rotation_speed"):
             object.__setattr__(self, name, as_positive(getattr(self, name), name))
         for name in ("height_safety", "lateral_safety"):
             object.__setattr__(self, name, as_nonnegative(getattr(self, name), name))
-        if self.mass is not None:
-            object.__setattr__(self, "mass", as_positive(self.mass, "mass"))
+
+    @property
+    def sheet(self) -> Sheet:
+        """The sheet (``carrier.sheet``)."""
+        return self.carrier.sheet
+
+    @property
+    def hold_height(self) -> float:
+        """Holding height :math:`z_r`, m (``carrier.hold_height``)."""
+        return self.carrier.hold_height
+
+    @property
+    def mass(self) -> float | None:
+        """Object mass, kg (``carrier.mass``)."""
+        return self.carrier.mass
 
     @property
     def n(self) -> int:
         """Number of robots."""
-        return self.sheet.n
-
-    @property
-    def side_safety(self) -> float:
-        """:math:`\\delta_s` of eqs. (1) and (4): robot radius plus lateral safety, m."""
-        return self.robot_radius + self.lateral_safety
+        return self.carrier.n
 
     @property
     def clearance(self) -> float:
-        """Least distance from a robot's centre to any obstacle or wall, m."""
+        """Least distance from a robot's centre to any obstacle or wall, m: robot radius
+        plus lateral safety, the side safety distance :math:`\\delta_s` of eqs. (1) and
+        (4)."""
         return self.robot_radius + self.lateral_safety
 
 

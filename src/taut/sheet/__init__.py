@@ -1,41 +1,131 @@
-"""Robot teams holding a deformable sheet that carries an object (virtual variable cables
-model, VVCM): model, forward and inverse kinematics, quasi-static simulation, formation
-geometry."""
+"""Robot teams holding a deformable sheet that carries an object (the virtual variable
+cables model, VVCM, of Hu et al.): forward and inverse kinematics, quasi-static simulation,
+formation geometry. Every public name is imported from here (``import taut.sheet as ts``).
 
-from .fk.forward import METHODS, forward_kinematics, forward_kinematics_batch
+Model
+-----
+Sheet
+    The deformable sheet: a convex polygon whose vertex ``i`` robot ``i`` holds.
+SheetTeam
+    The model every analysis takes: sheet, common hold height, optional object mass.
+check_formation, check_formations
+    Validate one formation (N, 2) / a batch (B, N, 2) against the sheet (no pair of robots
+    farther apart than its sheet vertices).
+check_hold_height
+    Validate a hold height (> 0, finite).
+
+Forward kinematics
+------------------
+forward_kinematics
+    Every rest state of the object for one formation (FK paper, Algorithm 1).
+forward_kinematics_batch
+    The same for many formations at once, as padded arrays.
+FKSolver
+    Forward kinematics of one team for many formations, with the fixed work done once.
+FKResult, BatchFKResult
+    The outcomes (``success``, ``status``, ``message``; per formation in a batch).
+Equilibrium
+    One rest state: taut cables, object, contact point, load shares, tensions, kind.
+Funnel
+    Step counts of Algorithm 1 (``method="exhaustive"``).
+
+Inverse kinematics
+------------------
+inverse_kinematics
+    A formation that holds the object stably at a target, or a proof that none exists.
+IKResult
+    Its outcome (formation, weights, tensions, ``success``, ``status``, ``message``).
+IKCertificate
+    A checkable proof that a target is unreachable.
+IKConstraints, ik_constraints
+    The conditions of an all-taut stable state for given cable angles (for optimisers).
+formation_from_angles
+    Robot positions from the cable angles (planning paper eq. 10).
+contact_weights
+    Maximum-entropy load shares of a contact point (barycentric for N = 3).
+
+Simulation
+----------
+simulate
+    Quasi-static simulation of the object along a time series of formations.
+Simulator
+    The same, one step at a time (for control loops).
+SimulationResult, SimulatorState
+    A whole run / the state after a step (``success``, ``status``, ``message``).
+SimulationEvent, EventKind
+    A change during a run (taut set change, jump, object lost or recovered) and its kinds.
+
+Formation geometry
+------------------
+formation_metrics, FormationMetrics
+    Size, obstacle clearance and robot spacing of a formation at once.
+minimum_enclosing_circle, formation_size
+    The smallest circle around the robots; its diameter plus a margin.
+min_robot_distance
+    The closest pair of robots.
+max_obstacle_height, max_obstacle_diameter
+    The largest obstacle the team can pass over / enclose.
+
+Random teams
+------------
+random_convex_polygon
+    A random convex sheet.
+random_team
+    A random sheet and a feasible formation of it.
+random_scattered_team
+    A random sheet and robots scattered in any order (the harder case for FK).
+
+Constants and types
+-------------------
+GRAVITY
+    Gravitational acceleration for tensions, m/s^2.
+Method, METHODS
+    Forward-kinematics algorithm (``"fast"``, ``"exhaustive"``, ``"subsets"``).
+Backend
+    Compute backend (``"auto"``, ``"numba"``, ``"numpy"``).
+HAVE_NUMBA
+    Whether the compiled kernels are available.
+COMPILED_MAX_N
+    Largest team for which the compiled solver tries every small subset.
+EquilibriumKind
+    What a rest state is: ``"stable"``, ``"saddle"``, ``"not_equilibrium"``.
+"""
+
+from ._options import METHODS, Backend, Method
+from .fk.forward import forward_kinematics, forward_kinematics_batch
+from .._units import GRAVITY
+from .fk.results import BatchFKResult, Equilibrium, EquilibriumKind, FKResult, Funnel
+from .fk.solver import COMPILED_MAX_N, HAVE_NUMBA, FKSolver
 from .geometry import (FormationMetrics, formation_metrics, formation_size,
                        max_obstacle_diameter, max_obstacle_height, min_robot_distance,
                        minimum_enclosing_circle)
-from .ik.inverse import (IKConstraints, IKResult, contact_weights, formation_from_angles,
-    ik_constraints, inverse_kinematics)
-from .model import Sheet, check_formation, check_formations
-from .fk.results import GRAVITY, BatchFKResult, Equilibrium, FKResult, Funnel
-from .sim.simulate import SimulationEvent, SimulationResult, simulate
-from .fk.solver import FKSolver
-from .ik.inverse import IKCertificate
-from .sim.simulate import SimulatorState
+from .ik.inverse import (IKCertificate, IKConstraints, IKResult, contact_weights,
+                         formation_from_angles, ik_constraints, inverse_kinematics)
+from .model import Sheet, check_formation, check_formations, check_hold_height
+from .random import random_convex_polygon, random_scattered_team, random_team
+from .sim.results import EventKind, SimulationEvent, SimulationResult, SimulatorState
+from .sim.simulate import simulate
 from .sim.simulator import Simulator
+from .team import SheetTeam
 
 __all__ = [
-    "Sheet", "check_formation", "check_formations",
-    "forward_kinematics", "forward_kinematics_batch", "METHODS",
-    "FKResult", "BatchFKResult", "Equilibrium", "Funnel", "GRAVITY",
-    "inverse_kinematics", "IKResult", "IKConstraints", "formation_from_angles",
-    "ik_constraints", "contact_weights",
-    "simulate", "SimulationResult", "SimulationEvent",
+    # Model
+    "Sheet", "SheetTeam", "check_formation", "check_formations", "check_hold_height",
+    # Forward kinematics
+    "forward_kinematics", "forward_kinematics_batch", "FKSolver", "FKResult",
+    "BatchFKResult", "Equilibrium", "Funnel",
+    # Inverse kinematics
+    "inverse_kinematics", "IKResult", "IKCertificate", "IKConstraints", "ik_constraints",
+    "formation_from_angles", "contact_weights",
+    # Simulation
+    "simulate", "Simulator", "SimulationResult", "SimulatorState", "SimulationEvent",
+    "EventKind",
+    # Formation geometry
     "formation_metrics", "FormationMetrics", "minimum_enclosing_circle", "formation_size",
-    "max_obstacle_height", "min_robot_distance", "max_obstacle_diameter",
-    "FKSolver",
-    "IKCertificate", "Simulator", "SimulatorState",
+    "min_robot_distance", "max_obstacle_height", "max_obstacle_diameter",
+    # Random teams
+    "random_convex_polygon", "random_team", "random_scattered_team",
+    # Constants and types
+    "GRAVITY", "Method", "METHODS", "Backend", "HAVE_NUMBA", "COMPILED_MAX_N",
+    "EquilibriumKind",
 ]
-
-# Re-exports of every name the submodules' __all__ list (one public import path: taut.sheet).
-from .fk.forward import Method  # noqa: E402
-from .model import check_hold_height  # noqa: E402
-from .random import random_convex_polygon, random_scattered_team, random_team  # noqa: E402
-from .fk.results import Status  # noqa: E402
-from .sim.simulate import EventKind  # noqa: E402
-from .fk.solver import COMPILED_MAX_N, HAVE_NUMBA, Backend  # noqa: E402
-
-__all__ += ["Method", "check_hold_height", "random_convex_polygon", "random_scattered_team",
-            "random_team", "Status", "EventKind", "COMPILED_MAX_N", "HAVE_NUMBA", "Backend"]

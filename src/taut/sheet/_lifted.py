@@ -39,13 +39,14 @@ from ._tol import (ANGLE_TOL, COINCIDE_RTOL2, CURVATURE_TOL, MAX_CONDITION, MAX_
 from ._util import Q_SIGNS
 
 __all__ = ["TAUT_TOL", "WEIGHT_TOL", "CURVATURE_TOL", "SINGULAR_RTOL", "MAX_CONDITION",
-           "ANGLE_TOL", "STATUS_STABLE", "STATUS_SADDLE", "STATUS_NOT_EQUILIBRIUM",
-           "STATUS_NAMES", "Frame", "Solved", "solve_candidates", "solve_table",
+           "ANGLE_TOL", "KIND_STABLE", "KIND_SADDLE", "KIND_NOT_EQUILIBRIUM",
+           "KIND_NAMES", "Frame", "Solved", "solve_candidates", "solve_table",
            "height_ok", "taut_masks", "maximiser_masks", "in_hull_2d",
            "reduced_hessian_min_eig", "pad_groups"]
 
-STATUS_STABLE, STATUS_SADDLE, STATUS_NOT_EQUILIBRIUM = 0, 1, 2
-STATUS_NAMES = ("stable", "saddle", "not_equilibrium")
+#: Codes of the kinds of rest state (``Equilibrium.kind``) in the solvers' arrays.
+KIND_STABLE, KIND_SADDLE, KIND_NOT_EQUILIBRIUM = 0, 1, 2
+KIND_NAMES = ("stable", "saddle", "not_equilibrium")
 
 # Reduced Hessian of q, up to the factor 2 (does not change signs).
 _H = Q_SIGNS

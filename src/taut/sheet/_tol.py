@@ -95,7 +95,7 @@ WINDING_TOL = 1e-6
 #: full check (which applies GEOMETRY_RTOL).
 FAST_CHECK_RTOL = 1e-12
 #: Formations within this distance (relative to the sheet size) of a similar copy of the
-#: sheet are solved as that copy (see fk._snap_near_similar; docs/sheet_fk_solver.md):
+#: sheet are solved as that copy (see fk._solve._snap_near_similar; docs/sheet_fk_solver.md):
 #: closer than this, float64 names one rest state by many taut sets (seen: 40 stable
 #: "states" within 1.1e-8 of each other at 1e-10 from a copy, N = 22).
 SNAP_TOL = 1e-7

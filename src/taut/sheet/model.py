@@ -151,6 +151,54 @@ def check_hold_height(hold_height: float) -> float:
     return z
 
 
+def _formation_batch(sheet: Sheet, formations: ArrayLike, field: str) -> np.ndarray:
+    """``formations`` as a finite float64 array of shape (B, N, 2) for ``sheet``, or an
+    :class:`InvalidInputError` (wrong shape or robot count, NaN/inf, out of range)."""
+    require_instance(sheet, Sheet, "sheet")
+    r = check_range(as_array(formations, field, ndim=3), field, MAX_SHEET_LENGTH, "sheet units")
+    if r.shape[2] != 2:
+        raise InvalidInputError(field, f"last axis must have length 2 (x, y), got {r.shape[2]}")
+    if r.shape[1] != sheet.n:
+        raise InvalidInputError(field, f"has {r.shape[1]} robots but the sheet has "
+                                       f"{sheet.n} vertices")
+    return r
+
+
+def _pair_limits(sheet: Sheet) -> np.ndarray:
+    """Largest accepted distance of each robot pair, shape (N, N): the sheet distance
+    widened by ``GEOMETRY_RTOL`` (relative, and of the sheet size)."""
+    return sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
+
+
+def _torn_pairs(sheet: Sheet, r: np.ndarray) -> np.ndarray:
+    """Bool (B, P): which robot pairs (``numpy.triu_indices`` order) of the validated
+    formations ``r`` (B, N, 2) stand farther apart than their sheet vertices allow."""
+    iu, ju = np.triu_indices(sheet.n, 1)
+    lim2 = _pair_limits(sheet)[iu, ju] ** 2
+    torn = np.zeros((r.shape[0], len(iu)), dtype=bool)
+    # Chunks keep the (chunk, pairs, 2) temporaries small (fresh large arrays are slow).
+    step = max(1, (1 << 18) // max(len(iu), 1))
+    for start in range(0, r.shape[0], step):
+        chunk = r[start:start + step]
+        diff = chunk[:, iu, :] - chunk[:, ju, :]
+        torn[start:start + step] = np.einsum("bpk,bpk->bp", diff, diff) > lim2
+    return torn
+
+
+def feasible_formations(sheet: Sheet, formations: ArrayLike, field: str = "formations"
+                        ) -> np.ndarray:
+    """Which formations of a batch (B, N, 2) the sheet can span (the paper's
+    ``FormationFeasible``, as :func:`check_formations`), as a bool array of shape (B,).
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shape, robot count different from the sheet's, NaN/inf.
+    """
+    torn = _torn_pairs(sheet, _formation_batch(sheet, formations, field))
+    return np.asarray(~torn.any(axis=1))
+
+
 def check_formations(sheet: Sheet, formations: ArrayLike, field: str = "formations"
                      ) -> np.ndarray:
     """Validate a batch of formations, shape (B, N, 2), against the sheet.
@@ -167,38 +215,20 @@ def check_formations(sheet: Sheet, formations: ArrayLike, field: str = "formatio
         Some pair of robots is farther apart than its sheet vertices; ``step`` holds the
         batch index for batched input.
     """
-    require_instance(sheet, Sheet, "sheet")
-    r = check_range(as_array(formations, field, ndim=3), field, MAX_SHEET_LENGTH, "sheet units")
-    if r.shape[2] != 2:
-        raise InvalidInputError(field, f"last axis must have length 2 (x, y), got {r.shape[2]}")
-    if r.shape[1] != sheet.n:
-        raise InvalidInputError(field, f"has {r.shape[1]} robots but the sheet has "
-                                       f"{sheet.n} vertices")
-    limit = sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
-    n = sheet.n
-    iu, ju = np.triu_indices(n, 1)
-    lim2 = limit[iu, ju] ** 2
-    # Chunks keep the (chunk, pairs, 2) temporaries small (fresh large arrays are slow).
-    step = max(1, (1 << 18) // max(len(iu), 1))
-    bad = None
-    for start in range(0, r.shape[0], step):
-        chunk = r[start:start + step]
-        diff = chunk[:, iu, :] - chunk[:, ju, :]
-        d2 = np.einsum("bpk,bpk->bp", diff, diff)
-        if np.any(d2 > lim2):
-            bad = d2 > lim2
-            break
-    if bad is not None:
-        b, p = np.argwhere(bad)[0]
+    r = _formation_batch(sheet, formations, field)
+    torn = _torn_pairs(sheet, r)
+    if torn.any():
+        b, p = (int(k) for k in np.argwhere(torn)[0])
+        iu, ju = np.triu_indices(sheet.n, 1)
         i, j = int(iu[p]), int(ju[p])
-        dr = np.sqrt(d2)
-        b += start
-        at: int | None = int(b) if r.shape[0] > 1 else None
+        limit = _pair_limits(sheet)[i, j]
+        at: int | None = b if r.shape[0] > 1 else None
         where = f" at step {at}" if at is not None else ""
         raise InfeasibleFormationError(
             field,
-            f"robots {i + 1} and {j + 1} are {dr[b - start, p]:.6g} apart{where} but their sheet "
-            f"vertices only {limit[i, j] / (1 + GEOMETRY_RTOL):.6g} (the sheet would tear)",
+            f"robots {i + 1} and {j + 1} are {np.linalg.norm(r[b, i] - r[b, j]):.6g} apart"
+            f"{where} but their sheet vertices only {limit / (1 + GEOMETRY_RTOL):.6g} "
+            "(the sheet would tear)",
             pair=(i, j), step=at)
     return r
 

@@ -7,6 +7,18 @@ parameters and the outputs to keep. :func:`run_sweep` evaluates it chunk by chun
 chunks depend only on the sweep, so the rows are the same whatever the number of workers,
 and a resumed run skips the chunks already stored.
 
+Sweep files
+    :func:`load_sweep` reads and validates a sweep file (YAML or JSON),
+    :func:`sweep_from_mapping` an already parsed one; both return a :class:`SweepSpec` of
+    :class:`Parameter` values.
+Tasks
+    :data:`TASKS` maps each task name to its :class:`Task` (parameters, outputs, base).
+Running
+    :func:`run_sweep` writes ``results.parquet`` and returns a :class:`SweepResult`;
+    :func:`evaluate_chunk` computes one chunk's rows, :func:`chunk_size_of` its size.
+Results
+    :func:`read_results` reads a results folder back as numpy columns and metadata.
+
 Examples
 --------
 >>> import numpy as np
@@ -17,9 +29,20 @@ Examples
 array([0., 1., 2.])
 """
 
+from .file import load_sweep, sweep_from_mapping
+from .registry import TASKS
+from .results import read_results
 from .runner import SweepResult, chunk_size_of, evaluate_chunk, run_sweep
 from .spec import Parameter, SweepSpec
-from .tasks import TASKS, Task
+from .task import Task
 
-__all__ = ["TASKS", "Task", "Parameter", "SweepSpec", "SweepResult", "run_sweep",
-           "evaluate_chunk", "chunk_size_of"]
+__all__ = [
+    # sweep files
+    "load_sweep", "sweep_from_mapping", "SweepSpec", "Parameter",
+    # tasks
+    "TASKS", "Task",
+    # running
+    "run_sweep", "SweepResult", "evaluate_chunk", "chunk_size_of",
+    # results
+    "read_results",
+]

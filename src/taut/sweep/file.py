@@ -24,14 +24,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, cast
 
 import numpy as np
 
+from .._validate import as_path
 from ..errors import SweepError
-from .spec import DISTRIBUTIONS, Parameter, SweepSpec
-from .tasks import TASKS
 from ..io.files import read_mapping, read_text
+from .registry import TASKS
+from .spec import DISTRIBUTIONS, Parameter, SweepSpec, _choice
 
 __all__ = ["load_sweep", "sweep_from_mapping", "base_model"]
 
@@ -133,8 +134,10 @@ def _base(data: Mapping[str, Any], task: str, root: Path
 
 def base_model(spec: SweepSpec) -> Any:
     """The sweep's base scenario or model, built from the parsed file in the spec (or the
-    preset), so that a worker needs no access to the file."""
+    preset), so that a worker needs no access to the file; None for a task without one."""
     need = TASKS[spec.task].needs_base
+    if not need:
+        return None
     if spec.base_data is None:
         from ..io.cdpr_model import load_cdpr_model
         return load_cdpr_model(str(spec.base))
@@ -161,18 +164,38 @@ _BUILDERS = {"sheet scenario": _sheet, "plan scenario": _plan, "cdpr model": _cd
 
 def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".",
                        source: str = "") -> SweepSpec:
-    """Validate a parsed sweep file; relative ``base`` paths are resolved from ``root``."""
-    unknown = set(data) - _KEYS
+    """Validate a parsed sweep file; relative ``base`` paths are resolved from ``root``.
+
+    Parameters
+    ----------
+    data : mapping
+        The sweep file's top level (see the module docstring).
+    root : path
+        Folder that relative ``base`` paths start from.
+    source : str
+        The file's text, kept in the results' metadata.
+
+    Returns
+    -------
+    SweepSpec
+
+    Raises
+    ------
+    SweepError
+        Any invalid key or value, naming it.
+    """
+    if not isinstance(data, Mapping):
+        raise SweepError("data", f"must be a mapping of sweep keys, got {type(data).__name__}")
+    folder = as_path(root, "root")
+    if not isinstance(source, str):
+        raise SweepError("source", f"must be the file's text (str), got {type(source).__name__}")
+    unknown = {str(k) for k in data} - _KEYS
     if unknown:
         raise SweepError(sorted(unknown)[0], "unknown key")
-    task = data.get("task")
-    if task not in TASKS:
-        raise SweepError("task", f"unknown task {task!r}; expected one of "
-                         f"{', '.join(sorted(TASKS))}")
+    task = _choice(data.get("task"), sorted(TASKS), "task")
     spec_task = TASKS[task]
-    mode = data.get("mode", "grid")
-    if mode not in ("grid", "random"):
-        raise SweepError("mode", f"must be grid or random, got {mode!r}")
+    mode = cast(Literal["grid", "random"],
+                _choice(data.get("mode", "grid"), ("grid", "random"), "mode"))
     seed = _count(data.get("seed", 0), "seed", 0, 2**63 - 1)
     samples = 0
     if mode == "random":
@@ -195,14 +218,14 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".",
     if not isinstance(outputs, list):
         raise SweepError("outputs", "must be a list of output names")
     for k, name in enumerate(outputs):
-        if name not in spec_task.outputs:
+        if not isinstance(name, str) or name not in spec_task.outputs:
             raise SweepError(f"outputs[{k}]", f"unknown output {name!r} of {task}; expected "
                              f"one of {', '.join(spec_task.outputs)}")
     chunk = _count(data.get("chunk_size", 0), "chunk_size", 0, 10**7)
     options = data.get("options", {})
     if not isinstance(options, Mapping):
         raise SweepError("options", "must be a mapping")
-    base, base_data = _base(data, task, Path(root))
+    base, base_data = _base(data, task, folder)
     spec = SweepSpec(task=task, parameters=tuple(params), base=base, base_data=base_data,
                      mode=mode, samples=samples, seed=seed, chunk_size=chunk,
                      outputs=tuple(outputs), options=dict(options), source=source)
@@ -221,6 +244,6 @@ def load_sweep(path: str | Path) -> SweepSpec:
     ScenarioError
         A missing, unreadable or malformed file.
     """
-    p = Path(path)
+    p = as_path(path)
     data = read_mapping(p)
     return sweep_from_mapping(data, p.parent, read_text(p))

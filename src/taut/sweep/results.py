@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._validate import as_path
 from ..errors import SweepError
 
 __all__ = ["read_results"]
@@ -19,7 +20,7 @@ def read_results(folder: str | Path) -> tuple[dict[str, np.ndarray], dict[str, s
     SweepError
         No ``results.parquet`` in ``folder``, or pyarrow missing.
     """
-    path = Path(folder) / "results.parquet"
+    path = as_path(folder, "folder") / "results.parquet"
     if not path.is_file():
         raise SweepError("folder", f"{folder} holds no results.parquet (run `taut sweep` "
                          "first)")

@@ -20,13 +20,14 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from .._validate import as_array, as_count, as_flag, as_path, require_instance
 from ..errors import SweepError
+from .file import base_model
 from .points import chunk_bounds, expand, point_seeds
+from .registry import TASKS
 from .spec import SweepSpec
 from .store import Store
-from .tasks import TASKS, Columns
-from .._validate import as_array, as_count, as_flag, require_instance
-from .._validate import as_path
+from .task import Columns
 
 __all__ = ["SweepResult", "run_sweep", "evaluate_chunk", "chunk_size_of"]
 
@@ -75,7 +76,7 @@ def chunk_size_of(spec: SweepSpec) -> int:
 def _context(spec: SweepSpec) -> Any:
     ctx = _CONTEXTS.get(spec.digest)
     if ctx is None:
-        ctx = _CONTEXTS[spec.digest] = TASKS[spec.task].prepare(spec)
+        ctx = _CONTEXTS[spec.digest] = TASKS[spec.task].prepare(spec, base_model(spec))
     return ctx
 
 
@@ -173,8 +174,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     A 3 x 2 stability map of a square team, run serially:
 
     >>> import tempfile, pathlib
-    >>> from taut.sweep.file import sweep_from_mapping
-    >>> from taut.sweep.results import read_results
+    >>> from taut.sweep import read_results, sweep_from_mapping
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> _ = (tmp / "team.yaml").write_text(
     ...     "hold_height: 800\nsheet: [[0, 0], [1000, 0], [1000, 1000], [0, 1000]]\n"

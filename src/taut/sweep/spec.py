@@ -15,12 +15,21 @@ from typing import Any, Literal
 
 import numpy as np
 
-from ..errors import SweepError
+from .._validate import as_choice
+from ..errors import InvalidInputError, SweepError
 
 __all__ = ["Parameter", "SweepSpec", "Distribution", "DISTRIBUTIONS"]
 
 Distribution = Literal["uniform", "normal", "integers", "choice"]
 DISTRIBUTIONS: tuple[str, ...] = ("uniform", "normal", "integers", "choice")
+
+
+def _choice(value: Any, choices: Any, field: str) -> str:
+    """:func:`taut._validate.as_choice`, failing with a :class:`~taut.errors.SweepError`."""
+    try:
+        return as_choice(value, choices, field)
+    except InvalidInputError as exc:
+        raise SweepError(exc.field, exc.problem) from None
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,10 +77,8 @@ class Parameter:
             self._check_distribution()
 
     def _check_distribution(self) -> None:
+        _choice(self.distribution, DISTRIBUTIONS, f"parameters.{self.name}")
         where = f"parameters.{self.name}.{self.distribution}"
-        if self.distribution not in DISTRIBUTIONS:
-            raise SweepError(f"parameters.{self.name}", f"unknown distribution "
-                             f"{self.distribution!r}; expected one of {', '.join(DISTRIBUTIONS)}")
         a = self.arguments
         assert a is not None
         if self.distribution in ("uniform", "integers", "normal") and a.size != 2:

@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..physics.sheet import EquilibriaCheck, SettleResult  # noqa: E402
-from .sheet import STATUS_COLOURS  # noqa: E402
+from .sheet import KIND_COLOURS  # noqa: E402
 
 __all__ = ["plot_equilibria_check", "animate_settle"]
 
@@ -47,7 +47,7 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
     for k, s in enumerate(check.states):
         ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
         _draw_sheet(ax, s.nodes, s.triangles, np.asarray(formation), hold_height)
-        ax.scatter(*s.predicted, s=60, color=STATUS_COLOURS.get(s.status, "k"),
+        ax.scatter(*s.predicted, s=60, color=KIND_COLOURS.get(s.status, "k"),
                    edgecolor="k", depthshade=False, label="taut")
         ax.scatter(*s.settled, s=50, marker="x", color="k", depthshade=False,
                    label="physics, released")

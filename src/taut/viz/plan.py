@@ -17,6 +17,7 @@ from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 from matplotlib.patches import Polygon as PolygonPatch  # noqa: E402
 
+from ..plan.checks.profile import plan_profile  # noqa: E402
 from ..plan.result import PlanResult  # noqa: E402
 from ..plan.world import Scenario  # noqa: E402
 
@@ -42,15 +43,6 @@ def draw_world(ax, scenario: Scenario) -> None:
     pad = 0.2
     ax.set_xlim(fs[:, 0].min() - pad, fs[:, 0].max() + pad)
     ax.set_ylim(fs[:, 1].min() - pad, fs[:, 1].max() + pad)
-
-
-def _beneath(scenario: Scenario, r: PlanResult) -> np.ndarray:
-    """Height of the tallest obstacle beneath the sheet per sample (0 when none), m."""
-    hulls = shapely.convex_hull(shapely.multipoints(r.robots))
-    out = np.zeros(len(r.times))
-    for o in scenario.world.obstacles:
-        out = np.where(shapely.intersects(hulls, o.geometry), np.maximum(out, o.height), out)
-    return out
 
 
 def _top_view(ax, scenario: Scenario, r: PlanResult) -> None:
@@ -134,7 +126,7 @@ def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
     ax.set_xlabel("time [s]")
     ax.set_ylabel("robot distance / sheet distance")
     ax.set_title(f"pair distances vs sheet limits (least slack "
-                 f"{(limit[None] - d).min() * 1e3:.1f} mm)")
+                 f"{plan_profile(r).sheet_slack_m.min() * 1e3:.1f} mm)")
     ax.set_ylim(min(0.0, float(ratio.min()) - 0.05), 1.08)
     ax.legend(fontsize=6, ncol=2 if len(iu) <= 10 else 1)
 
@@ -149,11 +141,12 @@ def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
     fig, axs = plt.subplots(2, 2, figsize=(12, 8))
     _top_view(axs[0, 0], scenario, r)
     ax = axs[0, 1]
-    ax.plot(r.times, r.object[:, 2], label="object height (model)")
-    ax.fill_between(r.times, 0, _beneath(scenario, r), color="0.6", step="mid",
+    profile = plan_profile(r)
+    ax.plot(profile.times_s, profile.object_height_m, label="object height (model)")
+    ax.fill_between(profile.times_s, 0, profile.beneath_height_m, color="0.6", step="mid",
                     label="tallest obstacle beneath the sheet")
-    ax.plot(r.times, _beneath(scenario, r) + scenario.team.height_safety, color="0.3",
-            ls="--", lw=0.7, label="+ height safety")
+    ax.plot(profile.times_s, profile.beneath_height_m + scenario.team.height_safety,
+            color="0.3", ls="--", lw=0.7, label="+ height safety")
     ax.axhline(scenario.team.hold_height, color="k", ls=":", lw=0.8, label="hold height")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("height [m]")

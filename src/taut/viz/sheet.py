@@ -17,15 +17,15 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 from ..sheet.fk.results import Equilibrium, FKResult  # noqa: E402
 
-__all__ = ["draw_equilibrium", "plot_fk", "STATUS_COLOURS"]
+__all__ = ["draw_equilibrium", "plot_fk", "KIND_COLOURS"]
 
-STATUS_COLOURS = {"stable": "tab:green", "saddle": "tab:orange", "not_equilibrium": "tab:red"}
+KIND_COLOURS = {"stable": "tab:green", "saddle": "tab:orange", "not_equilibrium": "tab:red"}
 
 
 def legend_handles() -> list[Line2D]:
     """Legend entries of :func:`draw_equilibrium`'s marks."""
     obj = [Line2D([], [], ls="none", marker="o", ms=7, mec="k", color=c,
-                  label=f"object: {k.replace('_', ' ')}") for k, c in STATUS_COLOURS.items()]
+                  label=f"object: {k.replace('_', ' ')}") for k, c in KIND_COLOURS.items()]
     return [Line2D([], [], color="tab:blue", lw=1.6, label="taut cable"),
             Line2D([], [], color="tab:blue", lw=0.8, ls=":", label="slack cable"),
             Line2D([], [], color="0.55", lw=0.8, ls="--", label="formation at hold height"),
@@ -62,10 +62,10 @@ def draw_equilibrium(ax: Any, formation: np.ndarray, hold_height: float, e: Equi
         order = np.argsort(np.arctan2(sub[:, 1] - c[1], sub[:, 0] - c[0]))
         poly = np.vstack([sub[order], sub[order][:1]])
         ax.plot(poly[:, 0], poly[:, 1], np.zeros(len(poly)), color="tab:blue", lw=0.6, alpha=0.6)
-    ax.scatter(*e.object, s=60, color=STATUS_COLOURS[e.status], edgecolor="k", zorder=5)
+    ax.scatter(*e.object, s=60, color=KIND_COLOURS[e.kind], edgecolor="k", zorder=5)
     ax.plot([e.object[0]] * 2, [e.object[1]] * 2, [0, e.object[2]], color="0.7", lw=0.6)
     label = "{" + ",".join(str(i + 1) for i in e.taut) + "}"
-    ax.set_title(f"taut {label}: {e.status.replace('_', ' ')}\n"
+    ax.set_title(f"taut {label}: {e.kind.replace('_', ' ')}\n"
                  f"z_o = {e.object[2]:.4g}{' ' + units if units else ''}", fontsize=9)
     ax.set_zlim(0, hold_height * 1.08)
     span = np.ptp(formation, axis=0)
@@ -84,7 +84,7 @@ def plot_fk(result: FKResult, path: str | Path | None = None, *, units: str | No
 
     At most ``max_panels`` states are drawn; when there are more, the figure says how many
     were left out (the stable ones are always drawn first)."""
-    order = sorted(result.equilibria, key=lambda e: (not e.stable, e.status != "saddle"))
+    order = sorted(result.equilibria, key=lambda e: (not e.stable, e.kind != "saddle"))
     eqs = order[:max_panels]
     left_out = len(order) - len(eqs)
     k = max(1, len(eqs))

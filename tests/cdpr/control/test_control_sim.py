@@ -1,6 +1,6 @@
 """Control simulation of the CDPR: rest, energy, tipping monitor, tracking, bad input.
 
-Short runs use the numpy engine (no compilation); the paper's claim and the engine
+Short runs use the numpy backend (no compilation); the paper's claim and the backend
 cross-check are marked slow.
 """
 
@@ -31,7 +31,7 @@ def _hold(robot, pose, seconds=0.5):
 @pytest.mark.parametrize("controller", [VelocityController(), TorqueController()],
                          ids=["velocity", "torque"])
 def test_rest_holds_pose_and_tensions_match_the_distribution(fk_stab, controller):
-    run = simulate(fk_stab, _hold(fk_stab, HOLD), controller, engine="numpy")
+    run = simulate(fk_stab, _hold(fk_stab, HOLD), controller, backend="numpy")
     assert run.success, run.message
     assert np.abs(run.poses - HOLD).max() < 1e-6
     ref = distribute_tensions(fk_stab, HOLD, "closed_form", tipping=False).tensions
@@ -42,7 +42,7 @@ def test_rest_holds_pose_and_tensions_match_the_distribution(fk_stab, controller
 
 
 def test_tipping_monitor_with_errors_matches_tipping_moments_at_rest(fk_stab):
-    run = simulate(fk_stab, _hold(fk_stab, HOLD, 0.3), TorqueController(), engine="numpy",
+    run = simulate(fk_stab, _hold(fk_stab, HOLD, 0.3), TorqueController(), backend="numpy",
                    model_errors=ModelErrors(exit_offset=0.0, mass_scale=1.1))
     k = len(run.times) - 1
     tm = tipping_moments(fk_stab, run.poses[k], run.tensions[k]).moments
@@ -98,7 +98,7 @@ def test_energy_is_conserved_without_losses(fastkit):
 
 def test_velocity_control_without_model_error_tracks_within_1_mm(fk_stab):
     ref = pick_and_place(fk_stab, [[-0.6, 0, 1.0], [0.6, 0, 1.0]], dwell=0.2)
-    run = simulate(fk_stab, ref, VelocityController(), engine="numpy")
+    run = simulate(fk_stab, ref, VelocityController(), backend="numpy")
     assert run.success, run.message
     assert np.abs(run.reference[:, 0] - run.reference[0, 0]).max() > 1.1   # it moved 1.2 m
     assert run.tracking_error.max() < 1e-3
@@ -107,7 +107,7 @@ def test_velocity_control_without_model_error_tracks_within_1_mm(fk_stab):
 def test_deployment_short_base_move_holds_the_platform(fk_stab):
     bm = BaseMotion.line(fk_stab, "active", (0.1, 0.0, 0.0), duration=1.0, start=0.1)
     run = simulate(fk_stab, _hold(fk_stab, HOLD, 1.3), VelocityController(), base_motion=bm,
-                   engine="numpy")
+                   backend="numpy")
     moved = run.base_poses[-1, 0, 0] - run.base_poses[0, 0, 0]
     assert abs(moved - 0.1) < 1e-9
     assert run.tracking_error.max() < 2e-3
@@ -116,9 +116,9 @@ def test_deployment_short_base_move_holds_the_platform(fk_stab):
 def test_monte_carlo_batch_equals_single_runs(fk_stab):
     ref = pick_and_place(fk_stab, [[-0.3, 0, 1.0], [0.3, 0, 1.0]], dwell=0.1)
     errs = [ModelErrors(exit_offset=0.003, seed=s) for s in (1, 2)]
-    mc = monte_carlo(fk_stab, ref, TorqueController(), errs, engine="numpy", settle=0.3)
+    mc = monte_carlo(fk_stab, ref, TorqueController(), errs, backend="numpy", settle=0.3)
     for i, e in enumerate(errs):
-        one = simulate(fk_stab, ref, TorqueController(), model_errors=e, engine="numpy",
+        one = simulate(fk_stab, ref, TorqueController(), model_errors=e, backend="numpy",
                        settle=0.3)
         assert mc.max_tracking_error[i] == pytest.approx(one.tracking_error.max(), rel=1e-9)
         assert mc.max_tension[i] == pytest.approx(one.tensions.max(), rel=1e-9)
@@ -126,7 +126,7 @@ def test_monte_carlo_batch_equals_single_runs(fk_stab):
 
 
 def test_diverging_plant_is_a_result_naming_the_time(fk_stab):
-    run = simulate(fk_stab, _hold(fk_stab, HOLD, 1.0), TorqueController(), engine="numpy",
+    run = simulate(fk_stab, _hold(fk_stab, HOLD, 1.0), TorqueController(), backend="numpy",
                    external_wrench=[0, 0, 5000.0, 0, 0, 0], settle=0.0)
     assert not run.success and run.status == "diverged"
     assert "diverged at t = " in run.message
@@ -142,11 +142,15 @@ def test_bad_input(fk_stab):
     with pytest.raises(InvalidInputError):
         pick_and_place(fk_stab, [[0, 0, np.nan], [1.0, 0, 1.0]])
     with pytest.raises(InvalidInputError, match="control_rate.*at least"):
-        simulate(fk_stab, ref, VelocityController(), control_rate=50.0, engine="numpy")
+        simulate(fk_stab, ref, VelocityController(), control_rate=50.0, backend="numpy")
     with pytest.raises(InvalidInputError, match="control_rate"):
         simulate(fk_stab, ref, VelocityController(), control_rate=-1.0)
     with pytest.raises(InvalidInputError, match="controller"):
         simulate(fk_stab, ref, "velocity")
+    with pytest.raises(InvalidInputError, match="^backend: unknown backend 'fortran'"):
+        simulate(fk_stab, ref, VelocityController(), backend="fortran")
+    with pytest.raises(InvalidInputError, match="^profile: "):
+        pick_and_place(fk_stab, [[0, 0, 1.0], [1.0, 0, 1.0]], profile="cubic")
     with pytest.raises(InvalidModelError, match="cable_stiffness"):
         DynamicsModel(cable_stiffness=0.0)
     with pytest.raises(InvalidInputError, match="length_gain"):
@@ -155,7 +159,7 @@ def test_bad_input(fk_stab):
         ModelErrors(exit_offset=-0.001)
     high = pick_and_place(fk_stab, [[0, 0, 1.0], [0, 0, 1.85]], dwell=0.1)
     with pytest.raises(InfeasiblePoseError, match=r"wrench-feasible workspace at t = "):
-        simulate(fk_stab, high, TorqueController(), engine="numpy")
+        simulate(fk_stab, high, TorqueController(), backend="numpy")
 
 
 def test_pick_and_place_profiles_reach_the_speed(fk_stab):
@@ -194,13 +198,13 @@ def test_deployment_active_base_moves_half_a_metre(fk_stab):
 
 
 @pytest.mark.slow
-def test_numba_and_numpy_engines_agree(fk_stab):
+def test_numba_and_numpy_backends_agree(fk_stab):
     pytest.importorskip("numba")
     ref = pick_and_place(fk_stab, [[-0.5, 0, 1.0], [0.5, 0, 1.0]], dwell=0.1)
     me = ModelErrors(exit_offset=0.005, length_offset=0.002, friction_scale=1.5, seed=4)
     for ctl in (VelocityController(), TorqueController()):
-        a = simulate(fk_stab, ref, ctl, model_errors=me, engine="numba")
-        b = simulate(fk_stab, ref, ctl, model_errors=me, engine="numpy")
+        a = simulate(fk_stab, ref, ctl, model_errors=me, backend="numba")
+        b = simulate(fk_stab, ref, ctl, model_errors=me, backend="numpy")
         assert np.abs(a.poses - b.poses).max() < 1e-9
         assert np.abs(a.tensions - b.tensions).max() < 1e-6
         assert np.abs(a.motor_torques - b.motor_torques).max() < 1e-9
@@ -224,3 +228,17 @@ def test_tipping_monitor_moving_and_static_paths_agree(fk_stab):
     moving = tipping_margins(fk_stab, ex2, st.unit, t, bp2)
     ref = -tipping_moments(fk_stab, P, t).moments
     assert np.allclose(static, ref, atol=1e-9) and np.allclose(moving, ref, atol=1e-9)
+
+
+def test_the_compiled_loop_uses_the_one_numba_set_up():
+    """`backend` is the one name of the numba/numpy switch, and the compiled loop is built by
+    taut._jit (no numba set-up of its own)."""
+    import inspect
+
+    import taut._jit
+    from taut.cdpr.control import _kernel
+
+    for f in (simulate, monte_carlo):
+        params = inspect.signature(f).parameters
+        assert params["backend"].default == "auto" and "engine" not in params
+    assert _kernel.jit is taut._jit.jit and "import numba" not in inspect.getsource(_kernel)

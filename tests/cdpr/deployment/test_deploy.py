@@ -32,7 +32,7 @@ WEIGHT = 12.0 * 9.81                             # 5 kg platform + 7 kg payload,
 def deployment():
     """A real (seeded) deployment search: heavy, so only `slow` tests use it."""
     from taut.io.cdpr_model import load_cdpr_model
-    robot = with_stabilisers(load_cdpr_model("fastkit"), True)
+    robot = with_stabilisers(load_cdpr_model("fastkit"))
     return plan_deployment(robot, BOX, required_twist=TWIST, maxiter=3, popsize=5,
                            grid=(6, 2, 3), verify_grid=(11, 3, 5), seed=0)
 
@@ -64,7 +64,7 @@ def test_model_placement_is_worse():
     """The shipped placement (bases at +-3 m) is not wrench-feasible over this box with
     tipping: the planner improved on it."""
     from taut.io.cdpr_model import load_cdpr_model
-    robot = with_stabilisers(load_cdpr_model("fastkit"), True)
+    robot = with_stabilisers(load_cdpr_model("fastkit"))
     pts, _ = grid_points(BOX, (11, 3, 5))
     assert not wrench_feasible(robot, pts, tipping=True).all()
 
@@ -73,7 +73,7 @@ def test_model_placement_is_worse():
 def test_full_height_box_reports_why(fastkit):
     """With the 7 kg payload and 45 N cables no placement holds the platform 2 m high over
     5 m: the planner says so and names the worst point."""
-    res = plan_deployment(with_stabilisers(fastkit, True), [[-2.5, -0.05, 0.0],
+    res = plan_deployment(with_stabilisers(fastkit), [[-2.5, -0.05, 0.0],
                                                             [2.5, 0.05, 2.0]],
                           maxiter=1, popsize=4, grid=(5, 1, 3), verify_grid=(5, 2, 3))
     assert not res.success
@@ -181,22 +181,22 @@ def test_cli_deploy(capsys, tmp_path, monkeypatch, success):
     assert out["points"] == 12 and out["feasible_points"] == (12 if success else 8)
     assert out["evaluations"] == 42 and out["margin"] == (1.5 if success else -0.5)
     assert out["base_poses"] == {"active": [-3.4, 0.0, 0.0], "passive": [3.4, 0.0, 3.1416]}
-    assert out["reason"] == ("" if success else "best placement found: stub")
+    assert out["message"] == ("verified" if success else "best placement found: stub")
     assert out["lift_bound"]["refutes"] is False
     assert (tmp_path / "d.png").stat().st_size > 1000
     # the CLI passed its settings through and deployed the stabilisers
     robot, box, kwargs = stub.calls[0]
     np.testing.assert_array_equal(box, [[-1.0, -0.05, 0.4], [1.0, 0.05, 0.9]])
-    assert kwargs["maxiter"] == 1 and kwargs["seed"] == 0
+    assert kwargs["maxiter"] == 1 and "seed" not in kwargs      # the library's default seed
     assert all(b.stabilisers_deployed for b in robot.bases if b.mobile)
 
 
-def test_cli_deploy_text_with_disturbance(capsys, monkeypatch):
+def test_cli_deploy_text_with_external_wrench(capsys, monkeypatch):
     stub = _StubPlanner(False)
     monkeypatch.setattr("taut.cdpr.plan_deployment", stub)
     code = taut_main(["cdpr", "deploy", "fastkit", "--workspace", "-0.5", "0.5", "-0.05",
                       "0.05", "0.5", "0.8", "--stabilisers", "--maxiter", "1",
-                      "--disturbance", "2", "2", "2", "0", "0", "0", "--twist", "0.5", "0",
+                      "--external-wrench", "2", "2", "2", "0", "0", "0", "--twist", "0.5", "0",
                       "0", "0", "0", "0"])
     text = capsys.readouterr().out
     assert code == 1
@@ -382,7 +382,7 @@ def test_certificate_is_nearly_attained(fastkit):
 
 
 def test_plan_deployment_stops_at_the_certificate(fastkit):
-    res = plan_deployment(with_stabilisers(fastkit, True), FULL)
+    res = plan_deployment(with_stabilisers(fastkit), FULL)
     assert not res.success and res.refuted and res.evaluations == 0
     assert res.status == "refuted"
     assert res.message.startswith("no placement can work: at z = 2.2 m the cables can lift "
@@ -395,7 +395,7 @@ def test_plan_deployment_stops_at_the_certificate(fastkit):
 
 @pytest.mark.slow
 def test_tallest_workspace_fastkit(fastkit):
-    robot = with_stabilisers(fastkit, True)
+    robot = with_stabilisers(fastkit)
     tw = tallest_workspace(robot, FULL, tol=0.25, maxiter=3, popsize=5, grid=(6, 2, 3),
                            verify_grid=(11, 3, 5))
     assert tw.deployment is not None and tw.deployment.success

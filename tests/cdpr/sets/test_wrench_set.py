@@ -7,7 +7,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.optimize import linprog
 
 from taut.cdpr import (available_wrench_set, axis_capacities, capacity_margin, cable_state,
-                       disturbance_box, with_stabilisers, wrench_feasible)
+                       external_wrench_box, with_stabilisers, wrench_feasible)
 from taut.cdpr.statics._common import constraints  # private: the constraint rows under test
 
 from cdpr_helpers import A, H, MASS, random_poses
@@ -37,7 +37,7 @@ def test_hrep_is_exact_on_random_wrenches(request, name, tipping):
     poses = random_poses(robot, 6, seed=4)
     agree, total, inside = 0, 0, 0
     for pose in poses:
-        aws = available_wrench_set(robot, pose, tipping)
+        aws = available_wrench_set(robot, pose, tipping=tipping)
         if not aws.nonempty:
             continue
         # Points near the boundary: Chebyshev-free scan along random rays from W t_mid.
@@ -72,8 +72,8 @@ def test_tipping_aws_inside_plain_aws(fastkit):
     # Set containment on sampled wrenches: W t for random t in the box, filtered by tipping.
     g = np.random.default_rng(9)
     for pose in poses[:5]:
-        a_t = available_wrench_set(fastkit, pose, True)
-        a_f = available_wrench_set(fastkit, pose, False)
+        a_t = available_wrench_set(fastkit, pose, tipping=True)
+        a_f = available_wrench_set(fastkit, pose, tipping=False)
         W = cable_state(fastkit, pose).W
         T = g.uniform(fastkit.t_min, fastkit.t_max, (500, fastkit.m))
         w = T @ W.T
@@ -122,7 +122,7 @@ def test_point_mass_capacities_analytic(point_mass, z0):
 
 
 def test_stabilisers_never_reduce_capacities(fastkit):
-    deployed = with_stabilisers(fastkit, True)
+    deployed = with_stabilisers(fastkit)
     assert all(b.stabilisers_deployed for b in deployed.bases)
     assert deployed.n_edges == fastkit.n_edges
     poses = random_poses(fastkit, 60, seed=21, angle=0.1)
@@ -134,13 +134,13 @@ def test_stabilisers_never_reduce_capacities(fastkit):
     fa = wrench_feasible(fastkit, poses, tipping=True)
     fb = wrench_feasible(deployed, poses, tipping=True)
     assert not np.any(fa & ~fb)
-    back = with_stabilisers(deployed, False)
+    back = with_stabilisers(deployed, deployed=False)
     np.testing.assert_allclose(back.edge_weight_moment, fastkit.edge_weight_moment)
 
 
 def test_capacity_margin_sign_matches_feasibility(fastkit):
     poses = random_poses(fastkit, 120, seed=31, angle=0.05)
-    D = disturbance_box(fastkit, [3, 3, 3, 0.3, 0.3, 0.3])
+    D = external_wrench_box(fastkit, [3, 3, 3, 0.3, 0.3, 0.3])
     assert D.shape == (64, 6)
     for tip in (False, True):
         margin = capacity_margin(fastkit, poses, D, tipping=tip)
@@ -161,7 +161,7 @@ def test_capacity_margin_sign_matches_feasibility(fastkit):
 def test_gravity_in_aws_iff_tensions_exist(fastkit, x, z, yaw, tip):
     from taut.cdpr import distribute_tensions
     pose = [x, 0.0, z, 0.0, 0.0, yaw]
-    aws = available_wrench_set(fastkit, pose, tip)
+    aws = available_wrench_set(fastkit, pose, tipping=tip)
     lp = distribute_tensions(fastkit, pose, "lp_min_sum", tipping=tip).success
     assert bool(aws.contains(-aws.gravity_wrench, tol=1e-7)) == lp
     assert bool(wrench_feasible(fastkit, pose, tipping=tip)) == lp

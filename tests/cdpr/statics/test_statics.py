@@ -172,3 +172,53 @@ def test_tipping_moment_about_front_edge_by_hand():
     assert res.stable
     tip = tipping_moments(robot, [2.0, 0.0, h], [M * G * 0.5 / h + 1.0, 0, 0, 0])
     assert not tip.stable and tip.worst_edge == front
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.2])
+def test_binding_is_the_workspace_s(fastkit, mu):
+    """`binding` of the exact methods is the first condition (limits, tipping, sliding)
+    whose addition makes a pose infeasible: the wrench-feasible workspace's, point by point
+    (LP/QP poses without tensions are told apart by solving again without the later
+    conditions)."""
+    from taut.cdpr import grid_points, with_friction, wrench_feasible_workspace
+
+    robot = with_friction(fastkit, mu)
+    pts, _ = grid_points([[-2.4, 0, 0.3], [2.4, 0, 2.1]], (13, 1, 7))
+    want = wrench_feasible_workspace(robot, pts).binding
+    assert {"", "limits", "tipping", "sliding"} <= set(want)
+    for method in ("lp_min_sum", "qp_min_norm"):
+        res = distribute_tensions(robot, pts, method)
+        np.testing.assert_array_equal(res.binding, want)
+        np.testing.assert_array_equal(res.success, want == "")
+
+
+def test_one_pose_message_says_why(fastkit):
+    """One pose: the message names the failing condition (for returned tensions, the bases
+    that tip); `within_limits` marks each tension; the batch keeps the counting message."""
+    tip = distribute_tensions(fastkit, [0, 0, 1.2])                 # closed form, tipping on
+    assert (tip.success, tip.binding) == (False, "tipping") and tip.within_limits.all()
+    assert tip.message.startswith("not wrench-feasible: mobile bases active, passive tip over")
+    moments = tipping_moments(fastkit, [0, 0, 1.2], tip.tensions)
+    assert f"{moments.moments.max():.2f} N m" in tip.message
+    lp = distribute_tensions(fastkit, [0, 0, 1.2], "lp_min_sum")    # no tensions found
+    assert lp.binding == "tipping" and "tips a mobile base" in lp.message
+    assert distribute_tensions(fastkit, [0, 0, 1.2], "lp_min_sum", tipping=False).success
+    high = distribute_tensions(fastkit, [0, 0, 2.35])
+    assert high.binding == "limits" and not high.within_limits.all()
+    assert "leave the cable limits" in high.message
+    ok = distribute_tensions(fastkit, [0, 0, 0.6])
+    assert ok.success and ok.binding == "" and ok.message.startswith("wrench-feasible")
+    batch = distribute_tensions(fastkit, [[0, 0, 0.6], [0, 0, 1.2]])
+    assert batch.binding.tolist() == ["", "tipping"] and batch.message.startswith("1 of 2 ")
+
+
+def test_tipping_per_base(fastkit, ipanema):
+    P = [[0, 0, 1.2], [0, 0, 0.6]]
+    tip = tipping_moments(fastkit, P, distribute_tensions(fastkit, P, tipping=False).tensions)
+    for k in range(len(fastkit.bases)):
+        sel = fastkit.edge_base == k
+        np.testing.assert_array_equal(tip.base_moment[:, k], tip.moments[:, sel].max(axis=1))
+    assert tip.base_stable.tolist() == [[False, False], [True, True]]
+    np.testing.assert_array_equal(tip.base_stable.all(axis=1), tip.stable)
+    fixed = tipping_moments(ipanema, [0, 0, 1.5], ipanema.t_min)
+    assert np.all(fixed.base_moment == -np.inf) and fixed.base_stable.all()

@@ -89,7 +89,7 @@ def test_cli_tensions_table(capsys):
 
 def test_cli_wrench_set(capsys):
     assert main(["cdpr", "wrench-set", "fastkit", "--pose", "0", "0", "0.6", "--json",
-                 "--disturbance", "2", "2", "2", "0.1", "0.1", "0.1"]) == 0
+                 "--external-wrench", "2", "2", "2", "0.1", "0.1", "0.1"]) == 0
     out = json.loads(capsys.readouterr().out)
     a, b = out["tension_limits_only"], out["with_tipping"]
     for k in a["capacity_positive"]:
@@ -115,8 +115,8 @@ def test_axis_capacity_figure(tmp_path, fastkit):
     from taut.cdpr import axis_capacities
     from taut.viz.cdpr import plot_axis_capacities
     pose = [0, 0, 0.6]
-    fig = plot_axis_capacities(axis_capacities(fastkit, pose, False),
-                               axis_capacities(fastkit, pose, True), tmp_path / "cap.png")
+    fig = plot_axis_capacities(axis_capacities(fastkit, pose, tipping=False),
+                               axis_capacities(fastkit, pose, tipping=True), tmp_path / "cap.png")
     assert (tmp_path / "cap.png").stat().st_size > 5_000
     assert len(fig.axes) == 2
 

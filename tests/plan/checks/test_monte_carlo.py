@@ -4,6 +4,7 @@ simulation and what it counts."""
 import pytest
 
 from taut.plan import _tol
+from taut.plan import plan_robustness
 from taut.plan.checks.robustness import replay
 
 from ..test_plan import EXAMPLES
@@ -37,17 +38,17 @@ def test_a_robot_pushed_into_a_wall_is_a_collision_and_a_pair_pulled_apart_a_tea
 
 def test_probabilities_follow_the_margins(paper_corridor_plan):
     sc, r = paper_corridor_plan
-    small = r.robustness(0.005, 10, seed=2)       # the default 5 mm position accuracy
+    small = plan_robustness(r, 0.005, 10, seed=2)       # the default 5 mm position accuracy
     assert small.tear_probability == 0.0 and small.worst_extension < 0
     assert small.failure_probability == 0.0 and small.collision_probability == 0.0
     # The plan holds the object exactly the height safety above the obstacles, so noise
     # makes it unsafe (below the safety) in most trials without any contact.
     assert small.unsafe_probability > 0.5 and small.contact_probability == 0.0
     assert 0 < small.worst_height_margin < sc.team.height_safety
-    big = r.robustness(0.2, 10, seed=2)
+    big = plan_robustness(r, 0.2, 10, seed=2)
     assert big.tear_probability > 0.5 and big.failure_probability >= big.tear_probability
     # 4 cm at every sample squeezes the compact formation until the object is lost.
-    assert r.robustness(0.04, 5, seed=2).drop_probability > 0
+    assert plan_robustness(r, 0.04, 5, seed=2).drop_probability > 0
 
 
 def test_cli_reports_margins_and_robustness(capsys):

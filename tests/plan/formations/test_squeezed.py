@@ -1,4 +1,4 @@
-"""Squeezed formations (taut.plan.formations.squeezed): narrower than the narrowest all-taut formation,
+"""Squeezed formations (taut.plan.formations._squeezed): narrower than the narrowest all-taut formation,
 checked independently of the optimiser with forward kinematics and shapely."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from shapely.geometry import MultiPoint, Point
 
 from taut.errors import InvalidInputError
 from taut.plan import formation_library, generate_scenario
-from taut.plan.formations.squeezed import squeezed_formation
+from taut.plan.formations._squeezed import squeezed_formation
 from taut.sheet import forward_kinematics
 
 SHEET_MARGIN = 0.01
@@ -33,7 +33,7 @@ def _team(index):
 
 @functools.lru_cache(maxsize=None)
 def _narrow(index):
-    _, others, _ = formation_library(_scenario(index), SHEET_MARGIN)
+    _, others, _ = formation_library(_scenario(index), sheet_margin=SHEET_MARGIN)
     return next(f for f in others if f.kind == "narrow")
 
 
@@ -47,7 +47,7 @@ def _check(team, f, inset):
     """Every requirement, from forward kinematics and shapely alone; returns the inset and
     height margins (m)."""
     assert f.kind == "squeezed" and not f.robots.flags.writeable
-    stable = forward_kinematics(team.sheet, f.robots, team.hold_height).stable
+    stable = forward_kinematics(team.carrier, f.robots).stable
     assert len(stable) == 1, [e.taut for e in stable]
     e = stable[0]
     np.testing.assert_allclose(e.object, [0.0, 0.0, f.object_height], rtol=0, atol=1e-6)
@@ -138,13 +138,13 @@ def test_squeezed_state_survives_position_error(index):
     the design (the design asks 5 cm on its own 12 draws)."""
     team = _team(index)
     f = squeezed_formation(team, sheet_margin=SHEET_MARGIN, width=NEEDED.get(index, 1.0))
-    e0 = forward_kinematics(team.sheet, f.robots, team.hold_height).stable[0]
+    e0 = forward_kinematics(team.carrier, f.robots).stable[0]
     rng = np.random.default_rng(777)
     for _ in range(40):
         r = 0.005 * np.sqrt(rng.uniform(0, 1, team.n))
         a = rng.uniform(0, 2 * np.pi, team.n)
         P = f.robots + np.column_stack([r * np.cos(a), r * np.sin(a)])
-        stable = forward_kinematics(team.sheet, P, team.hold_height).stable
+        stable = forward_kinematics(team.carrier, P).stable
         assert stable
         e = min(stable, key=lambda e: np.linalg.norm(e.object - e0.object))
         assert np.linalg.norm(e.object - e0.object) <= 0.10
@@ -161,7 +161,7 @@ def test_library_refuses_a_crossing_formation_that_loses_the_object():
     from taut.plan import optimal_formation
     from taut.plan.formations.library import _robust
     sc = generate_scenario(2042, 3)
-    _, others, notes = formation_library(sc, SHEET_MARGIN)
+    _, others, notes = formation_library(sc, sheet_margin=SHEET_MARGIN)
     assert all(f.object_height < 0.2 for f in others)
     assert any("'o2' (0.178 m tall) cannot be crossed" in n and "loses it" in n for n in notes)
     flat = optimal_formation(sc.team, kind="crossing", height=0.178, diameter=0.2,
@@ -174,6 +174,6 @@ def test_library_refuses_a_crossing_formation_that_loses_the_object():
         r = 0.005 * np.sqrt(rng.uniform(0, 1, 3))
         a = rng.uniform(0, 2 * np.pi, 3)
         P = flat.robots + np.column_stack([r * np.cos(a), r * np.sin(a)])
-        lost += not forward_kinematics(sc.team.sheet, P, sc.team.hold_height).stable
+        lost += not forward_kinematics(sc.team.carrier, P).stable
     assert 0 < lost < 60
     assert _robust(sc.team, others[0])

@@ -11,7 +11,7 @@ from taut.plan.se2 import _lattice
 from taut.plan import _tol
 from taut.plan._kernels.lattice import OFFSETS
 from taut.plan._kernels.clearance import morph_clear
-from taut.plan.se2.space import PoseChecker
+from taut.plan.se2._space import PoseChecker
 
 from ..test_plan import corridor_team
 
@@ -24,7 +24,7 @@ def small():
                    [2.3, 0.5], [2.3, 0.7], [0, 0.7]],
                   (Obstacle("post", 0.1, center=[1.3, 0.05], radius=0.08),))
     sc = Scenario(world, corridor_team(), [0.6, 0.0], [3.1, -0.1])
-    compact, others, _ = formation_library(sc, 0.01)
+    compact, others, _ = formation_library(sc, sheet_margin=0.01)
     forms = [compact, others[0]]
     return sc, forms, [PoseChecker(sc, f, allow_crossing=True) for f in forms]
 

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from taut.sheet import FKSolver, Sheet
 from taut.sheet import random_convex_polygon, random_scattered_team, random_team
+from taut.sheet import SheetTeam
 from taut.sheet._tol import BACKEND_RTOL, BACKEND_WEIGHT_TOL
 
 pytest.importorskip("numba")
@@ -109,15 +110,15 @@ def _shrunk_copy(V, rng, scale, noise):
 
 
 def assert_same(a, b, size):
-    """Same taut sets and statuses, in the same order; equilibria (stable, saddle) at the
+    """Same taut sets and kinds, in the same order; equilibria (stable, saddle) at the
     same place within ``BACKEND_RTOL`` of the sheet size with the same load shares (within
     ``BACKEND_WEIGHT_TOL``). Non-equilibria near Lemma 2 can have weights ~1e5 (their
     systems' condition number), where rounding differences are amplified by that much:
     only their positions are compared, with a tolerance growing with the largest weight
     and ten times the equilibria's (near_copy seed 601, n 8, hold 0.3: weights 3.5e4,
     positions 1.1e-9 x weight x size apart)."""
-    sig_a = [(e.taut, e.status) for e in a.equilibria]
-    sig_b = [(e.taut, e.status) for e in b.equilibria]
+    sig_a = [(e.taut, e.kind) for e in a.equilibria]
+    sig_b = [(e.taut, e.kind) for e in b.equilibria]
     assert sig_a == sig_b
     worst = 0.0
     for ea, eb in zip(a.equilibria, b.equilibria):
@@ -142,10 +143,11 @@ def assert_same(a, b, size):
 def compare(kind, seed, n, hold_ratio, method="fast"):
     sheet, R = make_team(kind, seed, n)
     hold = hold_ratio * sheet.size
-    compiled = FKSolver(sheet, hold, method=method, backend="numba")
-    numpy_ = FKSolver(sheet, hold, method=method, backend="numpy")
-    a = compiled.solve(R, mass=1.5)
-    b = numpy_.solve(R, mass=1.5)
+    team = SheetTeam(sheet, hold, mass=1.5)
+    compiled = FKSolver(team, method=method, backend="numba")
+    numpy_ = FKSolver(team, method=method, backend="numpy")
+    a = compiled.solve(R)
+    b = numpy_.solve(R)
     assert_same(a, b, sheet.size)
     return a
 
@@ -193,8 +195,9 @@ def test_fast_equals_subsets_next_to_a_similar_copy(seed, n):
     the sheet size, formation 1e-10 from a similar copy). Both now answer the copy."""
     sheet, R = make_team("near_copy", seed, n)
     hold = 2.0 * sheet.size
-    fast = FKSolver(sheet, hold, method="fast").solve(R, mass=1.0)
-    subsets = FKSolver(sheet, hold, method="subsets").solve(R, mass=1.0)
+    team = SheetTeam(sheet, hold, mass=1.0)
+    fast = FKSolver(team, method="fast").solve(R)
+    subsets = FKSolver(team, method="subsets").solve(R)
     assert fast.stable
     assert_same(fast, subsets, sheet.size)
 
@@ -207,18 +210,18 @@ def test_compiled_batch_equals_numpy_batch(kind, seed, n, batch):
     rng = np.random.default_rng(seed)
     forms = R[None] * rng.uniform(0.97, 1.0, (batch, 1, 1))
     hold = 1.5 * sheet.size
-    a = FKSolver(sheet, hold, backend="numba").solve_batch(forms, mass=2.0)
-    b = FKSolver(sheet, hold, backend="numpy").solve_batch(forms, mass=2.0)
+    team = SheetTeam(sheet, hold, mass=2.0)
+    a = FKSolver(team, backend="numba").solve_batch(forms)
+    b = FKSolver(team, backend="numpy").solve_batch(forms)
     np.testing.assert_array_equal(a.count, b.count)
     np.testing.assert_array_equal(a.taut, b.taut)
-    np.testing.assert_array_equal(a.status, b.status)
-    eq = (a.status == 0) | (a.status == 1)
+    np.testing.assert_array_equal(a.kind, b.kind)
+    eq = (a.kind == 0) | (a.kind == 1)
     np.testing.assert_allclose(a.object[eq], b.object[eq], rtol=0, atol=1e-9 * sheet.size)
     np.testing.assert_allclose(a.weights[eq], b.weights[eq], rtol=0, atol=1e-7)
     for k in range(batch):
         assert_same(a.result(k), b.result(k), sheet.size)
-        assert_same(a.result(k), FKSolver(sheet, hold, backend="numba").solve(forms[k], mass=2.0),
-                    sheet.size)
+        assert_same(a.result(k), FKSolver(team, backend="numba").solve(forms[k]), sheet.size)
 
 
 def test_degenerate_kinds_reach_their_special_cases():
@@ -239,7 +242,7 @@ def test_degenerate_kinds_reach_their_special_cases():
 def test_similar_fit_equals_similar_copy(kind, seed, n, mirror):
     """The compiled snap screen (closed-form 2-D Procrustes) matches the SVD fit."""
     from taut.sheet._kernels import small as sk
-    from taut.sheet.fk.forward import similar_copy
+    from taut.sheet.fk._similar import similar_copy
 
     if kind in ("collinear_robots", "coincident"):
         kind = "convex"      # (nearly) singular cross-covariance: rotation vs reflection is noise
@@ -267,7 +270,7 @@ def test_kernel_is_cached_on_disk_and_cache_dir_falls_back(monkeypatch, tmp_path
     from taut.sheet._kernels import small as _small_kernel
 
     sheet = Sheet.regular(4, 1.0)
-    FKSolver(sheet, 1.0).solve(0.8 * sheet.vertices)
+    FKSolver(SheetTeam(sheet, 1.0)).solve(0.8 * sheet.vertices)
     where = (os.environ.get("NUMBA_CACHE_DIR")
              or os.path.join(os.path.dirname(_small_kernel.__file__), "__pycache__"))
     index = [f for _, _, files in os.walk(where) for f in files

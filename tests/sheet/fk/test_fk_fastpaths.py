@@ -7,11 +7,12 @@ from hypothesis import strategies as st
 
 from taut.errors import InfeasibleFormationError
 from taut.sheet import Sheet, _lifted as _kernel, forward_kinematics, forward_kinematics_batch
-from taut.sheet.fk import forward as fk
+from taut.sheet.fk import _numpy as fk_numpy, _solve as fk_solve
 from taut.sheet.fk._candidates import hull_candidates, padded_small_subsets
 from taut.sheet._lifted import Frame, reduced_hessian_min_eig, solve_candidates, solve_table
 from taut.sheet import check_formation
 from taut.sheet import random_scattered_team, random_team
+from taut.sheet import SheetTeam
 
 SETTINGS = settings(max_examples=30, deadline=None)
 
@@ -22,7 +23,7 @@ def team(seed, n):
 
 
 def signature(result):
-    return [(e.taut, e.status) for e in result.equilibria]
+    return [(e.taut, e.kind) for e in result.equilibria]
 
 
 @SETTINGS
@@ -71,13 +72,13 @@ def test_fast_equals_subsets_in_output_order(seed, n):
     """N <= 8 uses the subset table, larger teams the hull; both give the same list."""
     sheet, formation = team(seed, n)
     hold = 1.5 * sheet.size
-    fast = forward_kinematics(sheet, formation, hold, mass=1.0)
-    subsets = forward_kinematics(sheet, formation, hold, mass=1.0, method="subsets")
+    fast = forward_kinematics(SheetTeam(sheet, hold, mass=1.0), formation)
+    subsets = forward_kinematics(SheetTeam(sheet, hold, mass=1.0), formation, method="subsets")
     assert signature(fast) == signature(subsets)
     for x, y in zip(fast.equilibria, subsets.equilibria):
         np.testing.assert_allclose(x.object, y.object, atol=1e-9 * sheet.size)
         if x.tensions is None or y.tensions is None:
-            assert x.tensions is None and y.tensions is None and x.status == "not_equilibrium"
+            assert x.tensions is None and y.tensions is None and x.kind == "not_equilibrium"
         else:
             np.testing.assert_allclose(x.tensions, y.tensions, rtol=1e-6, atol=1e-9)
 
@@ -88,33 +89,34 @@ def test_batch_blocks_do_not_change_results(monkeypatch):
     forms = formation[None] + rng.normal(scale=2e-3 * sheet.size, size=(40, 6, 2))
     d = np.linalg.norm(forms[:, :, None] - forms[:, None], axis=3)
     forms = forms[np.all(d <= sheet.side_lengths(), axis=(1, 2))]
-    whole = forward_kinematics_batch(sheet, forms, 2.0 * sheet.size)
-    monkeypatch.setattr(fk, "TABLE_BLOCK", 7 * len(padded_small_subsets(6, False)))
-    blocks = forward_kinematics_batch(sheet, forms, 2.0 * sheet.size)
+    whole = forward_kinematics_batch(SheetTeam(sheet, 2.0 * sheet.size), forms)
+    monkeypatch.setattr(fk_solve, "TABLE_BLOCK", 7 * len(padded_small_subsets(6, False)))
+    blocks = forward_kinematics_batch(SheetTeam(sheet, 2.0 * sheet.size), forms)
     np.testing.assert_array_equal(whole.count, blocks.count)
     np.testing.assert_array_equal(whole.taut, blocks.taut)
-    np.testing.assert_array_equal(whole.status, blocks.status)
+    np.testing.assert_array_equal(whole.kind, blocks.kind)
     np.testing.assert_allclose(whole.object, blocks.object, equal_nan=True)
 
 
 def test_formation_check_fast_path_matches_model_check():
     sheet = Sheet.regular(5, 1.0)
     exact = sheet.vertices.copy()                      # every pair exactly at its limit
-    np.testing.assert_array_equal(fk._formations(sheet, exact, "formation", True)[0],
+    np.testing.assert_array_equal(fk_numpy._formations(sheet, exact, "formation", True)[0][0],
                                   check_formation(sheet, exact))
     inside = 0.9 * exact
-    np.testing.assert_array_equal(fk._formations(sheet, inside, "formation", True)[0], inside)
+    np.testing.assert_array_equal(fk_numpy._formations(sheet, inside, "formation", True)[0][0],
+                                  inside)
     torn = exact.copy()
     torn[0] *= 1.01
     with pytest.raises(InfeasibleFormationError) as fast_err:
-        forward_kinematics(sheet, torn, 1.0)
+        forward_kinematics(SheetTeam(sheet, 1.0), torn)
     with pytest.raises(InfeasibleFormationError) as model_err:
         check_formation(sheet, torn)
     assert fast_err.value.pair == model_err.value.pair
     assert str(fast_err.value) == str(model_err.value)
-    with pytest.raises(InfeasibleFormationError) as batch_err:
-        forward_kinematics_batch(sheet, np.stack([inside, torn]), 1.0)
-    assert batch_err.value.step == 1
+    batch = forward_kinematics_batch(SheetTeam(sheet, 1.0), np.stack([inside, torn]))
+    assert batch.feasible.tolist() == [True, False] and batch.count[1] == 0
+    assert model_err.value.problem in batch.message
 
 
 def test_per_size_systems_with_collinear_vertices(monkeypatch):
@@ -123,11 +125,11 @@ def test_per_size_systems_with_collinear_vertices(monkeypatch):
     assert sheet.has_collinear_vertices
     rng = np.random.default_rng(4)
     forms = 0.9 * sheet.vertices[None] + rng.normal(scale=0.01, size=(30, 5, 2))
-    whole = forward_kinematics_batch(sheet, forms, 1.5)
+    whole = forward_kinematics_batch(SheetTeam(sheet, 1.5), forms)
     monkeypatch.setattr(_kernel, "PER_SIZE_MIN", 0)
-    split = forward_kinematics_batch(sheet, forms, 1.5)
+    split = forward_kinematics_batch(SheetTeam(sheet, 1.5), forms)
     np.testing.assert_array_equal(whole.taut, split.taut)
-    np.testing.assert_array_equal(whole.status, split.status)
+    np.testing.assert_array_equal(whole.kind, split.kind)
     np.testing.assert_allclose(whole.object, split.object, equal_nan=True, atol=1e-12)
-    single = [signature(forward_kinematics(sheet, f, 1.5)) for f in forms]
+    single = [signature(forward_kinematics(SheetTeam(sheet, 1.5), f)) for f in forms]
     assert single == [signature(split.result(b)) for b in range(len(forms))]

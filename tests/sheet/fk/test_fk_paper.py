@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from taut.sheet import GRAVITY, Sheet, forward_kinematics
+from taut.sheet import SheetTeam
 
 # Table III of the FK paper (Example 2, r2 and r4 at +-353 mm): taut set (1-based),
 # v_o (mm), p_o (mm).
@@ -18,8 +19,8 @@ TABLE_III = [
 
 
 def solve(example, method="fast", mass=None):
-    return forward_kinematics(Sheet(example["Vn_mm"]), np.array(example["Rn_mm"]),
-                              example["zr_mm"], method=method, mass=mass)
+    return forward_kinematics(SheetTeam(Sheet(example["Vn_mm"]), example["zr_mm"], mass=mass),
+                              np.array(example["Rn_mm"]), method=method)
 
 
 def as_table(result):
@@ -64,11 +65,11 @@ def test_example3_funnel_up_to_one_borderline_set(reference):
     assert r.funnel.force_closure == 8
 
 
-def test_example1_statuses(reference):
+def test_example1_kinds(reference):
     """Three paper solutions; {1,2,3,4} passes the paper's test but is no equilibrium."""
     r = solve(reference["example1"])
-    status = {t: e.status for t, e in as_table(r).items()}
-    assert status == {(1, 2, 3): "stable", (1, 3, 4): "stable",
+    kinds = {t: e.kind for t, e in as_table(r).items()}
+    assert kinds == {(1, 2, 3): "stable", (1, 3, 4): "stable",
                       (1, 2, 3, 4): "not_equilibrium"}
     w = as_table(r)[(1, 2, 3, 4)].weights
     np.testing.assert_allclose(w, [1.03, -0.48, 0.95, -0.51], atol=0.01)   # docs/sheet_kinematics.md §3
@@ -120,7 +121,7 @@ def test_table_v(reference, name, taut):
         assert tuple(i + 1 for i in e.taut) == taut
         np.testing.assert_allclose(e.object, [0, 0, 1000 - np.sqrt(900**2 - 500**2)], atol=1e-6)
         np.testing.assert_allclose(e.contact, [0, 0], atol=1e-6)
-        assert e.status == "stable"
+        assert e.kind == "stable"
         np.testing.assert_allclose(e.weights.sum(), 1.0)
         assert np.all(e.weights >= 0)
 
@@ -132,7 +133,7 @@ def test_lemma2_regular_polygons(n):
     sheet = Sheet.regular(n, rs, phase=0.3)
     t = 0.3 + 2 * np.pi * np.arange(n) / n
     formation = rf * np.column_stack([np.cos(t), np.sin(t)])
-    r = forward_kinematics(sheet, formation, zr, mass=2.0)
+    r = forward_kinematics(SheetTeam(sheet, zr, mass=2.0), formation)
     assert len(r.equilibria) == 1
     e = r.equilibria[0]
     assert e.taut == tuple(range(n))
@@ -160,7 +161,7 @@ def test_tensions_balance_the_weight(reference, name):
         slack = np.setdiff1d(np.arange(len(R)), taut)
         assert np.all(span[slack] < cable[slack])
         np.testing.assert_allclose(e.cable_lengths, cable[taut], rtol=1e-12)
-        if e.status == "not_equilibrium":
+        if e.kind == "not_equilibrium":
             continue
         unit = (p[taut] - e.object) / span[taut, None]
         force = (e.tensions[:, None] * unit).sum(axis=0)

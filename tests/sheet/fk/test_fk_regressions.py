@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from taut.sheet import Sheet, forward_kinematics
-from taut.sheet.fk import forward as fk_module
+from taut.sheet.fk import _solve as fk_module
 from taut.sheet import forward_kinematics_batch
-from taut.sheet.fk.forward import similar_copy
+from taut.sheet import SheetTeam
+from taut.sheet.fk._similar import similar_copy
 
 DATA = Path(__file__).parents[2] / "data"
 
@@ -22,8 +23,9 @@ def test_nearly_coplanar_upper_facets(monkeypatch, small_team):
     monkeypatch.setattr(fk_module, "SMALL_TEAM", small_team)
     case = json.loads((DATA / "fk_coplanar_facets_case.json").read_text())
     sheet, formation = Sheet(case["sheet"]), np.array(case["formation"])
-    fast = forward_kinematics(sheet, formation, case["hold_height"])
-    exhaustive = forward_kinematics(sheet, formation, case["hold_height"], method="exhaustive")
+    fast = forward_kinematics(SheetTeam(sheet, case["hold_height"]), formation)
+    exhaustive = forward_kinematics(SheetTeam(sheet, case["hold_height"]), formation,
+                                    method="exhaustive")
     assert [e.taut for e in fast.equilibria] == [e.taut for e in exhaustive.equilibria]
     assert (1, 2, 5) in [e.taut for e in fast.equilibria]
 
@@ -34,8 +36,8 @@ def test_state_at_a_taut_set_change_stays_an_equilibrium():
     case = json.loads((DATA / "fk_transition_case.json").read_text())
     sheet, formation = Sheet(case["sheet"]), np.array(case["formation"])
     for method in ("fast", "subsets", "exhaustive"):
-        r = forward_kinematics(sheet, formation, case["hold_height"], method=method)
-        assert [(e.taut, e.status) for e in r.equilibria] == [((1, 2, 5, 6), "stable")]
+        r = forward_kinematics(SheetTeam(sheet, case["hold_height"]), formation, method=method)
+        assert [(e.taut, e.kind) for e in r.equilibria] == [((1, 2, 5, 6), "stable")]
 
 
 def test_formation_within_1e_10_of_a_scaled_sheet_keeps_its_rest_state():
@@ -48,13 +50,13 @@ def test_formation_within_1e_10_of_a_scaled_sheet_keeps_its_rest_state():
     n, h = 10, 3.0
     V = np.column_stack([np.cos(np.arange(n) * 2 * np.pi / n),
                          np.sin(np.arange(n) * 2 * np.pi / n)])
-    exact = forward_kinematics(Sheet(V), 0.7 * V, h).stable
+    exact = forward_kinematics(SheetTeam(Sheet(V), h), 0.7 * V).stable
     assert len(exact) == 1 and len(exact[0].taut) == n
     target = np.array([0.0, 0.0, h - np.sqrt(1 - 0.7 ** 2)])
     np.testing.assert_allclose(exact[0].object, target, atol=1e-12)
     for seed in range(60):
         R = 0.7 * V + np.random.default_rng(seed).normal(scale=3e-10, size=V.shape)
-        stable = forward_kinematics(Sheet(V), R, h).stable
+        stable = forward_kinematics(SheetTeam(Sheet(V), h), R).stable
         assert stable, seed
         for e in stable:
             assert np.linalg.norm(e.object - target) < 1e-7, (seed, e.object)
@@ -75,9 +77,9 @@ def test_near_similar_formations_are_solved_as_the_similar_copy(n, noise):
     target = np.array([2.0, -1.0, h - np.sqrt(1 - 0.6 ** 2)])
     rng = np.random.default_rng(n)
     forms = copy + rng.normal(scale=noise, size=(30, n, 2))
-    batch = forward_kinematics_batch(Sheet(V), forms, h)
+    batch = forward_kinematics_batch(SheetTeam(Sheet(V), h), forms)
     for b in range(len(forms)):
-        single = forward_kinematics(Sheet(V), forms[b], h)
+        single = forward_kinematics(SheetTeam(Sheet(V), h), forms[b])
         for res in (single, batch.result(b)):
             assert res.stable, (b, noise)
             for e in res.stable:
@@ -109,7 +111,7 @@ def test_dependent_taut_set_weights_do_not_depend_on_input_rounding():
     V, R = 900 * unit, 500 * unit
     R[0] = [450.0, 0.0]
     rounded = [np.round(a, 9) for a in (V, R)]
-    got = [forward_kinematics(Sheet(v), r, 1000.0).stable for v, r in ((V, R), rounded)]
+    got = [forward_kinematics(SheetTeam(Sheet(v), 1000.0), r).stable for v, r in ((V, R), rounded)]
     assert [e.taut for e in got[0]] == [e.taut for e in got[1]] == [(1, 2, 3, 4, 5, 6, 7)]
     np.testing.assert_allclose(got[1][0].weights, got[0][0].weights, atol=1e-9)
     # and they are the minimum-norm ones (mirror-symmetric about robot 5, which the

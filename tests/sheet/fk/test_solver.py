@@ -10,13 +10,14 @@ from taut.errors import InfeasibleFormationError, InvalidInputError
 from taut.sheet import FKSolver, Sheet, forward_kinematics, forward_kinematics_batch
 from taut.sheet.fk import solver
 from taut.sheet import random_team
+from taut.sheet import SheetTeam
 
 
 def two_stable_team():
     """A random team with two stable states (seed found by search, checked below)."""
     for seed in range(100):
         sheet, R = random_team(4, np.random.default_rng(seed))
-        res = forward_kinematics(sheet, R, 2.0 * sheet.size)
+        res = forward_kinematics(SheetTeam(sheet, 2.0 * sheet.size), R)
         if len(res.stable) >= 2:
             return sheet, R, res
     raise AssertionError("no team with two stable states")
@@ -27,9 +28,9 @@ def two_stable_team():
 def test_solve_equals_forward_kinematics(seed, n, check):
     sheet, R = random_team(n, np.random.default_rng(seed))
     hold = 1.5 * sheet.size
-    a = FKSolver(sheet, hold).solve(R, mass=3.0, check=check)
-    b = forward_kinematics(sheet, R, hold, mass=3.0)
-    assert [(e.taut, e.status) for e in a.equilibria] == [(e.taut, e.status) for e in b.equilibria]
+    a = FKSolver(SheetTeam(sheet, hold, mass=3.0)).solve(R, check=check)
+    b = forward_kinematics(SheetTeam(sheet, hold, mass=3.0), R)
+    assert [(e.taut, e.kind) for e in a.equilibria] == [(e.taut, e.kind) for e in b.equilibria]
     for x, y in zip(a.equilibria, b.equilibria):
         np.testing.assert_array_equal(x.object, y.object)
         np.testing.assert_array_equal(x.tensions, y.tensions)
@@ -39,9 +40,9 @@ def test_solve_equals_forward_kinematics(seed, n, check):
 def test_batch_rows_equal_single_solves():
     sheet, R, _ = two_stable_team()
     forms = np.stack([R, R * 0.98, R * 0.96])
-    s = FKSolver(sheet, 2.0 * sheet.size)
+    s = FKSolver(SheetTeam(sheet, 2.0 * sheet.size))
     batch = s.solve_batch(forms)
-    ref = forward_kinematics_batch(sheet, forms, 2.0 * sheet.size)
+    ref = forward_kinematics_batch(SheetTeam(sheet, 2.0 * sheet.size), forms)
     np.testing.assert_array_equal(batch.count, ref.count)
     for b in range(3):
         single = s.solve(forms[b])
@@ -55,12 +56,13 @@ def test_torn_formation_raises_with_the_usual_message(check):
     sheet = Sheet.regular(5, 1.0)
     R = sheet.vertices * 1.01
     with pytest.raises(InfeasibleFormationError, match="robots 1 and 2") as exc:
-        FKSolver(sheet, 1.0).solve(R, check=check)
+        FKSolver(SheetTeam(sheet, 1.0)).solve(R, check=check)
     assert exc.value.pair == (0, 1)
     bad = np.stack([0.9 * sheet.vertices, R])
-    with pytest.raises(InfeasibleFormationError) as exc:
-        FKSolver(sheet, 1.0).solve_batch(bad)
-    assert exc.value.step == 1
+    batch = FKSolver(SheetTeam(sheet, 1.0)).solve_batch(bad, check=check)
+    assert batch.feasible.tolist() == [True, False] and batch.count[1] == 0
+    assert batch.status.tolist() == ["ok", "infeasible"]
+    assert "formation 1: robots 1 and 2" in batch.message
 
 
 @pytest.mark.parametrize("formation, field", [
@@ -71,30 +73,32 @@ def test_torn_formation_raises_with_the_usual_message(check):
 def test_bad_formation_is_a_typed_error(formation, field):
     sheet = Sheet.regular(5, 1.0)
     with pytest.raises(InvalidInputError) as exc:
-        FKSolver(sheet, 1.0).solve(formation)
+        FKSolver(SheetTeam(sheet, 1.0)).solve(formation)
     assert exc.value.field == field
 
 
 def test_bad_solver_arguments():
     sheet = Sheet.regular(4, 1.0)
     with pytest.raises(InvalidInputError, match="backend"):
-        FKSolver(sheet, 1.0, backend="gpu")      # type: ignore[arg-type]
+        FKSolver(SheetTeam(sheet, 1.0), backend="gpu")      # type: ignore[arg-type]
     with pytest.raises(InvalidInputError, match="hold_height"):
-        FKSolver(sheet, -1.0)
+        FKSolver(SheetTeam(sheet, -1.0))
     with pytest.raises(InvalidInputError, match="method"):
-        FKSolver(sheet, 1.0, method="magic")     # type: ignore[arg-type]
+        FKSolver(SheetTeam(sheet, 1.0), method="magic")     # type: ignore[arg-type]
     with pytest.raises(InvalidInputError, match="mass"):
-        FKSolver(sheet, 1.0).solve(0.8 * sheet.vertices, mass=-1.0)
+        FKSolver(SheetTeam(sheet, 1.0, mass=-1.0))
+    with pytest.raises(InvalidInputError, match="team"):
+        FKSolver(sheet)                          # type: ignore[arg-type]
 
 
 def test_without_numba_auto_falls_back_and_numba_is_refused(monkeypatch):
     monkeypatch.setattr(solver, "HAVE_NUMBA", False)
     sheet = Sheet.regular(4, 1.0)
-    s = FKSolver(sheet, 1.0)
+    s = FKSolver(SheetTeam(sheet, 1.0))
     assert s.backend == "numpy"
     assert s.solve(0.8 * sheet.vertices).stable
     with pytest.raises(InvalidInputError, match="numba"):
-        FKSolver(sheet, 1.0, backend="numba")
+        FKSolver(SheetTeam(sheet, 1.0), backend="numba")
 
 
 def test_closest_stable_picks_the_nearest_state():
@@ -104,13 +108,13 @@ def test_closest_stable_picks_the_nearest_state():
         assert res.closest_stable(e.object[:2]) is e
     with pytest.raises(InvalidInputError, match="point"):
         res.closest_stable([1.0, 2.0, 3.0, 4.0])
-    flat = forward_kinematics(sheet, R, 1e-3 * sheet.size)   # too low: nothing hangs
+    flat = forward_kinematics(SheetTeam(sheet, 1e-3 * sheet.size), R)   # too low: nothing hangs
     assert flat.closest_stable([0, 0, 0]) is None
 
 
 def test_result_is_frozen_and_lazy_length_is_exact():
     sheet, R, _ = two_stable_team()
-    res = FKSolver(sheet, 2.0 * sheet.size).solve(R)
+    res = FKSolver(SheetTeam(sheet, 2.0 * sheet.size)).solve(R)
     n = len(res)
     assert n == len(res.equilibria) == len(res)
     with pytest.raises(AttributeError):

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from taut.sheet import FKSolver, Sheet
 from taut._jit import HAVE_NUMBA
 from taut.sheet import random_team
+from taut.sheet import SheetTeam
 
 pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
 
@@ -42,7 +43,7 @@ def test_solve_batch_equals_per_call_solve(seed, n, kind):
     from taut.sheet._kernels import small as sk
     rng = np.random.default_rng(seed)
     sheet, R = random_team(n, rng)
-    solver = FKSolver(sheet, float(rng.uniform(0.5, 2.0)) * sheet.size)
+    solver = FKSolver(SheetTeam(sheet, float(rng.uniform(0.5, 2.0)) * sheet.size, mass=2.0))
     forms = _batch(sheet, R, rng, kind)
     iu, ju = np.triu_indices(n, 1)
     d = np.linalg.norm(forms[:, iu] - forms[:, ju], axis=2)
@@ -54,19 +55,37 @@ def test_solve_batch_equals_per_call_solve(seed, n, kind):
     assert a[2] == b[2]
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[1], b[1])
-    batch = solver.solve_batch(forms, mass=2.0)
+    batch = solver.solve_batch(forms)
     for k in range(len(forms)):
-        one = solver.solve(forms[k], mass=2.0)
+        one = solver.solve(forms[k])
         got = batch.result(k).equilibria
-        assert [(e.taut, e.status) for e in got] == [(e.taut, e.status) for e in one.equilibria]
+        assert [(e.taut, e.kind) for e in got] == [(e.taut, e.kind) for e in one.equilibria]
         for x, y in zip(got, one.equilibria):
             np.testing.assert_allclose(x.object, y.object, rtol=0, atol=1e-12 * sheet.size)
             np.testing.assert_allclose(x.weights, y.weights, rtol=0, atol=1e-12)
 
 
-def test_batch_with_a_torn_formation_names_it():
-    from taut.errors import InfeasibleFormationError
-    sheet = Sheet.regular(4, 1.0)
-    forms = np.stack([0.9 * sheet.vertices, 1.01 * sheet.vertices])
-    with pytest.raises(InfeasibleFormationError):
-        FKSolver(sheet, 1.0).solve_batch(forms)
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+@pytest.mark.parametrize("n", [4, 14])
+def test_batch_with_a_torn_formation_flags_it(backend, n):
+    """A torn formation is flagged in its row; the others get their own answers."""
+    if backend == "numba" and not HAVE_NUMBA:
+        pytest.skip("numba is not installed")
+    sheet = Sheet.regular(n, 1.0)
+    forms = np.stack([0.9 * sheet.vertices, 1.01 * sheet.vertices, 0.8 * sheet.vertices])
+    solver = FKSolver(SheetTeam(sheet, 1.0, mass=2.0), backend=backend)
+    batch = solver.solve_batch(forms)
+    assert batch.feasible.tolist() == [True, False, True]
+    assert batch.success.tolist() == [True, False, True]
+    assert batch.status.tolist() == ["ok", "infeasible", "ok"] and batch.count[1] == 0
+    assert "1 infeasible" in batch.message and "formation 1: robots" in batch.message
+    for b in (0, 2):
+        one = solver.solve(forms[b])
+        got = batch.result(b)
+        assert [(e.taut, e.kind) for e in got.equilibria] == \
+            [(e.taut, e.kind) for e in one.equilibria]
+        for x, y in zip(got.equilibria, one.equilibria):
+            np.testing.assert_allclose(x.object, y.object, atol=1e-12)
+            np.testing.assert_allclose(x.tensions, y.tensions, rtol=1e-12)
+    everything_torn = solver.solve_batch(forms[1:2] * 1.1)
+    assert everything_torn.count.tolist() == [0] and not everything_torn.success[0]

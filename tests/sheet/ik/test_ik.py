@@ -14,11 +14,12 @@ from taut.sheet.ik._certificate import verify_certificate
 from taut.sheet import check_formation
 from taut.sheet import random_team
 from taut.sheet import GRAVITY
+from taut.sheet import SheetTeam
 
 
 def all_taut_stable_at(sheet, formation, z, target, contact=None, tol=1e-6, mass=None):
     """The FK equilibrium that is stable, has every cable taut and sits at the target."""
-    fk = forward_kinematics(sheet, formation, z, mass=mass)
+    fk = forward_kinematics(SheetTeam(sheet, z, mass=mass), formation)
     for e in fk.equilibria:
         if not (e.stable and len(e.taut) == sheet.n):
             continue
@@ -48,7 +49,7 @@ def fk_targets(seed, count, sizes):
     while len(out) < count:
         n = int(rng.choice(sizes))
         sheet, R = random_team(n, rng)
-        st_ = forward_kinematics(sheet, R, 1.0).stable
+        st_ = forward_kinematics(SheetTeam(sheet, 1.0), R).stable
         if st_:
             e = st_[int(rng.integers(len(st_)))]
             out.append((sheet, e.object, e.contact, R, len(e.taut)))
@@ -60,7 +61,7 @@ def test_round_trip_success_rate_n3_to_12():
     targets = fk_targets(7, 72, range(3, 13))
     ok = proved = 0
     for k, (sheet, p, vo, _, _) in enumerate(targets):
-        r = inverse_kinematics(sheet, p, 1.0, contact=vo, heading=0.37 * k)
+        r = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo, heading=0.37 * k)
         if not r.success:
             # Only targets proved unreachable may fail, each with a certificate that an
             # independent re-check confirms: 100 % of the rest are found.
@@ -87,19 +88,19 @@ def test_unreachable_target_is_proved_by_radial_spacing():
     sheet = Sheet(V)
     p = [0.2520437052874605, -0.3440197874546382, 0.32611031440979465]
     vo = [0.01905116787815906, 0.15351676460669145]
-    r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo)
     assert (r.success, r.status) == (False, "unreachable")
     assert r.certificate.kind == "radial_spacing" and r.certificate.pair == (0, 7)
     assert "robots 1 and 8 must stand" in r.message
     assert np.all(np.isnan(r.formation))
     assert_valid_certificate(sheet, np.array(p), np.array(vo), r.certificate)
     # Scale invariance: the same target in millimetres is just as unreachable.
-    mm = inverse_kinematics(Sheet(np.array(V) * 1000), np.array(p) * 1000, 1000.0,
+    mm = inverse_kinematics(SheetTeam(Sheet(np.array(V) * 1000), 1000.0), np.array(p) * 1000,
                             contact=np.array(vo) * 1000)
     assert mm.status == "unreachable" and "robots 1 and 8" in mm.message
     # A slightly higher object shrinks the gap below the edge length: no longer refuted
     # by this test (whatever the search then finds).
-    higher = inverse_kinematics(sheet, [p[0], p[1], 0.5], 1.0, contact=vo)
+    higher = inverse_kinematics(SheetTeam(sheet, 1.0), [p[0], p[1], 0.5], contact=vo)
     assert "robots 1 and 8 must stand" not in higher.message
 
 
@@ -108,7 +109,7 @@ def test_round_trip_is_exact_for_all_taut_targets():
     targets = [t for t in fk_targets(11, 60, [3, 4, 5]) if t[4] == t[0].n][:20]
     assert len(targets) >= 10
     for sheet, p, vo, _, _ in targets:
-        r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+        r = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo)
         e = all_taut_stable_at(sheet, r.formation, 1.0, p, vo)
         assert e is not None
         np.testing.assert_allclose(np.sort(e.weights), np.sort(r.weights[list(e.taut)]),
@@ -123,7 +124,7 @@ def test_default_contact_solution_or_typed_error(seed, n, depth, heading):
     sheet, _ = random_team(n, rng)
     target = np.array([rng.normal(), rng.normal(), 1.0 - depth * sheet.size])
     assume(target[2] > 0)
-    r = inverse_kinematics(sheet, target, 1.0, heading=heading, budget=3)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), target, heading=heading, budget=3)
     assert r.status in STATUSES and r.message
     if not r.success:
         assert r.status in ("unreachable", "budget_exhausted")
@@ -141,7 +142,7 @@ def test_default_contact_solution_or_typed_error(seed, n, depth, heading):
 def test_square_sheet_centroid_contact_is_symmetric():
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
     target = np.array([0.3, -0.2, 0.4])
-    r = inverse_kinematics(sheet, target, 1.0, mass=2.0)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0, mass=2.0), target)
     np.testing.assert_allclose(r.weights, 0.25, atol=1e-12)
     np.testing.assert_allclose(r.contact, [0, 0], atol=1e-12)
     rho = np.sqrt(2.0 - 0.6 ** 2)
@@ -155,8 +156,8 @@ def test_square_sheet_centroid_contact_is_symmetric():
 def test_heading_turns_the_formation_about_the_object():
     sheet = Sheet.regular(5, 1.0)
     target = np.array([0.2, 0.1, 0.55])
-    a = inverse_kinematics(sheet, target, 1.0, contact=[0.1, -0.05])
-    b = inverse_kinematics(sheet, target, 1.0, contact=[0.1, -0.05], heading=0.7)
+    a = inverse_kinematics(SheetTeam(sheet, 1.0), target, contact=[0.1, -0.05])
+    b = inverse_kinematics(SheetTeam(sheet, 1.0), target, contact=[0.1, -0.05], heading=0.7)
     c, s = np.cos(0.7), np.sin(0.7)
     rotated = (a.formation - target[:2]) @ np.array([[c, s], [-s, c]]) + target[:2]
     np.testing.assert_allclose(b.formation, rotated, atol=1e-9)
@@ -166,7 +167,7 @@ def test_heading_turns_the_formation_about_the_object():
 def test_three_robots_weights_are_barycentric_and_fixed_by_contact():
     sheet = Sheet([[0, 0], [2, 0], [0.5, 1.5]])
     vo = np.array([0.8, 0.5])
-    r = inverse_kinematics(sheet, [0, 0, 0.6], 1.0, contact=vo)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.6], contact=vo)
     np.testing.assert_allclose(r.weights @ sheet.vertices, vo, atol=1e-12)
     np.testing.assert_allclose(contact_weights(sheet, vo), r.weights, atol=1e-12)
     assert r.curvature > 0
@@ -174,8 +175,8 @@ def test_three_robots_weights_are_barycentric_and_fixed_by_contact():
 
 def test_reference_keeps_robots_close():
     for sheet, p, vo, R, _ in fk_targets(3, 6, [4, 5, 6]):
-        free = inverse_kinematics(sheet, p, 1.0, contact=vo)
-        near = inverse_kinematics(sheet, p, 1.0, contact=vo, reference=R)
+        free = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo)
+        near = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo, reference=R)
         if not (free.success and near.success):
             continue
         assert np.sum((near.formation - R) ** 2) <= np.sum((free.formation - R) ** 2) + 1e-9
@@ -185,25 +186,25 @@ def test_reference_keeps_robots_close():
 def test_angle_parameterisation_matches_ik_and_its_constraints():
     sheet = Sheet.regular(6, 1.0, phase=0.2)
     target = np.array([0.0, 0.0, 0.5])
-    r = inverse_kinematics(sheet, target, 1.0)
-    R = formation_from_angles(sheet, target, 1.0, r.angles)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), target)
+    R = formation_from_angles(SheetTeam(sheet, 1.0), target, r.angles)
     np.testing.assert_allclose(R, r.formation, atol=1e-12)
-    c = ik_constraints(sheet, target, 1.0, r.angles, r.weights)
+    c = ik_constraints(SheetTeam(sheet, 1.0), target, r.angles, r.weights)
     assert bool(c.feasible)
     assert np.abs(c.balance).max() < 1e-12 and c.spacing.min() >= 0
     # Batched angles; turning one cable breaks the horizontal balance.
     th = np.stack([r.angles, r.angles + np.eye(6)[0] * 0.3])
-    cb = ik_constraints(sheet, target, 1.0, th, r.weights)
+    cb = ik_constraints(SheetTeam(sheet, 1.0), target, th, r.weights)
     assert cb.feasible.tolist() == [True, False]
     assert np.linalg.norm(cb.balance[1]) > 1e-3
     # Default weights: the least-squares ones, exact when a balance exists.
-    assert bool(ik_constraints(sheet, target, 1.0, r.angles).feasible)
+    assert bool(ik_constraints(SheetTeam(sheet, 1.0), target, r.angles).feasible)
 
 
 def test_angle_constraints_flag_torn_sheet():
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
     th = np.radians([45, 50, 225, 230])          # robots 1, 2 pulled to the same side
-    c = ik_constraints(sheet, [0, 0, 0.9], 1.0, th, np.full(4, 0.25))
+    c = ik_constraints(SheetTeam(sheet, 1.0), [0, 0, 0.9], th, np.full(4, 0.25))
     assert not bool(c.feasible)
 
 
@@ -215,7 +216,7 @@ def test_unreachable_targets_say_why(kwargs, kind, words):
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
     args = dict(hold_height=1.0) | kwargs
     p, z = np.array(args.pop("object_position"), float), args.pop("hold_height")
-    r = inverse_kinematics(sheet, p, z, **args)
+    r = inverse_kinematics(SheetTeam(sheet, z), p, **args)
     assert (r.success, r.status, r.certificate.kind) == (False, "unreachable", kind)
     assert words in r.message
     assert_valid_certificate(sheet, p, r.contact, r.certificate, z=z)
@@ -228,21 +229,21 @@ def test_unreachable_targets_say_why(kwargs, kind, words):
 ])
 def test_malformed_targets_raise(kwargs, field, words):
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
-    args = dict(hold_height=1.0) | kwargs
+    team = SheetTeam(sheet, 1.0)
     with pytest.raises(InvalidInputError) as exc:
-        inverse_kinematics(sheet, args.pop("object_position"), args.pop("hold_height"), **args)
+        inverse_kinematics(team, kwargs.pop("object_position"), **kwargs)
     assert exc.value.field == field and words in exc.value.problem
 
 
 def test_three_robots_contact_near_vertex_cannot_balance():
     sheet = Sheet([[0, 0], [2, 0], [0.5, 1.5]])
-    r = inverse_kinematics(sheet, [0, 0, 0.5], 1.0, contact=[0.6, 0.05])
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.5], contact=[0.6, 0.05])
     assert r.status == "unreachable" and r.certificate.kind == "triangle"
     assert "no stable all-taut formation" in r.message
     assert "cable 2 would pull sideways harder than the other two" in r.message
     assert_valid_certificate(sheet, np.array([0, 0, 0.5]), np.array([0.6, 0.05]),
                              r.certificate)
-    r = inverse_kinematics(sheet, [0, 0, 0.95], 1.0, contact=[1.2, 0.1])  # shallow
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.95], contact=[1.2, 0.1])  # shallow
     assert r.status == "unreachable" and r.certificate.kind == "triangle"
     assert "farther apart than the sheet allows" in r.message
 
@@ -258,15 +259,16 @@ def test_three_robots_contact_near_vertex_cannot_balance():
 ])
 def test_bad_inputs_raise_typed_errors(kwargs, field):
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
-    args = dict(object_position=[0, 0, 0.5], hold_height=1.0) | kwargs
+    args = dict(object_position=[0, 0, 0.5], hold_height=1.0, mass=None) | kwargs
     with pytest.raises(InvalidInputError) as exc:
-        inverse_kinematics(sheet, args.pop("object_position"), args.pop("hold_height"), **args)
+        team = SheetTeam(sheet, args.pop("hold_height"), mass=args.pop("mass"))
+        inverse_kinematics(team, args.pop("object_position"), **args)
     assert exc.value.field == field
 
 
 def test_angles_of_wrong_length():
     with pytest.raises(InvalidInputError) as exc:
-        formation_from_angles(Sheet.regular(4, 1.0), [0, 0, 0.5], 1.0, [0.0, 1.0])
+        formation_from_angles(SheetTeam(Sheet.regular(4, 1.0), 1.0), [0, 0, 0.5], [0.0, 1.0])
     assert exc.value.field == "angles"
 
 
@@ -291,7 +293,7 @@ def test_boundary_target_with_a_pair_at_exactly_its_sheet_distance():
     inequality) and, being feasible, equality: the pair is at its limit in all of them."""
     V, F = BOUNDARY_SHEET, BOUNDARY_FORMATION
     sheet = Sheet(V)
-    state = [e for e in forward_kinematics(sheet, F, 1.0).stable if len(e.taut) == 5]
+    state = [e for e in forward_kinematics(SheetTeam(sheet, 1.0), F).stable if len(e.taut) == 5]
     assert len(state) == 1
     p, vo = state[0].object, state[0].contact
     Vn = np.array(V)
@@ -299,7 +301,7 @@ def test_boundary_target_with_a_pair_at_exactly_its_sheet_distance():
     rho = np.sqrt(lengths ** 2 - (1.0 - p[2]) ** 2)
     edge = np.linalg.norm(Vn[2] - Vn[3])
     assert abs(abs(rho[3] - rho[2]) - edge) < 1e-12 * sheet.size        # the tight bound
-    r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo)
     assert r.success, r.message
     assert abs(np.linalg.norm(r.formation[2] - r.formation[3]) - edge) < 1e-9
     assert r.spacing == pytest.approx(0.0, abs=1e-9)
@@ -311,22 +313,22 @@ def test_result_convention_and_budget():
     """Outcome fields on success and failure; a zero budget on a target that needs the
     search reports budget_exhausted (what was tried), never a false 'unreachable'."""
     sheet = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
-    ok = inverse_kinematics(sheet, [0, 0, 0.5], 1.0)
+    ok = inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.5])
     assert (ok.success, ok.status, ok.certificate) == (True, "ok", None) and ok.message
     V, F = BOUNDARY_SHEET, BOUNDARY_FORMATION
-    e = [q for q in forward_kinematics(Sheet(V), F, 1.0).stable if len(q.taut) == 5][0]
-    r = inverse_kinematics(Sheet(V), e.object, 1.0, contact=e.contact, budget=0)
+    e = [q for q in forward_kinematics(SheetTeam(Sheet(V), 1.0), F).stable if len(q.taut) == 5][0]
+    r = inverse_kinematics(SheetTeam(Sheet(V), 1.0), e.object, contact=e.contact, budget=0)
     # Without the multi-start search the answer is a verified formation (the joint
     # optimisation may reach the pair at its limit) or budget_exhausted, never unreachable.
     if r.success:
-        res = forward_kinematics(Sheet(V), r.formation, 1.0)
-        assert any(q.status == "stable" and len(q.taut) == 5 and
+        res = forward_kinematics(SheetTeam(Sheet(V), 1.0), r.formation)
+        assert any(q.kind == "stable" and len(q.taut) == 5 and
                    np.allclose(q.object, e.object, atol=1e-6) for q in res.equilibria)
     else:
         assert (r.status, r.certificate) == ("budget_exhausted", None)
         assert "multi-start" in r.message and np.all(np.isnan(r.formation))
     with pytest.raises(InvalidInputError):
-        inverse_kinematics(sheet, [0, 0, 0.5], 1.0, budget=-1)
+        inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.5], budget=-1)
 
 
 def test_lp_relaxation_certificate():
@@ -337,7 +339,7 @@ def test_lp_relaxation_certificate():
          [-0.6835135471718619, 0.3485312377993233], [-0.6584213906229159, -0.4093340061843917]]
     vo = np.array([0.3603519753616005, -0.2859430096203684])
     p = np.array([0.1, 0.2, 1.0 - 0.05713317576543746])
-    r = inverse_kinematics(Sheet(V), p, 1.0, contact=vo)
+    r = inverse_kinematics(SheetTeam(Sheet(V), 1.0), p, contact=vo)
     assert r.status == "unreachable" and r.certificate.kind == "closure_lp"
     y = r.certificate.multipliers
     assert np.all(y >= 0) and y.sum() == pytest.approx(1.0)
@@ -349,7 +351,7 @@ def test_relaxation_never_refutes_a_reachable_target():
     nor the pair proof claims unreachability."""
     from taut.sheet.ik._certificate import closure_lp_certificate, radial_certificate
     for sheet, p, vo, _, _ in fk_targets(5, 30, range(4, 10)):
-        r = inverse_kinematics(sheet, p, 1.0, contact=vo)
+        r = inverse_kinematics(SheetTeam(sheet, 1.0), p, contact=vo)
         if not r.success:
             continue
         s = sheet.size

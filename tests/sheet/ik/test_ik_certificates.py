@@ -15,6 +15,7 @@ from taut.sheet.ik._branch import BranchProof, _arc_min, _cut, branch_proof, ver
 from taut.sheet.ik._certificate import (closure_lp_certificate, radial_certificate,
     verify_certificate)
 from taut.sheet import random_team
+from taut.sheet import SheetTeam
 
 DATA = json.loads((Path(__file__).parents[2] / "data" / "ik_missed_targets.json").read_text())
 
@@ -33,7 +34,7 @@ def verified_by_fk(sheet, formation, p, vo, z=1.0, tol=1e-6):
     return any(e.stable and len(e.taut) == sheet.n
                and np.linalg.norm(e.object - p) <= tol * sheet.size
                and np.linalg.norm(e.contact - vo) <= tol * sheet.size
-               for e in forward_kinematics(sheet, formation, z).equilibria)
+               for e in forward_kinematics(SheetTeam(sheet, z), formation).equilibria)
 
 
 @pytest.mark.parametrize("case", DATA["targets"], ids=lambda c: f"bench{c['bench_index']}")
@@ -43,10 +44,10 @@ def test_formerly_missed_targets_are_proved_unreachable(case):
     holds it: IK now says so with a proof that re-checks from the target alone."""
     sheet = Sheet(case["vertices"])
     p, vo = np.array(case["object"]), np.array(case["contact"])
-    fk = forward_kinematics(sheet, case["generating_formation"], DATA["hold_height"])
+    fk = forward_kinematics(SheetTeam(sheet, DATA["hold_height"]), case["generating_formation"])
     assert any(e.stable and sorted(e.taut) == case["generating_taut"]
                and np.allclose(e.object, p, atol=1e-9) for e in fk.equilibria)
-    r = inverse_kinematics(sheet, p, DATA["hold_height"], contact=vo,
+    r = inverse_kinematics(SheetTeam(sheet, DATA["hold_height"]), p, contact=vo,
                            heading=case["heading"])
     assert (r.success, r.status) == (False, case["expected_status"])
     assert r.certificate.kind == case["expected_certificate"]
@@ -81,7 +82,7 @@ def test_tampered_branch_proofs_are_rejected():
 def test_branch_budget_zero_reports_budget_exhausted():
     """Without the proof (branch_boxes=0) the same target is honestly budget_exhausted."""
     case = DATA["targets"][0]
-    r = inverse_kinematics(Sheet(case["vertices"]), case["object"], 1.0,
+    r = inverse_kinematics(SheetTeam(Sheet(case["vertices"]), 1.0), case["object"],
                            contact=case["contact"], budget=1, branch_boxes=0)
     assert (r.status, r.certificate) == ("budget_exhausted", None)
     assert "branch-and-bound" in r.message
@@ -123,7 +124,7 @@ def test_branch_proof_never_refutes_a_reachable_target():
     while found < 6:
         n = int(rng.integers(3, 8))
         sheet, R = random_team(n, rng)
-        for e in forward_kinematics(sheet, R, 1.0).stable:
+        for e in forward_kinematics(SheetTeam(sheet, 1.0), R).stable:
             if len(e.taut) == n:
                 V, rho, _, _ = normalised(sheet, e.object, e.contact)
                 assert branch_proof(V, rho, max_boxes=12) is None
@@ -141,11 +142,11 @@ def test_ik_of_a_stable_fk_state_is_verified_or_certified(seed, n, pick, heading
     rng = np.random.default_rng(seed)
     while True:
         sheet, R = random_team(n, rng)
-        stable = forward_kinematics(sheet, R, 1.0).stable
+        stable = forward_kinematics(SheetTeam(sheet, 1.0), R).stable
         if stable:
             break
     e = stable[pick % len(stable)]
-    r = inverse_kinematics(sheet, e.object, 1.0, contact=e.contact, heading=heading)
+    r = inverse_kinematics(SheetTeam(sheet, 1.0), e.object, contact=e.contact, heading=heading)
     if r.success:
         assert verified_by_fk(sheet, r.formation, e.object, e.contact)
         return
@@ -163,11 +164,11 @@ def test_every_answer_is_verified_or_certified_on_150_fk_targets():
     while len(outcomes) < 150:
         n = int(rng.integers(3, 13))
         sheet, R = random_team(n, rng)
-        stable = forward_kinematics(sheet, R, 1.0).stable
+        stable = forward_kinematics(SheetTeam(sheet, 1.0), R).stable
         if not stable:
             continue
         e = stable[int(rng.integers(len(stable)))]
-        r = inverse_kinematics(sheet, e.object, 1.0, contact=e.contact,
+        r = inverse_kinematics(SheetTeam(sheet, 1.0), e.object, contact=e.contact,
                                heading=float(rng.uniform(-np.pi, np.pi)))
         if r.success:
             assert verified_by_fk(sheet, r.formation, e.object, e.contact)

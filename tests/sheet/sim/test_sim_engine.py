@@ -19,6 +19,7 @@ from taut.sheet.sim._branch import Tracker, solve_support_one, solve_taut_sets
 from taut._jit import HAVE_NUMBA
 from taut.sheet import random_team
 from taut.sheet import simulate
+from taut.sheet import SheetTeam
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples/sheet/trajectories"
 pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
@@ -27,7 +28,7 @@ pytestmark = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
 def team(n, rng):
     while True:
         sheet, R = random_team(n, rng)
-        if forward_kinematics(sheet, R, 1.0).stable:
+        if forward_kinematics(SheetTeam(sheet, 1.0), R).stable:
             return sheet, R
 
 
@@ -57,7 +58,7 @@ def test_compiled_support_solve_matches_numpy(seed, n, zoom):
     sheet = type(sheet)(sheet.vertices * zoom)
     R = R * zoom
     z = 1.0 * zoom
-    tracker = Tracker(sheet, z, compiled=True)
+    tracker = Tracker(SheetTeam(sheet, z), compiled=True)
     sets = [c for k in (3, 4, 5) for c in itertools.combinations(range(n), k)][:60]
     idx = np.full((len(sets), 5), -1, dtype=np.intp)
     for r, c in enumerate(sets):
@@ -104,10 +105,10 @@ def test_compiled_simulation_matches_numpy_on_key_frames(seed, n, amp):
     rng = np.random.default_rng(seed)
     sheet, R0 = team(n, rng)
     R = keyframes(sheet, R0, rng, 3, 40, amp)
-    fast = simulate(sheet, R, 1.0, backend="numba")
-    slow = simulate(sheet, R, 1.0, backend="numpy")
+    fast = simulate(SheetTeam(sheet, 1.0), R, backend="numba")
+    slow = simulate(SheetTeam(sheet, 1.0), R, backend="numpy")
     _same_run(fast, slow, sheet.size)
-    sims = [Simulator(sheet, 1.0, R[0], backend=b) for b in ("numba", "numpy")]
+    sims = [Simulator(SheetTeam(sheet, 1.0), R[0], backend=b) for b in ("numba", "numpy")]
     for t in range(1, len(R)):
         a, b = (s.step(R[t]) for s in sims)
         assert a.taut == b.taut and a.status == b.status
@@ -125,11 +126,12 @@ def test_key_frames_exercise_taut_changes_and_jumps():
     for n in (4, 5, 6):
         sheet, R0 = team(n, rng)
         R = keyframes(sheet, R0, rng, 4, 50, 0.25)
-        fast = simulate(sheet, R, 1.0, backend="numba")
-        _same_run(fast, simulate(sheet, R, 1.0, backend="numpy"), sheet.size)
+        fast = simulate(SheetTeam(sheet, 1.0), R, backend="numba")
+        _same_run(fast, simulate(SheetTeam(sheet, 1.0), R, backend="numpy"), sheet.size)
         kinds |= {e.kind for e in fast.events}
         dt = 0.1
-        sims = [Simulator(sheet, 1.0, R[0], backend=b, dt=dt) for b in ("numba", "numpy")]
+        sims = [Simulator(SheetTeam(sheet, 1.0), R[0], backend=b, dt=dt)
+                for b in ("numba", "numpy")]
         for t in range(1, len(R)):
             v = (R[t] - R[t - 1]) / dt
             a, b = (s.step(velocities=v) for s in sims)
@@ -139,8 +141,8 @@ def test_key_frames_exercise_taut_changes_and_jumps():
     # The square-sheet jump scenario of the examples (a branch ends: the object rolls).
     R = load_trajectory(EXAMPLES / "square4_jump.csv").formations
     square = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
-    fast = simulate(square, R, 1.5, backend="numba")
-    _same_run(fast, simulate(square, R, 1.5, backend="numpy"), square.size)
+    fast = simulate(SheetTeam(square, 1.5), R, backend="numba")
+    _same_run(fast, simulate(SheetTeam(square, 1.5), R, backend="numpy"), square.size)
     kinds |= {e.kind for e in fast.events}
     assert {"taut_change", "jump"} <= kinds
 
@@ -149,6 +151,6 @@ def test_backend_is_validated():
     from taut.errors import InvalidInputError
     sheet, R = team(4, np.random.default_rng(0))
     with pytest.raises(InvalidInputError, match="backend"):
-        simulate(sheet, R[None], 1.0, backend="fortran")
+        simulate(SheetTeam(sheet, 1.0), R[None], backend="fortran")
     with pytest.raises(InvalidInputError, match="backend"):
-        Simulator(sheet, 1.0, R, backend="gpu")
+        Simulator(SheetTeam(sheet, 1.0), R, backend="gpu")

@@ -15,6 +15,7 @@ from taut.sheet import Sheet, forward_kinematics, forward_kinematics_batch
 from taut.sheet import inverse_kinematics
 from taut.sheet import random_team
 from taut.sheet import simulate
+from taut.sheet import SheetTeam
 
 EXAMPLES = Path(__file__).parents[3] / "examples" / "sheet" / "trajectories"
 SQUARE = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
@@ -24,7 +25,7 @@ def team(n, rng, **kw):
     """A random team whose object has a stable rest state at hold height 1."""
     while True:
         sheet, R = random_team(n, rng, **kw)
-        if forward_kinematics(sheet, R, 1.0).stable:
+        if forward_kinematics(SheetTeam(sheet, 1.0), R).stable:
             return sheet, R
 
 
@@ -43,7 +44,7 @@ def wobble(R, T, rng, amp=0.04):
 
 def continuity_oracle(sheet, R, z, start):
     """Per-step FK ('subsets': every set of <= 5 cables) and nearest stable state."""
-    b = forward_kinematics_batch(sheet, R, z, method="subsets")
+    b = forward_kinematics_batch(SheetTeam(sheet, z), R, method="subsets")
     cur, out = start, [start]
     for t in range(1, len(R)):
         st = b.object[t][b.stable[t]]
@@ -61,7 +62,7 @@ def test_smooth_trajectories_match_per_step_fk(seed):
     n = 4 + seed % 5
     sheet, R0 = team(n, rng, slack=(0.6, 0.8))
     R = wobble(R0, 150, rng)
-    res = simulate(sheet, R, 1.0)
+    res = simulate(SheetTeam(sheet, 1.0), R)
     want, ended = continuity_oracle(sheet, R, 1.0, res.object[0])
     if ended is None:
         assert not res.jumps
@@ -69,7 +70,7 @@ def test_smooth_trajectories_match_per_step_fk(seed):
     else:
         assert res.jumps and res.jumps[0].step == ended
         np.testing.assert_allclose(res.object[:ended], want[:ended], atol=1e-9 * sheet.size)
-    fk_first = forward_kinematics(sheet, R[0], 1.0)
+    fk_first = forward_kinematics(SheetTeam(sheet, 1.0), R[0])
     assert np.allclose(res.object[0], fk_first.lowest.object)
     # Weights: the object is the weighted mean of the taut robots and vertices.
     mask = res.taut_mask
@@ -85,8 +86,8 @@ def test_every_simulated_state_is_a_stable_fk_state(seed, n, amp):
     rng = np.random.default_rng(seed)
     sheet, R0 = team(n, rng)
     R = wobble(R0, 40, rng, amp=amp)
-    res = simulate(sheet, R, 1.0)
-    b = forward_kinematics_batch(sheet, R, 1.0, method="subsets")
+    res = simulate(SheetTeam(sheet, 1.0), R)
+    b = forward_kinematics_batch(SheetTeam(sheet, 1.0), R, method="subsets")
     for t in range(len(R)):
         if np.isnan(res.object[t, 0]):
             assert any(e.kind == "lost" for e in res.events)
@@ -100,7 +101,7 @@ def test_every_simulated_state_is_a_stable_fk_state(seed, n, amp):
 def test_square_team_jump_happens_at_the_right_step():
     traj = load_trajectory(EXAMPLES / "square4_jump.csv")
     R = traj.formations
-    res = simulate(SQUARE, R, 1.5)
+    res = simulate(SheetTeam(SQUARE, 1.5), R)
     _, ended = continuity_oracle(SQUARE, R, 1.5, res.object[0])
     assert ended == 120
     assert [e.kind for e in res.events] == ["jump"]
@@ -111,7 +112,7 @@ def test_square_team_jump_happens_at_the_right_step():
     assert jump.drop == pytest.approx(jump.object_before[2] - jump.object_after[2])
     # Before and after the jump: stable FK states, on different branches.
     for t in (119, 120, 200):
-        st = [e for e in forward_kinematics(SQUARE, R[t], 1.5).stable
+        st = [e for e in forward_kinematics(SheetTeam(SQUARE, 1.5), R[t]).stable
               if np.allclose(e.object, res.object[t], atol=1e-9)]
         assert st and st[0].taut == res.taut[t]
     assert np.linalg.norm(res.object[120] - res.object[119]) > 0.1
@@ -119,10 +120,10 @@ def test_square_team_jump_happens_at_the_right_step():
 
 def test_start_picks_the_requested_stable_state():
     R = load_trajectory(EXAMPLES / "square4_jump.csv").formations[:30]
-    stable = forward_kinematics(SQUARE, R[0], 1.5).stable
+    stable = forward_kinematics(SheetTeam(SQUARE, 1.5), R[0]).stable
     assert len(stable) >= 1
     other = max(stable, key=lambda e: e.height)
-    res = simulate(SQUARE, R, 1.5, start=other.object + 0.01)
+    res = simulate(SheetTeam(SQUARE, 1.5), R, start=other.object + 0.01)
     np.testing.assert_allclose(res.object[0], other.object)
 
 
@@ -150,7 +151,7 @@ def test_taut_set_changes_are_continuous():
     for n in (5, 6, 7):
         sheet, R0 = team(n, rng)
         R = keyframes(sheet, R0, rng)
-        res = simulate(sheet, R, 1.0)
+        res = simulate(SheetTeam(sheet, 1.0), R)
         for e in res.events:
             if e.kind != "taut_change":
                 continue
@@ -158,12 +159,12 @@ def test_taut_set_changes_are_continuous():
             assert set(e.taut_before) != set(e.taut_after)
             np.testing.assert_allclose(e.object_before, e.object_after, atol=1e-5)
             # The state after the step is a stable FK state with the reported taut set.
-            fk = forward_kinematics(sheet, R[e.step], 1.0, method="subsets").stable
+            fk = forward_kinematics(SheetTeam(sheet, 1.0), R[e.step], method="subsets").stable
             match = [q for q in fk if np.allclose(q.object, res.object[e.step], atol=1e-9)]
             assert match and match[0].taut == res.taut[e.step]
         # Between jumps the object stays on its branch: at each step it is the stable
         # FK state nearest to where it was.
-        b = forward_kinematics_batch(sheet, R, 1.0, method="subsets")
+        b = forward_kinematics_batch(SheetTeam(sheet, 1.0), R, method="subsets")
         jumps = {e.step for e in res.events if e.kind != "taut_change"}
         for t in range(1, len(R)):
             if t in jumps or np.isnan(res.object[t - 1, 0]):
@@ -178,12 +179,12 @@ def test_tensions_match_fk():
     rng = np.random.default_rng(2)
     sheet, R0 = team(5, rng, slack=(0.6, 0.8))
     R = wobble(R0, 40, rng)
-    res = simulate(sheet, R, 1.0, mass=1.5)
+    res = simulate(SheetTeam(sheet, 1.0, mass=1.5), R)
     for t in (0, 17, 39):
-        e = [q for q in forward_kinematics(sheet, R[t], 1.0, mass=1.5).stable
+        e = [q for q in forward_kinematics(SheetTeam(sheet, 1.0, mass=1.5), R[t]).stable
              if np.allclose(q.object, res.object[t], atol=1e-9)][0]
         np.testing.assert_allclose(res.tensions[t, list(e.taut)], e.tensions, rtol=1e-7)
-    assert simulate(sheet, R, 1.0).tensions is None
+    assert simulate(SheetTeam(sheet, 1.0), R).tensions is None
 
 
 def test_leaving_an_all_taut_ik_formation():
@@ -191,11 +192,11 @@ def test_leaving_an_all_taut_ik_formation():
     robot 1 inwards slackens its cable only (the other seven stay on their common sphere);
     deforming the whole team then leaves the degenerate state along a continuous branch."""
     sheet = Sheet.regular(8, 1.0)
-    ik = inverse_kinematics(sheet, [0, 0, 0.5], 1.0, contact=[0.1, 0.05])
+    ik = inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.5], contact=[0.1, 0.05])
     s = np.linspace(0, 1, 30)[:, None]
     R = np.repeat(ik.formation[None], 30, axis=0)
     R[:, 0] -= 0.1 * s * ik.formation[0] / np.linalg.norm(ik.formation[0])
-    res = simulate(sheet, R, 1.0)
+    res = simulate(SheetTeam(sheet, 1.0), R)
     assert res.taut[0] == tuple(range(8))
     assert all(t == tuple(range(1, 8)) for t in res.taut[1:])
     assert not res.jumps
@@ -203,21 +204,21 @@ def test_leaving_an_all_taut_ik_formation():
     # A regular sheet keeps all cables taut under scaling (vertices on a circle, cf. the
     # FK paper's Lemma 2), so deform an IK formation of an irregular sheet.
     sheet, _ = random_team(8, np.random.default_rng(1))
-    ik = inverse_kinematics(sheet, [0, 0, 0.5], 1.0)
+    ik = inverse_kinematics(SheetTeam(sheet, 1.0), [0, 0, 0.5])
     R2 = wobble(ik.formation, 60, np.random.default_rng(0), amp=0.03)
-    res2 = simulate(sheet, R2, 1.0)
+    res2 = simulate(SheetTeam(sheet, 1.0), R2)
     # It ends translated (a rigid motion), where all eight are taut again.
     assert len(res2.taut[0]) == 8 == len(res2.taut[-1])
     assert all(len(t) <= 5 for t in res2.taut[1:-1])
     assert np.linalg.norm(res2.object[1] - res2.object[0]) < 1e-2
     for t in (1, 30, 59):
-        assert any(np.allclose(e.object, res2.object[t], atol=1e-9)
-                   for e in forward_kinematics(sheet, R2[t], 1.0, method="subsets").stable)
+        stable = forward_kinematics(SheetTeam(sheet, 1.0), R2[t], method="subsets").stable
+        assert any(np.allclose(e.object, res2.object[t], atol=1e-9) for e in stable)
 
 
 def test_object_touching_the_ground_is_lost_then_recovered():
     R = load_trajectory(EXAMPLES / "square4_jump.csv").formations
-    res = simulate(SQUARE, np.concatenate([R, R[::-1]]), 0.925)
+    res = simulate(SheetTeam(SQUARE, 0.925), np.concatenate([R, R[::-1]]))
     kinds = [e.kind for e in res.events]
     assert "lost" in kinds
     lost = kinds.index("lost")
@@ -232,7 +233,7 @@ def test_object_touching_the_ground_is_lost_then_recovered():
 def test_standing_still_changes_nothing():
     rng = np.random.default_rng(9)
     sheet, R0 = team(7, rng)
-    res = simulate(sheet, np.repeat(R0[None], 5, axis=0), 1.0)
+    res = simulate(SheetTeam(sheet, 1.0), np.repeat(R0[None], 5, axis=0))
     assert not res.events
     np.testing.assert_allclose(res.object, np.repeat(res.object[:1], 5, axis=0))
 
@@ -241,7 +242,7 @@ def test_infeasible_formation_mid_trajectory_reports_step():
     R = load_trajectory(EXAMPLES / "square4_jump.csv").formations[:20].copy()
     R[13, 0] = [5.0, 5.0]
     with pytest.raises(InfeasibleFormationError) as exc:
-        simulate(SQUARE, R, 1.5)
+        simulate(SheetTeam(SQUARE, 1.5), R)
     assert exc.value.step == 13 and "step 13" in str(exc.value)
 
 
@@ -253,7 +254,7 @@ def test_infeasible_formation_mid_trajectory_reports_step():
 ])
 def test_bad_shapes(formations, field):
     with pytest.raises(InvalidInputError) as exc:
-        simulate(SQUARE, formations, 1.0)
+        simulate(SheetTeam(SQUARE, 1.0), formations)
     assert exc.value.field == field
 
 
@@ -261,7 +262,7 @@ def test_no_stable_state_at_start():
     # Robots bunched in a corner: the object sits below the ground.
     R = np.full((3, 4, 2), 0.0) + np.array([[0, 0], [0.01, 0], [0.01, 0.01], [0, 0.01]])
     with pytest.raises(InvalidTrajectoryError) as exc:
-        simulate(SQUARE, R, 0.5)
+        simulate(SheetTeam(SQUARE, 0.5), R)
     assert "step 0" in exc.value.problem
 
 
@@ -270,8 +271,8 @@ def test_simulator_steps_reproduce_simulate_through_a_jump():
     formation by formation gives the same states and the same jump."""
     from taut.sheet import Simulator
     R = load_trajectory(EXAMPLES / "square4_jump.csv").formations
-    res = simulate(SQUARE, R, 1.5, mass=2.0)
-    sim = Simulator(SQUARE, 1.5, R[0], mass=2.0)
+    res = simulate(SheetTeam(SQUARE, 1.5, mass=2.0), R)
+    sim = Simulator(SheetTeam(SQUARE, 1.5, mass=2.0), R[0])
     np.testing.assert_allclose(sim.state.object, res.object[0], atol=1e-12)
     kinds = []
     for t in range(1, len(R)):
@@ -290,8 +291,8 @@ def test_simulator_velocities_match_formations_and_start():
     rng = np.random.default_rng(3)
     sheet, R0 = team(5, rng, slack=(0.6, 0.8))
     R = wobble(R0, 30, rng)
-    by_formation = Simulator(sheet, 1.0, R[0])
-    by_velocity = Simulator(sheet, 1.0, R[0], dt=0.5)
+    by_formation = Simulator(SheetTeam(sheet, 1.0), R[0])
+    by_velocity = Simulator(SheetTeam(sheet, 1.0), R[0], dt=0.5)
     for t in range(1, len(R)):
         a = by_formation.step(R[t])
         b = by_velocity.step(velocities=(R[t] - R[t - 1]) / 0.5)
@@ -302,9 +303,9 @@ def test_simulator_velocities_match_formations_and_start():
     np.testing.assert_allclose(c.formation, b.formation + (R[-1] - R[-2]), atol=1e-12)
     # start: the stable state of the first formation closest to a reference point.
     Rj = load_trajectory(EXAMPLES / "square4_jump.csv").formations
-    stable = forward_kinematics(SQUARE, Rj[0], 1.5).stable
+    stable = forward_kinematics(SheetTeam(SQUARE, 1.5), Rj[0]).stable
     other = max(stable, key=lambda e: e.height)
-    np.testing.assert_allclose(Simulator(SQUARE, 1.5, Rj[0], start=other.object + 0.01)
+    np.testing.assert_allclose(Simulator(SheetTeam(SQUARE, 1.5), Rj[0], start=other.object + 0.01)
                                .state.object, other.object)
     with pytest.raises(InvalidInputError):
         by_velocity.step(R[0], velocities=np.zeros((5, 2)))
@@ -314,5 +315,5 @@ def test_simulator_velocities_match_formations_and_start():
 
 def test_lost_object_is_a_diverged_result():
     R = load_trajectory(EXAMPLES / "square4_jump.csv").formations
-    res = simulate(SQUARE, np.concatenate([R, R[::-1]]), 0.925)
+    res = simulate(SheetTeam(SQUARE, 0.925), np.concatenate([R, R[::-1]]))
     assert not res.success and res.status == "diverged" and "lost at step" in res.message

@@ -1,7 +1,8 @@
-// Planner viewer: load a planning scenario, run the planner (the server runs the
-// bypass-only baseline, then the planner with obstacle crossing, and reports progress),
-// animate and scrub the plan, plot object height over obstacles and the sheet margin,
-// and compare with the baseline.
+// Planner viewer: load a planning scenario, run the planner (the server runs the SE(2)
+// bypass baseline, the same search with crossing disabled, then the planner with obstacle
+// crossing, and reports progress), animate and scrub the plan, plot object height over
+// obstacles and the least sheet slack (the library's plan_profile), and compare with the
+// baseline.
 "use strict";
 
 const PlanView = {
@@ -139,12 +140,12 @@ const PlanView = {
     const t = p.times, hs = this.world.height_safety;
     linePlot(document.getElementById("plan-height"), [
       {t, y: p.object.map(o => o[2]), color: "#e07010", label: "object height"},
-      {t, y: p.beneath.map(v => v > 0 ? v : null), color: "#666", label: "obstacle beneath"},
-      {t, y: p.height_over_obstacle, color: "#1a8a2a", label: "height over obstacle"},
+      {t, y: p.beneath_height_m.map(v => v > 0 ? v : null), color: "#666", label: "obstacle beneath"},
+      {t, y: p.height_over_obstacle_m, color: "#1a8a2a", label: "height over obstacle"},
       {t, y: t.map(() => hs), color: "#c00", dash: "3 3", label: "height safety"},
     ], {tc, zero: true});
     linePlot(document.getElementById("plan-margin"), [
-      {t, y: p.sheet_margin, color: "#46c", label: "min pair slack"},
+      {t, y: p.sheet_slack_m, color: "#46c", label: "least sheet slack"},
     ], {tc, zero: true});
   },
 
@@ -155,7 +156,7 @@ const PlanView = {
     for (const h of ["", "success", "duration [s]", "path [m]", "crossed", "bypassed", "object height [m]", "message"]) {
       const th = document.createElement("th"); th.textContent = h; head.appendChild(th);
     }
-    for (const [name, r] of [["planner (crossing)", d.plan], ["baseline (bypass only)", d.baseline]]) {
+    for (const [name, r] of [["planner (crossing)", d.plan], ["baseline (SE(2) bypass, no crossing)", d.baseline]]) {
       const row = tb.insertRow();
       row.dataset.planner = r.planner;
       [name, r.success ? "yes" : "no", fmt(r.duration), fmt(r.path_length, 3), r.crossed.join(", ") || "-",

@@ -5,7 +5,7 @@
 // play it through the quasi-static model.
 "use strict";
 
-const STATUS_COLOR = {stable: "#1a8a2a", saddle: "#d08020", not_equilibrium: "#999"};
+const KIND_COLOR = {stable: "#1a8a2a", saddle: "#d08020", not_equilibrium: "#999"};
 
 const SheetView = {
   sc: null, formation: null, fk: null, fkFormation: null, sel: null, mode: "drag",

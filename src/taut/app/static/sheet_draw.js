@@ -38,7 +38,7 @@ Object.assign(SheetView, {
     const fr = this.frame, g = el("g", {}, this.top);
     this.top.insertBefore(g, this.robotLayer);
     fk.equilibria.forEach((e, k) => {
-      const sel = k === this.sel, col = STATUS_COLOR[e.status], taut = new Set(e.taut);
+      const sel = k === this.sel, col = KIND_COLOR[e.kind], taut = new Set(e.taut);
       const [ox, oy] = fr.pt(e.object);
       for (let i = 0; i < F.length; i++) {
         const [x, y] = fr.pt(F[i]), t = taut.has(i);
@@ -47,7 +47,7 @@ Object.assign(SheetView, {
                     "stroke-width": sel ? (t ? 2.2 : 1.2) : 0.8, opacity: sel ? 1 : 0.35,
                     "stroke-dasharray": t ? "" : "3 4"}, g);
       }
-      el("circle", {cx: ox, cy: oy, r: sel ? 7 : 4.5, fill: e.status === "not_equilibrium" ? "none" : col,
+      el("circle", {cx: ox, cy: oy, r: sel ? 7 : 4.5, fill: e.kind === "not_equilibrium" ? "none" : col,
                     stroke: col, "stroke-width": 2, class: "equilibrium"}, g);
     });
   },
@@ -72,7 +72,7 @@ Object.assign(SheetView, {
     });
     if (!fk || !fk.feasible) return;
     fk.equilibria.forEach((e, k) => {
-      const sel = k === this.sel, col = STATUS_COLOR[e.status], taut = new Set(e.taut);
+      const sel = k === this.sel, col = KIND_COLOR[e.kind], taut = new Set(e.taut);
       const [cx, cy] = fr.pt(e.contact);
       if (sel) V.forEach((v, i) => {
         const t = taut.has(i), [x, y] = fr.pt(v);
@@ -88,7 +88,7 @@ Object.assign(SheetView, {
     clear(tb);
     if (!fk || !fk.feasible) return;
     const head = tb.insertRow();
-    for (const h of ["#", "taut", "x_o", "y_o", "z_o", "status", "tensions [N]"]) {
+    for (const h of ["#", "taut", "x_o", "y_o", "z_o", "kind", "tensions [N]"]) {
       const th = document.createElement("th"); th.textContent = h; head.appendChild(th);
     }
     fk.equilibria.forEach((e, k) => {
@@ -96,7 +96,7 @@ Object.assign(SheetView, {
       row.className = "equilibrium-row" + (k === this.sel ? " selected" : "");
       row.dataset.k = k;
       const cells = [k + 1, "{" + e.taut.map(i => i + 1).join(",") + "}", fmt(e.object[0]), fmt(e.object[1]),
-                     fmt(e.object[2]), e.status, e.tensions ? e.tensions.map(t => t.toFixed(3)).join(", ") : "-"];
+                     fmt(e.object[2]), e.kind, e.tensions ? e.tensions.map(t => t.toFixed(3)).join(", ") : "-"];
       cells.forEach(c => { row.insertCell().textContent = c; });
       row.addEventListener("click", () => { this.sel = k; this.draw(); });
     });

@@ -1,33 +1,32 @@
-"""Compiled control loop (numba), the fast engine of :func:`taut.cdpr.simulate`.
+"""Compiled control loop (numba), the fast backend of :func:`taut.cdpr.simulate`.
 
-It performs exactly the arithmetic of the numpy engine (:mod:`taut.cdpr.control.plant`,
-:mod:`taut.cdpr.control.controllers`, the ``_loop`` of :mod:`taut.cdpr.control.simulate`) with explicit loops, so
-one control step costs microseconds instead of ~100 numpy calls; the tests run both engines
-on the same problems and require them to agree. Only the two built-in controllers are
-compiled (``mode`` 0: velocity, 1: torque); other controllers run on the numpy engine.
+It performs exactly the arithmetic of the numpy backend (:mod:`taut.cdpr.control.plant`,
+:mod:`taut.cdpr.control.controllers`, the ``_loop`` of :mod:`taut.cdpr.control.simulate`)
+with explicit loops, so one control step costs microseconds instead of ~100 numpy calls; the
+tests run both backends on the same problems and require them to agree. Only the two
+built-in controllers are compiled (``mode`` 0: velocity, 1: torque); other controllers run
+on the numpy backend.
 
-Importing this module needs numba (a dependency of taut, optional at run time); the
-simulation imports it only when that engine is used. Functions compile on first call and
-are cached on disk by numba.
+Compiled by :func:`taut._jit.jit`, the package's one numba set-up (on-disk cache, numpy
+error model); without numba the functions stay plain Python and the simulation picks the
+numpy backend. Functions compile on first call.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
+from ..._jit import jit
 from .._tol import EVENT_TENSION_TOL, SO3_TAYLOR_SQ
 
-_jit = numba.njit(cache=True)
 
-
-@_jit
+@jit
 def _friction(w: float, fs: float, fc: float, fv: float, ws: float, weps: float) -> float:
     level = fc + (fs - fc) * np.exp(-(w / ws) ** 2)
     return level * np.tanh(w / weps) + fv * w
 
 
-@_jit
+@jit
 def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
          ctx_L0d: np.ndarray, ctx_L0dd: np.ndarray, ref_p: np.ndarray, ref_v: np.ndarray,
          R_ref: np.ndarray, t_ref: np.ndarray, W_pinv: np.ndarray, comT: np.ndarray,
@@ -39,10 +38,10 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
          speed: np.ndarray, integ: np.ndarray, h: float, substeps: int, lo: np.ndarray,
          hi: np.ndarray, check_every: int, rec: np.ndarray, rec_every: int, summ: np.ndarray,
          k_start: int, diverged: np.ndarray) -> None:
-    """Run every plant through every control step (arrays as in the numpy engine).
+    """Run every plant through every control step (arrays as in the numpy backend).
 
     Longer than 80 lines on purpose: measurement, both control laws and the monitors are
-    one compiled loop nest over (step, plant) that mirrors the numpy engine line by line;
+    one compiled loop nest over (step, plant) that mirrors the numpy backend line by line;
     the plant step is split out (:func:`_plant_step`).
 
     ``rec`` (T // rec_every, Brec, 12 + 3m) receives x_c, R (row-major), tensions, torques and
@@ -152,7 +151,7 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
                     diverged[b] = k
 
 
-@_jit
+@jit
 def _plant_step(b: int, mode: int, cmd: np.ndarray, tau: np.ndarray, T: np.ndarray,
                 u: np.ndarray, r: np.ndarray, ex: np.ndarray, ev: np.ndarray,
                 exit_off: np.ndarray, damp: float, EA: float, kl: float, eta: float,
@@ -246,7 +245,7 @@ def _plant_step(b: int, mode: int, cmd: np.ndarray, tau: np.ndarray, T: np.ndarr
         L0[b, c] += h * kl * speed[b, c]
 
 
-@_jit
+@jit
 def _rotate(R: np.ndarray, b: int, p0: float, p1: float, p2: float) -> None:
     """``R[b] <- R[b] exp([phi]x)`` (Rodrigues; Taylor series for small angles)."""
     th2 = p0 * p0 + p1 * p1 + p2 * p2

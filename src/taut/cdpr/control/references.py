@@ -9,13 +9,13 @@ accelerations ``[a; alpha]`` in the same order as the wrench ``[f; m]`` of FASTK
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._validate import (MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded,
-    as_nonnegative, as_positive)
+    as_choice, as_nonnegative, as_positive)
 from ...errors import InvalidInputError, InvalidTrajectoryError
 from .._tol import MAX_REFERENCE_SPEED, WAYPOINT_SAME
 from ..kinematics.cables import as_poses
@@ -144,10 +144,7 @@ def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, 
     acceleration = as_bounded(acceleration, "acceleration", 1e3 * MAX_SPEED, "m/s^2")
     rate = as_bounded(rate, "rate", MAX_RATE_HZ, "Hz")
     dwell = as_bounded(dwell, "dwell", MAX_DURATION_S, "s", positive=False)
-    if not isinstance(profile, str) or profile not in ("quintic",
-                                                       "trapezoidal"):
-        raise InvalidInputError("profile", f"unknown profile {profile!r}; choose quintic or "
-                                           "trapezoidal")
+    as_choice(profile, get_args(Profile), "profile")
     wp = as_array(waypoints, "waypoints")
     if wp.ndim != 2 or wp.shape[1] != 3 or wp.shape[0] < 2:
         raise InvalidInputError("waypoints", "must be at least two (x, y, z) positions, m")

@@ -10,13 +10,14 @@ with different seeded model errors, batched through one plant, summary numbers p
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable, Literal, Sequence
+from typing import Any, Callable, Literal, Sequence, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._jit import HAVE_NUMBA
 from ..._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
-    as_positive, require_instances)
+    as_choice, as_positive, require_instances)
 from ...errors import InvalidInputError
 from .._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
 from ..kinematics.forward import rpy_from_matrices
@@ -30,10 +31,10 @@ from .references import Reference
 from ._setup import BaseMotion, RefGeometry, build_context, reference_geometry
 from .results import ControlResult, MonteCarloResult, assemble_result, summarise
 
-__all__ = ["simulate", "monte_carlo", "ControlResult", "MonteCarloResult", "BaseMotion"]
+__all__ = ["simulate", "monte_carlo", "ControlResult", "MonteCarloResult", "BaseMotion", "Backend"]
 
-#: The integrators of :func:`simulate`: compiled (numba), plain numpy, or numba when available.
-Engine = Literal["auto", "numba", "numpy"]
+#: The control loops of :func:`simulate`: compiled (numba), plain numpy, or numba when it can.
+Backend = Literal["auto", "numba", "numpy"]
 
 _CHECK_EVERY = 50          # control steps between divergence checks
 _MC_RECORD_EVERY = 10      # Monte Carlo keeps every 10th state for the tipping monitor
@@ -168,24 +169,18 @@ def _loop(setup: _Setup, controller: Controller,
     return diverged
 
 
-def _engine(engine: str, controller: Controller) -> str:
-    """Resolve ``engine`` to "numba" or "numpy"."""
-    if not isinstance(engine, str) or engine not in ("auto", "numba", "numpy"):
-        raise InvalidInputError("engine", f"unknown engine {engine!r}; choose auto, numba or "
-                                          "numpy")
+def _backend(backend: str, controller: Controller) -> str:
+    """Resolve ``backend`` to "numba" or "numpy" (numba as set up by :mod:`taut._jit`)."""
+    as_choice(backend, get_args(Backend), "backend")
     compiled = type(controller) in (VelocityController, TorqueController)
-    if engine == "numpy" or (engine == "auto" and not compiled):
+    if backend == "numpy" or (backend == "auto" and not (compiled and HAVE_NUMBA)):
         return "numpy"
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        if engine == "numba":
-            raise InvalidInputError("engine", "numba is not installed (it is a dependency "
-                                              "of taut; pip install numba)") from None
-        return "numpy"
+    if not HAVE_NUMBA:
+        raise InvalidInputError("backend", "numba is not installed (it is a dependency "
+                                           "of taut; pip install numba)")
     if not compiled:
-        raise InvalidInputError("engine", "the numba engine runs VelocityController and "
-                                          "TorqueController only; use engine='numpy'")
+        raise InvalidInputError("backend", "the numba backend runs VelocityController and "
+                                           "TorqueController only; use backend='numpy'")
     return "numba"
 
 
@@ -234,7 +229,7 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
              control_rate: float = 1000.0, duration: float | None = None,
              dynamics: DynamicsModel | None = None, substeps: int = 1,
              external_wrench: ArrayLike | None = None, settle: float = 1.0,
-             engine: Engine = "auto",
+             backend: Backend = "auto",
              progress: Callable[[int, int], None] | None = None) -> ControlResult:
     """Simulate a controller driving the cable robot along a reference.
 
@@ -266,11 +261,11 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
         long (not recorded), so the run starts from the closed-loop rest state of this
         controller and plant rather than from the switch-on transient. The plant starts the
         pre-roll at rest in elastic equilibrium with the nominal unstretched lengths.
-    engine : {"auto", "numba", "numpy"}
-        The compiled loop (built-in controllers, needs the ``fast`` extra) or the numpy one
-        (any controller); "auto" picks numba when it can. Both compute the same model.
+    backend : {"auto", "numba", "numpy"}
+        The compiled loop (built-in controllers, needs numba) or the numpy one (any
+        controller); "auto" picks numba when it can. Both compute the same model.
     progress : callable(done, total), optional
-        Called during the run (numpy engine) or at its end (numba engine).
+        Called during the run (numpy backend) or at its end (numba backend).
 
     Returns
     -------
@@ -297,11 +292,11 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
     """
     if model_errors is not None and not isinstance(model_errors, ModelErrors):
         raise InvalidInputError("model_errors", "must be a taut.cdpr.ModelErrors")
-    eng = _engine(engine, controller)
+    used = _backend(backend, controller)
     setup = _prepare(robot, reference, controller, model_errors, base_motion, control_rate,
                      duration, dynamics, substeps, external_wrench, settle)
     n, m = len(setup.times), robot.m
-    if eng == "numba":
+    if used == "numba":
         rec_n, _, div_n = _loop_numba(setup, controller, 1, 1)
         r0 = rec_n[:, 0]
         hist = {"xc": r0[:, :3], "R": r0[:, 3:12].reshape(-1, 3, 3), "T": r0[:, 12:12 + m],
@@ -323,7 +318,7 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
                 model_errors: Sequence[ModelErrors], *, base_motion: BaseMotion | None = None,
                 control_rate: float = 1000.0, duration: float | None = None,
                 dynamics: DynamicsModel | None = None, substeps: int = 1,
-                settle: float = 1.0, engine: Engine = "auto",
+                settle: float = 1.0, backend: Backend = "auto",
                 progress: Callable[[int, int], None] | None = None) -> MonteCarloResult:
     """Run one simulation per entry of ``model_errors``, batched through one plant (the
     per-step work is vectorised over runs), keeping summary numbers per run.
@@ -337,11 +332,11 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
     errs = list(require_instances(model_errors, ModelErrors, "model_errors"))
     if not errs:
         raise InvalidInputError("model_errors", "needs at least one ModelErrors")
-    eng = _engine(engine, controller)
+    used = _backend(backend, controller)
     setup = _prepare(robot, reference, controller, errs, base_motion, control_rate,
                      duration, dynamics, substeps, None, settle)
     acc = summarise(setup)
-    if eng == "numba":
+    if used == "numba":
         rec, summ, div = _loop_numba(setup, controller, _MC_RECORD_EVERY, len(errs))
         acc.from_kernel(rec, summ, _MC_RECORD_EVERY)
         if progress is not None:

@@ -33,12 +33,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import differential_evolution, minimize
 
-from ..._outcome import check_status, deprecated_alias
+from ..._outcome import check_status
 from ..._validate import MAX_SPEED, as_array, check_range
 from ...errors import InvalidInputError, TautError
-from ..statics._common import renamed_keyword, wrench_vertices
+from ..statics._common import wrench_vertices
 from .._tol import DEPLOY_DE_TOL, DEPLOY_NM_FATOL, DEPLOY_NM_XATOL, FIXED_COORD_WIDTH
-from .lift import LiftBound, lift_bound, upward_force_bound
+from .lift import LiftBound, lift_bound
 from ..model.robot import CableRobot
 from ..kinematics.modes import MotionLimits, fastkit_motion_limits
 from .placement import footprint_overlap, place_bases, workspace_box
@@ -48,9 +48,6 @@ from ..sets.wrench import capacity_margin, wrench_feasible
 from ..._validate import require_instance
 
 __all__ = ["DeploymentOptions", "DeploymentResult", "plan_deployment", "evaluate_deployment"]
-
-# Kept importable from here (their home moved when this module was split).
-_MOVED = (LiftBound, lift_bound, upward_force_bound, place_bases, workspace_box)
 
 #: Penalty weight (per metre outside the frame, per m/s of twist shortfall, per metre of
 #: footprint overlap) added to the negative capacity margin; large against margins of a
@@ -94,10 +91,6 @@ class DeploymentOptions:
                                               f"got {value!r}")
 
 
-def _no_reason(self: Any, message: str) -> str:
-    return "" if self.success else message
-
-
 @dataclass(frozen=True)
 class DeploymentResult:
     """Outcome of :func:`plan_deployment`.
@@ -113,15 +106,13 @@ class DeploymentResult:
     ----------
     success : bool
         Verified: every verification point wrench-feasible with tipping, the required twist
-        available there, no footprint over the workspace. (``feasible`` is its deprecated
-        alias.)
+        available there, no footprint over the workspace.
     status : str
         ``"ok"``; ``"refuted"`` (the lift certificate proves that no placement exists);
         ``"budget_exhausted"`` (the seeded search found no verified placement: no proof
         either way).
     message : str
-        What was found, or why not. (``reason``, its deprecated alias, is empty on
-        success.)
+        What was found, or why not.
     base_poses : dict str -> (3,)
         ``(x, y, theta)`` of every mobile base, m and rad.
     robot : CableRobot
@@ -156,9 +147,6 @@ class DeploymentResult:
     workspace: np.ndarray
     evaluations: int
     lift_bound: LiftBound | None = None
-
-    feasible = deprecated_alias("success", "feasible")
-    reason = deprecated_alias("message", "reason", transform=_no_reason)
 
     def __post_init__(self) -> None:
         check_status(self.status)
@@ -274,8 +262,8 @@ def plan_deployment(robot: CableRobot, workspace: ArrayLike, *,
                     external_wrench: ArrayLike | None = None,
                     required_twist: ArrayLike | None = None,
                     limits: MotionLimits | None = None, moving: Sequence[str] | None = None,
-                    options: DeploymentOptions | None = None,
-                    disturbance: ArrayLike | None = None, **settings: Any) -> DeploymentResult:
+                    options: DeploymentOptions | None = None, **settings: Any
+                    ) -> DeploymentResult:
     """Find mobile-base placements for a desired workspace box.
 
     Parameters
@@ -289,8 +277,7 @@ def plan_deployment(robot: CableRobot, workspace: ArrayLike, *,
         zmax``, m, with positive volume.
     external_wrench : (V, n), optional
         Extra external wrenches on top of platform and payload weight (vertices, e.g.
-        :func:`taut.cdpr.external_wrench_box`), N and N m. ``disturbance`` is its
-        deprecated name.
+        :func:`taut.cdpr.external_wrench_box`), N and N m.
     required_twist : (n,) or (T, n), optional
         Twists (m/s, rad/s) that must be available everywhere (task mode).
     limits : MotionLimits, optional
@@ -316,9 +303,7 @@ def plan_deployment(robot: CableRobot, workspace: ArrayLike, *,
         raise InvalidInputError("robot", "has no mobile base to deploy")
     opts = _options(options, settings)
     limits = fastkit_motion_limits() if limits is None else limits
-    field_ = "disturbance" if disturbance is not None else "external_wrench"
-    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
-    D = None if ext is None else wrench_vertices(robot, ext, field_)
+    D = None if external_wrench is None else wrench_vertices(robot, external_wrench)
     tw = _required_twists(robot, required_twist)
     cert = lift_bound(robot, box, external_wrench=D)
     if cert.refutes:

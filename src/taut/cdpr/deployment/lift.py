@@ -15,7 +15,7 @@ from scipy.optimize import minimize
 
 from ..._validate import MAX_BATCH, as_array
 from ...errors import InvalidInputError
-from ..statics._common import renamed_keyword, wrench_vertices
+from ..statics._common import wrench_vertices
 from .._tol import LIFT_FTOL, LIFT_GTOL, LIFT_RTOL, REFUTE_REL
 from ..model.robot import CableRobot
 from .placement import workspace_box
@@ -232,8 +232,7 @@ class LiftBound:
 
 def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
                external_wrench: ArrayLike | None = None, samples: Sequence[int] = (41, 5),
-               refute_tol: float = REFUTE_REL, disturbance: ArrayLike | None = None
-               ) -> LiftBound:
+               refute_tol: float = REFUTE_REL) -> LiftBound:
     """Placement-independent necessary condition for a wrench-feasible workspace box.
 
     This is our own certificate built on FASTKIT's statics (eq. 17 equilibrium
@@ -255,8 +254,6 @@ def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
     refute_tol : float
         Refute only when the bound is below the required force by more than
         ``refute_tol`` times the weight (dimensionless; guards round-off at the boundary).
-    disturbance
-        Deprecated name of ``external_wrench``.
 
     Returns
     -------
@@ -327,10 +324,8 @@ def lift_bound(robot: CableRobot, workspace: ArrayLike, *,
     g_z = float(robot.gravity[2])
     weight = -robot.total_mass * g_z
     down = 0.0
-    field = "disturbance" if disturbance is not None else "external_wrench"
-    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
-    if ext is not None:
-        D = wrench_vertices(robot, ext, field)
+    if external_wrench is not None:
+        D = wrench_vertices(robot, external_wrench)
         down = float(np.max(-D[:, 2])) if len(D) else 0.0
     movable = np.array([robot.bases[k].mobile for k in robot.cable_base])
     per = np.zeros(robot.m)

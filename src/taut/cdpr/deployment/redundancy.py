@@ -21,14 +21,13 @@ point and its result is re-checked against the limits.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal, Sequence
+from typing import Literal, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import linprog, minimize
 
-from ..._outcome import deprecated_alias
-from ..._validate import as_array
+from ..._validate import as_array, as_choice
 from ...errors import InvalidInputError
 from .._tol import LEAST_BASE_CABLE_WEIGHT, RATE_FLOOR, REDUNDANCY_TOL, SCALE_ONE, SLSQP_FTOL
 from ..kinematics.first_order import FirstOrderModel, first_order_model
@@ -42,10 +41,6 @@ OBJECTIVES = ("min_norm", "least_base")
 Objective = Literal["min_norm", "least_base"]
 
 
-def _no_reason(self: Any, message: str) -> str:
-    return "" if self.success else message
-
-
 @dataclass(frozen=True)
 class RedundancyResult:
     """Joint rates for one desired platform twist.
@@ -54,13 +49,11 @@ class RedundancyResult:
     ----------
     success : bool
         The twist is available (inside the ATS) and ``q_dot`` reproduces it within limits.
-        (``feasible`` is its deprecated alias.)
     status : str
         ``"ok"``, or ``"infeasible"`` when only a fraction ``scale`` of the twist is
         available within the joint limits.
     message : str
-        One line: what was found, or why not (``reason``, its deprecated alias, is empty
-        on success).
+        One line: what was found, or why not.
     q_dot : (3k + m,) or (3,)
         Joint rates in ``joint_names`` order (base rates rad/s, m/s; cable speeds m/s).
         When infeasible: the rates of the largest feasible fraction ``scale`` of the twist.
@@ -85,9 +78,6 @@ class RedundancyResult:
     residual: float
     objective: str
     joint_names: tuple[str, ...]
-
-    feasible = deprecated_alias("success", "feasible")
-    reason = deprecated_alias("message", "reason", transform=_no_reason)
 
 
 def _lp_scale(C: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray, nb: int
@@ -141,8 +131,7 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
     """
     require_instance(robot, CableRobot, "robot")
     as_tolerance(tol, "tol")
-    if not isinstance(objective, str) or objective not in OBJECTIVES:
-        raise InvalidInputError("objective", "must be one of " + ", ".join(OBJECTIVES))
+    as_choice(objective, OBJECTIVES, "objective")
     limits = fastkit_motion_limits() if limits is None else limits
     P = as_array(pose, "pose")
     if P.ndim != 1:

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from ..._validate import MAX_CDPR_LENGTH_M, as_bounded
 from ...errors import InvalidInputError
-from ..statics._common import renamed_keyword, wrench_vertices
+from ..statics._common import wrench_vertices
 from .._tol import TALLEST_CERTIFICATE_TOL
 from .moving_base import plan_moving_deployment, staged_lift_bound
 from .deploy import DeploymentResult, plan_deployment
@@ -83,7 +83,7 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
                       external_wrench: ArrayLike | None = None,
                       tol: float = 0.05, certificate_tol: float = TALLEST_CERTIFICATE_TOL,
                       samples: Sequence[int] = (41, 5), warm_start: bool = True,
-                      disturbance: ArrayLike | None = None, stages: int = 1,
+                      stages: int = 1,
                       **plan_options: Any) -> TallestWorkspace:
     """Tallest box with a verified deployment, by bisection on ``zmax``.
 
@@ -94,8 +94,7 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
         Box whose x/y extent and ``zmin`` are kept; its ``zmax`` is the highest height
         tried.
     external_wrench : (V, n), optional
-        As for :func:`plan_deployment` (also used by the certificate); ``disturbance`` is
-        its deprecated name.
+        As for :func:`plan_deployment` (also used by the certificate).
     tol : float
         Stop when the bracket ``[verified, failed]`` of ``zmax`` is narrower, m.
     certificate_tol : float
@@ -138,9 +137,7 @@ def tallest_workspace(robot: CableRobot, workspace: ArrayLike, *,
         raise InvalidInputError("stages", "must be an integer from 1 to 50")
     tol = as_bounded(tol, "tol", MAX_CDPR_LENGTH_M, "m")
     certificate_tol = as_bounded(certificate_tol, "certificate_tol", MAX_CDPR_LENGTH_M, "m")
-    field = "disturbance" if disturbance is not None else "external_wrench"
-    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
-    D = None if ext is None else wrench_vertices(robot, ext, field)
+    D = None if external_wrench is None else wrench_vertices(robot, external_wrench)
     zmin, ztop = float(box[0, 2]), float(box[1, 2])
 
     def at(z: float) -> np.ndarray:

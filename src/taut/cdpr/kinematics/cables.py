@@ -25,7 +25,7 @@ __all__ = ["as_poses", "rotation_matrices", "CableState", "cable_state", "wrench
            "gravity_wrench", "tipping_matrix"]
 
 
-def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose",
+def as_poses(robot: CableRobot, poses: ArrayLike, field: str = "pose", *,
              check_bounds: bool = True) -> np.ndarray:
     """Validate platform poses and return them as a float64 ``(B, 6)`` array.
 

@@ -95,8 +95,9 @@ def fastkit_motion_limits() -> MotionLimits:
     """FASTKIT's joint velocity limits as printed in the paper: active base
     ``|theta_dot| <= 0.2 rad/s``, ``|rho1_dot|, |rho2_dot| <= 0.2 m/s`` (eqs. 10-12) and cable
     speeds ``|l_dot| <= 2 m/s`` (eq. 16, from the motor/winch table). The passive base is
-    fixed in task mode (eqs. 13-15) through the mode, not through these limits."""
-    return MotionLimits((-0.2, -0.2, -0.2), (0.2, 0.2, 0.2), -2.0, 2.0)
+    fixed in task mode (eqs. 13-15) through the mode, not through these limits. They are
+    the defaults of :class:`MotionLimits`."""
+    return MotionLimits()
 
 
 @dataclass(frozen=True)

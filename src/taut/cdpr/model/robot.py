@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ..._units import GRAVITY
 from ..._validate import MAX_TENSION_N, as_array, as_finite_scalar, check_range
 from ...errors import InvalidModelError
 from .footprint import check_footprint
@@ -80,7 +81,7 @@ class CableRobot:
     platform: Platform
     cables: tuple[Cable, ...]
     payload: Payload = field(default_factory=Payload)
-    gravity: Any = (0.0, 0.0, -9.81)
+    gravity: Any = (0.0, 0.0, -GRAVITY)
     bounds: Any = None
     desired_workspace: Any = None
     name: str = "cable robot"
@@ -272,7 +273,7 @@ def with_friction(robot: CableRobot, friction: float | None,
     return replace(robot, bases=bases)
 
 
-def with_stabilisers(robot: CableRobot, deployed: bool = True) -> CableRobot:
+def with_stabilisers(robot: CableRobot, *, deployed: bool = True) -> CableRobot:
     """The same robot with the stabilisers of every mobile base that has them deployed
     (or retracted). Deployed stabilisers replace the support polygon by the convex hull of
     wheels and stabiliser feet, so tipping limits can only get looser."""

@@ -21,27 +21,19 @@ from typing import Any, Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import InvalidInputError
 from .._batching import is_single, unbatch
 from .._tol import RANK_TOL, ZERO_ROW
 from ..kinematics.cables import as_poses
-from ..kinematics.first_order import (FOM_PER_POSE, FirstOrderModel, base_jacobians,
-    first_order_model, parallel_jacobian)
+from ..kinematics.first_order import FOM_PER_POSE, FirstOrderModel, first_order_model
 from ..model.robot import CableRobot
-from ..kinematics.modes import (BASE_JOINTS, MODES, TWIST_LABELS, Mode, ModeName, MotionLimits,
-    fastkit_motion_limits, joint_bounds, resolve_mode)
+from ..kinematics.modes import (TWIST_LABELS, Mode, ModeName, MotionLimits, fastkit_motion_limits,
+    joint_bounds)
 from .polytope import HPolytopeBatch, lp_max_step
 from .zonotope import _facets_base_and_identity, zonotope_hrep
-from ..._validate import as_count, require_instance
+from ..._validate import as_choice, as_count, require_instance
 
 __all__ = ["AvailableTwistSet", "available_twist_set", "TwistCapacities", "twist_capacities",
            "support"]
-
-# Kept importable from here (their home moved when this module was split).
-_MOVED = (MotionLimits, fastkit_motion_limits, MODES, Mode, resolve_mode, FirstOrderModel,
-          first_order_model, parallel_jacobian, base_jacobians, TWIST_LABELS, BASE_JOINTS,
-          joint_bounds, zonotope_hrep)
-
 
 @dataclass(frozen=True)
 class AvailableTwistSet(HPolytopeBatch):
@@ -138,7 +130,7 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     limits : MotionLimits, optional
         Default :func:`fastkit_motion_limits`.
     mode, moving
-        See :func:`resolve_mode`. ``mode="task", moving=()`` fixes every base.
+        See :func:`taut.cdpr.resolve_mode`. ``mode="task", moving=()`` fixes every base.
 
     Returns
     -------
@@ -211,8 +203,7 @@ def twist_capacities(robot: CableRobot, poses: ArrayLike, limits: MotionLimits |
     >>> cap.positive.shape, bool(cap.positive[0] >= 1.0)   # vx: at least the paper's 1 m/s
     ((6,), True)
     """
-    if not isinstance(method, str) or method not in ("hrep", "lp"):
-        raise InvalidInputError("method", "must be 'hrep' or 'lp'")
+    as_choice(method, ("hrep", "lp"), "method")
     single = is_single(poses)
     limits = fastkit_motion_limits() if limits is None else limits
     P = as_poses(robot, poses)

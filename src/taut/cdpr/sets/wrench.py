@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from ..._validate import as_array, as_choice, as_count, as_flag, require_instance
 from ...errors import InvalidInputError
 from .._batching import first, is_single, unbatch
-from ..statics._common import (constraints, feas_tol, renamed_keyword, required_wrench, svd_split,
+from ..statics._common import (constraints, feas_tol, required_wrench, svd_split,
     wrench_vertices)
 from ..statics._farkas import certificates, combine, nonempty
 from .._tol import CONTAINS_TOL, VERTEX_SLACK, ZERO_ROW
@@ -44,8 +44,8 @@ from ..model.robot import CableRobot
 from .polytope import HPolytopeBatch, lp_max_step
 
 __all__ = ["AvailableWrenchSet", "available_wrench_set", "wrench_feasible",
-           "AxisCapacities", "axis_capacities", "capacity_margin", "disturbance_box",
-           "external_wrench_box", "AXIS_LABELS"]
+           "AxisCapacities", "axis_capacities", "capacity_margin", "external_wrench_box",
+           "AXIS_LABELS"]
 
 AXIS_LABELS = ("fx", "fy", "fz", "mx", "my", "mz")
 
@@ -98,7 +98,7 @@ def _prepare(robot: CableRobot, poses: Any, tipping: bool, sliding: bool = False
     return P, st, pinv, N, ok, A, b
 
 
-def available_wrench_set(robot: CableRobot, poses: ArrayLike, tipping: bool = True, *,
+def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True,
                          sliding: bool = True) -> AvailableWrenchSet:
     """Exact H-representation of the available wrench set (FASTKIT eq. 24) at poses.
 
@@ -173,22 +173,18 @@ def external_wrench_box(robot: CableRobot, half_widths: ArrayLike) -> np.ndarray
     >>> external_wrench_box(load_cdpr_model("fastkit"), [2, 0, 3, 0, 0, 0]).shape
     (4, 6)
     """
-    hw = as_array(half_widths, "disturbance",
+    hw = as_array(half_widths, "half_widths",
                   shape=(require_instance(robot, CableRobot, "robot").dof,))
     if np.any(hw < 0):
-        raise InvalidInputError("disturbance", "half-widths must be non-negative")
+        raise InvalidInputError("half_widths", "must be non-negative")
     V = np.array(list(product(*[(-x, x) if x > 0 else (0.0,) for x in hw])))
     return V.reshape(-1, robot.dof)
 
 
-#: The former name of :func:`external_wrench_box` (same function).
-disturbance_box = external_wrench_box
-
 
 def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True,
                     external_wrench: ArrayLike | None = None, chunk: int = 256,
-                    sliding: bool = True, disturbance: ArrayLike | None = None
-                    ) -> np.ndarray:
+                    sliding: bool = True) -> np.ndarray:
     """Wrench feasibility (FASTKIT §4) of a batch of poses: can the cables hold platform
     and payload weight plus every extra wrench of ``external_wrench`` within tension limits
     (eq. 20) and, if ``tipping``, without tipping a mobile base (eqs. 21-23)?
@@ -210,8 +206,6 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     sliding : bool, default True
         Also require the friction condition of :mod:`taut.cdpr.statics.sliding` (bases with a
         friction coefficient only).
-    disturbance
-        Deprecated name of ``external_wrench``.
 
     Returns
     -------
@@ -228,12 +222,10 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     """
     tipping = as_flag(tipping, "tipping")
     sliding = as_flag(sliding, "sliding")
-    field = "disturbance" if disturbance is not None else "external_wrench"
-    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     single = is_single(poses)
     P = as_poses(robot, poses)
     chunk = as_count(chunk, "chunk", minimum=1)
-    D = wrench_vertices(robot, ext, field)
+    D = wrench_vertices(robot, external_wrench)
     out = np.empty(P.shape[0], dtype=bool)
     tol = feas_tol(robot)
     for s0 in range(0, P.shape[0], chunk):
@@ -276,8 +268,8 @@ class AxisCapacities:
     tipping: bool
 
 
-def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
-                    method: Literal["hrep", "lp"] = "hrep", *, sliding: bool = True
+def axis_capacities(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True,
+                    method: Literal["hrep", "lp"] = "hrep", sliding: bool = True
                     ) -> AxisCapacities:
     """Axis capacities ``max s >= 0`` with ``W t + w_e + s e = 0`` (eq. 17) inside the tension
     limits (eq. 20) and, if ``tipping``, the tipping limits (eqs. 21-23), for ``e`` each of
@@ -304,7 +296,7 @@ def axis_capacities(robot: CableRobot, poses: ArrayLike, tipping: bool = True,
     if method == "lp":
         caps = _axis_lp(robot, P, tipping, labels, sliding)
     else:
-        aws = available_wrench_set(robot, P, tipping, sliding=sliding)
+        aws = available_wrench_set(robot, P, tipping=tipping, sliding=sliding)
         pos, neg, reach = aws.axis_ray_lengths(-aws.gravity_wrench, tol=feas_tol(robot),
                                                sign=-1.0, zero=ZERO_ROW)
         ok = (aws.full_rank & aws.nonempty)[:, None]
@@ -339,9 +331,8 @@ def _axis_lp(robot: CableRobot, poses: ArrayLike, tipping: bool,
 
 
 def capacity_margin(robot: CableRobot, poses: ArrayLike,
-                    external_wrench: ArrayLike | None = None, tipping: bool = True, *,
-                    sliding: bool = True, disturbance: ArrayLike | None = None
-                    ) -> np.ndarray:
+                    external_wrench: ArrayLike | None = None, *, tipping: bool = True,
+                    sliding: bool = True) -> np.ndarray:
     """Capacity margin of the required wrench set at poses, (B,) (a float for one pose).
 
     The required set is platform and payload weight plus the extra external wrenches
@@ -349,8 +340,7 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     ``min_facets (h_k - max_v H_k w_v)`` over the unit-normal facets of the AWS: the
     distance (in mixed N / N m units) from the required set to the AWS boundary when
     positive; negative when some required wrench is not available. ``-inf`` at singular
-    poses or when the AWS is empty. ``disturbance`` is the deprecated name of
-    ``external_wrench``.
+    poses or when the AWS is empty.
 
     Examples
     --------
@@ -363,11 +353,9 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     """
     tipping = as_flag(tipping, "tipping")
     sliding = as_flag(sliding, "sliding")
-    field = "disturbance" if disturbance is not None else "external_wrench"
-    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     single = is_single(poses)
-    aws = available_wrench_set(robot, as_poses(robot, poses), tipping, sliding=sliding)
-    D = wrench_vertices(robot, ext, field)
+    aws = available_wrench_set(robot, as_poses(robot, poses), tipping=tipping, sliding=sliding)
+    D = wrench_vertices(robot, external_wrench)
     w = -(aws.gravity_wrench[:, None, :] + D[None, :, :])        # required cable wrenches
     hw = np.einsum("bsn,bvn->bsv", aws.H, w).max(axis=2)
     margin = np.min(aws.h - hw, axis=1)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from functools import lru_cache
 from itertools import combinations
 from typing import Any
@@ -94,18 +93,6 @@ def batch_outcome(success: np.ndarray, failure: str, what: str) -> tuple[np.ndar
     status = np.where(ok, "ok", failure)
     return status, f"{int(ok.sum())} of {ok.size} {what}"
 
-
-
-def renamed_keyword(new_value: Any, old_value: Any, new: str, old: str) -> Any:
-    """Accept a deprecated keyword ``old`` for ``new`` (kept for one release): warns with a
-    :class:`DeprecationWarning` and returns the value given; both at once is an error."""
-    if old_value is None:
-        return new_value
-    warnings.warn(f"keyword '{old}' is deprecated; use '{new}'", DeprecationWarning,
-                  stacklevel=3)
-    if new_value is not None:
-        raise InvalidInputError(new, f"give '{new}' or the deprecated '{old}', not both")
-    return old_value
 
 
 def wrench_vertices(robot: CableRobot, external_wrench: Any, field: str = "external_wrench"

@@ -27,34 +27,36 @@ Returned tensions are polished so that ``W t + w_e = 0`` holds to rounding error
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from itertools import combinations
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import linprog, minimize
 
-from ..._outcome import deprecated_alias
 from ...errors import InvalidInputError
 from ..._validate import as_choice, as_flag
 from .._batching import is_single, unbatch
 from ._common import batch_outcome, constraints, feas_tol, required_wrench, svd_split
+from .sliding import sliding_rows
 from .._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_FTOL, SLSQP_REL
-from ..kinematics.cables import as_poses, cable_state, tipping_matrix
+from ..kinematics.cables import CableState, as_poses, cable_state, tipping_matrix
 from ..model.robot import CableRobot
 
 __all__ = ["TensionResult", "distribute_tensions", "METHODS"]
 
-METHODS = ("closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm")
 TensionMethod = Literal["closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm"]
 QPSolver = Literal["auto", "enumeration", "scipy"]
+#: The methods of :func:`distribute_tensions`.
+METHODS: tuple[str, ...] = get_args(TensionMethod)
 
 
 @dataclass(frozen=True)
 class TensionResult:
     """Tensions for a batch of poses; for one pose every leading B axis is dropped
-    (``tensions`` (m,), ``success`` a bool, ``status`` a str, ``residual`` a float).
+    (``tensions`` (m,), ``success`` a bool, ``status`` and ``binding`` a str, ``residual`` a
+    float).
 
     Attributes
     ----------
@@ -62,12 +64,23 @@ class TensionResult:
         Cable tensions, N. For infeasible poses: the method's best attempt (closed form),
         or NaN where the solver found none (LP/QP); never use them without ``success``.
     success : ndarray (B,) of bool
-        True when the tensions satisfy eqs. 17 and 20 (and 21-23 when ``tipping``).
-        (``feasible`` is its deprecated alias.)
+        True when the tensions satisfy eqs. 17 and 20 (and 21-23 when ``tipping``, the
+        friction condition when ``sliding``).
     status : ndarray (B,) of str
         ``"ok"`` where ``success``, else ``"infeasible"`` (see :mod:`taut._outcome`).
     message : str
-        One line: how many poses are balanced within the limits.
+        One line. A batch: how many poses are balanced within the limits. One pose:
+        whether it is wrench-feasible and, if not, why (the binding condition; for tipping
+        the bases that tip).
+    binding : ndarray (B,) of str
+        ``""`` where ``success``; else the first condition, in the order ``"limits"``
+        (eqs. 17, 20), ``"tipping"``, ``"sliding"``, whose addition makes the pose
+        infeasible: for returned tensions the first condition they violate, for LP/QP
+        poses without tensions the first one whose addition leaves no solution (one more
+        solve per such pose).
+    within_limits : ndarray (B, m) of bool
+        Each returned tension within ``[t_min, t_max]`` (up to the feasibility tolerance
+        scaled by the largest limit); False where no tensions were found.
     residual : ndarray (B,)
         ``max |W t + w_e|`` (N, N m); NaN where no tensions were found.
     tipping_moments : ndarray (B, E)
@@ -84,13 +97,32 @@ class TensionResult:
     success: np.ndarray
     status: np.ndarray
     message: str
+    binding: np.ndarray
+    within_limits: np.ndarray
     residual: np.ndarray
     tipping_moments: np.ndarray
-    method: str
+    method: TensionMethod
     tipping: bool
-    sliding: bool = False
+    sliding: bool
 
-    feasible = deprecated_alias("success", "feasible")
+
+@dataclass(frozen=True)
+class _Solved:
+    """Tensions of a batch with the conditions they meet (private)."""
+
+    tensions: np.ndarray        # (B, m), NaN where none were found
+    found: np.ndarray           # (B,)
+    residual: np.ndarray        # (B,)
+    tipping_moments: np.ndarray  # (B, E)
+    within: np.ndarray          # (B, m) each tension within its limits
+    limits: np.ndarray          # (B,) balanced within the tension limits (eqs. 17, 20)
+    tips: np.ndarray            # (B, E) edge moments above the tolerance
+    slides: np.ndarray          # (B, F) friction rows violated
+    slide_base: np.ndarray      # (F,) base of each friction row
+
+    @property
+    def success(self) -> np.ndarray:
+        return self.limits & ~self.tips.any(axis=1) & ~self.slides.any(axis=1)
 
 
 def distribute_tensions(robot: CableRobot, poses: ArrayLike,
@@ -133,16 +165,18 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     >>> from taut.io.cdpr_model import load_cdpr_model
     >>> robot = load_cdpr_model("fastkit")
     >>> res = distribute_tensions(robot, [[0, 0, 0.6], [0, 0, 2.2]], "qp_min_norm")
-    >>> res.success.tolist(), res.status.tolist()
-    ([True, False], ['ok', 'infeasible'])
+    >>> res.success.tolist(), res.status.tolist(), res.binding.tolist()
+    ([True, False], ['ok', 'infeasible'], ['', 'limits'])
     >>> bool((robot.t_min <= res.tensions[0]).all()), bool(res.residual[0] < 1e-9)
     (True, True)
-    >>> one = distribute_tensions(robot, [0, 0, 0.6], "qp_min_norm")    # one pose
-    >>> one.success, one.status, one.tensions.shape
-    (True, 'ok', (8,))
+    >>> one = distribute_tensions(robot, [0, 0, 1.2])    # one pose
+    >>> one.success, one.binding, one.tensions.shape
+    (False, 'tipping', (8,))
+    >>> one.message
+    'not wrench-feasible: mobile bases active, passive tip over with the closed_form tensions (largest edge moment 87.85 N m)'
     """
     as_choice(method, METHODS, "method")
-    as_choice(qp_solver, ("auto", "enumeration", "scipy"), "qp_solver")
+    as_choice(qp_solver, get_args(QPSolver), "qp_solver")
     tipping = as_flag(tipping, "tipping")
     sliding = as_flag(sliding, "sliding")
     single = is_single(poses)
@@ -151,9 +185,31 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
     w = required_wrench(robot, st, external_wrench)
     use_tip = bool(tipping and robot.has_tipping)
     use_slide = bool(sliding and robot.has_sliding)
+    sol = _solve(robot, st, w, method, qp_solver, use_tip, use_slide)
+    feas = sol.success
+    binding = _binding(robot, st, w, method, qp_solver, use_tip, use_slide, sol)
+    names = ["tension"] + (["tipping"] if use_tip else []) + (["sliding"] if use_slide else [])
+    what = " and ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
+    status, message = batch_outcome(feas, "infeasible", f"poses balanced within the {what} "
+                                    "limits")
+    if single:
+        message = _pose_message(robot, method, use_tip, use_slide, sol, str(binding[0]))
+    out = TensionResult(tensions=sol.tensions, success=feas, status=status, message=message,
+                        binding=binding, within_limits=sol.within, residual=sol.residual,
+                        tipping_moments=sol.tipping_moments, method=method, tipping=use_tip,
+                        sliding=use_slide)
+    return unbatch(out, ("tensions", "success", "status", "binding", "within_limits",
+                         "residual", "tipping_moments"), single)
+
+
+def _solve(robot: CableRobot, st: CableState, w: np.ndarray, method: str, qp_solver: str,
+           use_tip: bool, use_slide: bool) -> _Solved:
+    """Tensions by ``method`` under the tension limits (and tipping, sliding rows), polished
+    onto ``W t = w``, with the conditions they meet."""
+    B = st.W.shape[0]
     A, b = constraints(robot, st, use_tip, use_slide)
     if method == "closed_form":
-        pinv, ok = None, np.ones(P.shape[0], dtype=bool)    # rank judged by the residual
+        pinv, ok = None, np.ones(B, dtype=bool)             # rank judged by the residual
         t = _closed_form(robot, st.W, w, ok)
     else:
         pinv, N, ok = svd_split(st.W)
@@ -167,8 +223,7 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
                                                  "cables; use qp_solver='scipy'")
         else:
             t = np.concatenate([_qp_enum(pinv[c], N[c], w[c], A[c], b[c], ok[c], robot)
-                                for c in _chunks(P.shape[0], 512)]) if P.shape[0] else \
-                np.zeros((0, robot.m))
+                                for c in _chunks(B, 512)]) if B else np.zeros((0, robot.m))
     found = np.all(np.isfinite(t), axis=1)
     # Polish: minimum-norm correction onto W t = w (removes solver round-off).
     tz = np.where(found[:, None], t, 0.0)
@@ -178,21 +233,74 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
              + robot.edge_weight_moment)
     tol = feas_tol(robot)
     wscale = 1.0 + np.abs(w).max(axis=1)
-    feas = (found & ok & (res <= RESIDUAL_REL * wscale)
-            & np.all(np.einsum("bkm,bm->bk", A, tz) <= b + tol, axis=1))
-    if use_tip:
-        feas &= np.all(tip_m <= tol, axis=1)
-    t_out = np.where(found[:, None], tz, np.nan)
-    names = ["tension"] + (["tipping"] if use_tip else []) + (["sliding"] if use_slide else [])
-    what = " and ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
-    status, message = batch_outcome(feas, "infeasible", f"poses balanced within the {what} "
-                                    "limits")
-    out = TensionResult(tensions=t_out, success=feas, status=status, message=message,
-                        residual=np.where(found, res, np.nan),
-                        tipping_moments=np.where(found[:, None], tip_m, np.nan),
-                        method=method, tipping=use_tip, sliding=use_slide)
-    return unbatch(out, ("tensions", "success", "status", "residual", "tipping_moments"),
-                   single)
+    rows = np.einsum("bkm,bm->bk", A, tz) <= b + tol        # bounds, tipping, sliding rows
+    m, k_tip = robot.m, 2 * robot.m + (robot.n_edges if use_tip else 0)
+    within = (rows[:, :m] & rows[:, m:2 * m]) & found[:, None]
+    limits = found & ok & (res <= RESIDUAL_REL * wscale) & within.all(axis=1)
+    tips = (~rows[:, 2 * m:k_tip] | (tip_m > tol)) if use_tip else np.zeros((B, 0), bool)
+    slide_base = sliding_rows(robot, st.unit[:1])[2] if use_slide else np.zeros(0, np.intp)
+    return _Solved(tensions=np.where(found[:, None], tz, np.nan), found=found,
+                   residual=np.where(found, res, np.nan),
+                   tipping_moments=np.where(found[:, None], tip_m, np.nan), within=within,
+                   limits=limits, tips=tips & found[:, None],
+                   slides=~rows[:, k_tip:] & found[:, None], slide_base=slide_base)
+
+
+def _subset(st: CableState, idx: np.ndarray) -> CableState:
+    return CableState(*(getattr(st, f.name)[idx] for f in fields(CableState)))
+
+
+def _binding(robot: CableRobot, st: CableState, w: np.ndarray, method: str, qp_solver: str,
+             use_tip: bool, use_slide: bool, sol: _Solved) -> np.ndarray:
+    """Per pose the first condition (limits, tipping, sliding) that fails (see
+    :class:`TensionResult`); poses without tensions are solved again without the later
+    conditions to tell which one leaves no solution."""
+    binding = np.where(sol.success, "", np.where(
+        ~sol.limits, "limits", np.where(sol.tips.any(axis=1), "tipping", "sliding")))
+    none = np.nonzero(~sol.found)[0]
+    if none.size and (use_tip or use_slide):
+        lim = _solve(robot, _subset(st, none), w[none], method, qp_solver, False, False)
+        held = none[lim.success]
+        binding[held] = "tipping" if use_tip else "sliding"
+        if use_tip and use_slide and held.size:
+            tip = _solve(robot, _subset(st, held), w[held], method, qp_solver, True, False)
+            binding[held[tip.success]] = "sliding"
+    return binding.astype(str)
+
+
+def _names(robot: CableRobot, bases: np.ndarray) -> str:
+    return ", ".join(robot.bases[int(k)].name for k in np.unique(bases))
+
+
+def _pose_message(robot: CableRobot, method: str, use_tip: bool, use_slide: bool,
+                  sol: _Solved, binding: str) -> str:
+    """The one-line answer for one pose: wrench-feasible or not, and why."""
+    if binding == "":
+        return ("wrench-feasible: tensions within the cable limits"
+                + (", no mobile base tips" if use_tip else "")
+                + (", no mobile base slides" if use_slide else "")
+                + (" (tipping not considered)" if robot.has_tipping and not use_tip else ""))
+    head = "not wrench-feasible: "
+    found = bool(sol.found[0])
+    if binding == "limits":
+        if method == "closed_form" and found:
+            return head + ("the closed_form tensions leave the cable limits (the closed form "
+                           "is conservative; an LP or QP method may still find tensions)")
+        return head + "no tensions within the cable limits balance the platform"
+    if binding == "tipping":
+        if not found:
+            return head + "every tension distribution within the cable limits tips a mobile base"
+        tips = sol.tips[0]
+        k = np.unique(robot.edge_base[tips])
+        return head + (f"mobile base{'s' if len(k) > 1 else ''} {_names(robot, k)} "
+                       f"tip{'' if len(k) > 1 else 's'} over with the {method} tensions "
+                       f"(largest edge moment {np.max(sol.tipping_moments[0]):.2f} N m)")
+    if not found:
+        return head + ("every tension distribution within the cable limits"
+                       + (" and the tipping limits" if use_tip else "") + " slides a mobile base")
+    k = np.unique(sol.slide_base[sol.slides[0]])
+    return head + (f"mobile base{'s' if len(k) > 1 else ''} {_names(robot, k)} "
+                   f"slide{'' if len(k) > 1 else 's'} with the {method} tensions")
 
 
 def _chunks(n: int, size: int) -> list[slice]:

@@ -44,12 +44,20 @@ class TippingResult:
         Index of the largest moment (-1 when the robot has no mobile base).
     edge_base : (E,) int
         Base index of each edge.
+    base_moment : (B, K)
+        Per base (``robot.bases`` order) its largest edge moment, N m; ``-inf`` for a base
+        without a support polygon (a fixed frame cannot tip). Minus the base's tipping
+        margin.
+    base_stable : (B, K) bool
+        The base does not tip: its ``base_moment`` <= 0 within the tolerance of ``stable``.
     """
 
     moments: np.ndarray
     stable: np.ndarray
     worst_edge: np.ndarray
     edge_base: np.ndarray
+    base_moment: np.ndarray
+    base_stable: np.ndarray
 
 
 def tipping_moments(robot: CableRobot, poses: ArrayLike, tensions: ArrayLike) -> TippingResult:
@@ -88,7 +96,14 @@ def tipping_moments(robot: CableRobot, poses: ArrayLike, tensions: ArrayLike) ->
         raise InvalidInputError("tensions", f"must have shape ({P.shape[0]}, {robot.m})")
     st = cable_state(robot, P, validated=True)
     M = np.einsum("bji,bi->bj", tipping_matrix(robot, st.unit), t) + robot.edge_weight_moment
-    stable = np.all(M <= feas_tol(robot), axis=1)
+    tol = feas_tol(robot)
+    stable = np.all(M <= tol, axis=1)
     worst = np.argmax(M, axis=1) if M.shape[1] else np.full(P.shape[0], -1)
-    return unbatch(TippingResult(M, stable, worst, robot.edge_base.copy()),
-                   ("moments", "stable", "worst_edge"), single)
+    per_base = np.full((P.shape[0], len(robot.bases)), -np.inf)
+    for k in range(len(robot.bases)):
+        sel = robot.edge_base == k
+        if np.any(sel):
+            per_base[:, k] = M[:, sel].max(axis=1)
+    return unbatch(TippingResult(M, stable, worst, robot.edge_base.copy(), per_base,
+                                 per_base <= tol),
+                   ("moments", "stable", "worst_edge", "base_moment", "base_stable"), single)

@@ -11,7 +11,6 @@ from numpy.typing import ArrayLike
 
 from ..._validate import MAX_BATCH, as_array
 from ...errors import InvalidInputError
-from ..statics._common import renamed_keyword
 from .._tol import BOX_REL, CLOSURE_TOL
 from .closure import closure_pass, inside_pass
 from ..model.robot import CableRobot
@@ -110,15 +109,14 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
                               external_wrench: ArrayLike | None = None,
                               shape: tuple[int, ...] | None = None, chunk: int = 2048,
                               progress: Callable[[int, int], None] | None = None,
-                              disturbance: ArrayLike | None = None, closure: bool = False,
+                              closure: bool = False,
                               closure_tol: float = CLOSURE_TOL) -> WorkspaceResult:
     """Evaluate the wrench-feasible workspace at positions ``points`` (P, 3), m.
 
     A position belongs to the WFW when, at every orientation of ``orientations`` ((O, 3)
     roll-pitch-yaw, rad; default level), the cables can hold platform and payload weight
-    plus every wrench of ``external_wrench`` ((V, n), N and N m; ``disturbance`` is its
-    deprecated name) within their tension limits,
-    and, for ``feasible_tipping``, without tipping a mobile base. Vectorised (see
+    plus every wrench of ``external_wrench`` ((V, n), N and N m) within their tension
+    limits, and, for ``feasible_tipping``, without tipping a mobile base. Vectorised (see
     :func:`taut.cdpr.sets.wrench.wrench_feasible`). ``progress(done, total)`` is called after
     each block of ``chunk`` poses. Positions outside the frame raise :class:`InfeasiblePoseError`.
 
@@ -140,7 +138,6 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
     if not isinstance(closure, (bool, np.bool_)):
         raise InvalidInputError("closure", f"must be true or false, got {closure!r}")
     chunk = as_count(chunk, "chunk", minimum=1)
-    ext = renamed_keyword(external_wrench, disturbance, "external_wrench", "disturbance")
     pts = as_array(points, "points", shape=(None, 3))
     ori = np.zeros((1, 3)) if orientations is None else \
         as_array(orientations, "orientations", shape=(None, 3))
@@ -153,7 +150,8 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
         passes.append(("sliding", True, True))
     extra = int(closure) + int(robot.platform_inside_exits)
     counter = _Progress(progress, poses.shape[0] * (len(passes) + extra))
-    res = {name: _feasible_pass(robot, poses, tip, slide, ext, chunk, counter).reshape(Pn, On)
+    res = {name: _feasible_pass(robot, poses, tip, slide, external_wrench, chunk,
+                                counter).reshape(Pn, On)
            for name, tip, slide in passes}
     feas = {name: np.asarray(r.all(axis=1)) for name, r in res.items()}
     if robot.platform_inside_exits:

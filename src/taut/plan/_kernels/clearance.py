@@ -3,7 +3,7 @@ motions (numba; the hot path of the SE(2) search).
 
 The *clearance* of a pose ``(x, y, psi)`` is a lower bound, in metres, of how far every
 robot and the robots' convex hull may move before a rule of
-:mod:`taut.plan.se2.space` breaks:
+:mod:`taut.plan.se2._space` breaks:
 
 * per robot: its signed distance to the walls (positive inside the free space) and to
   every obstacle (negative inside), minus ``clearance`` (robot radius + lateral safety);

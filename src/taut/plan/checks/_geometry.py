@@ -70,6 +70,27 @@ TOLERANCE = _tol.GEOMETRY_TOL
 Shapes = tuple[np.ndarray, np.ndarray]
 
 
+def beneath_height(scenario: Scenario, robots: np.ndarray) -> np.ndarray:
+    """Height of the tallest obstacle whose footprint meets the convex hull of ``robots``
+    (T, N, 2), m, per sample (0 when none)."""
+    hulls = shapely.convex_hull(shapely.multipoints(robots))
+    out = np.zeros(len(robots))
+    for o in scenario.world.obstacles:
+        out = np.where(shapely.intersects(hulls, o.geometry), np.maximum(out, o.height), out)
+    return out
+
+
+def pair_slack(scenario: Scenario, robots: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sheet slack (sheet distance less robot distance) of every robot pair of ``robots``
+    (T, N, 2), m: shape (T, P), and the pairs' robots ``i`` and ``j`` (P,), ``i < j``."""
+    V = scenario.team.sheet.vertices
+    iu, ju = np.triu_indices(V.shape[0], 1)
+    slack = (np.linalg.norm(V[iu] - V[ju], axis=1)[None]
+             - np.linalg.norm(robots[:, iu] - robots[:, ju], axis=2))
+    return slack, iu, ju
+
+
 def shapes_of(robots: np.ndarray) -> Shapes:
     """The robots' points and hulls of poses ``robots`` (P, N, 2), m, as shapely arrays."""
     return (shapely.points(robots.reshape(-1, 2)),

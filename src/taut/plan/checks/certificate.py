@@ -95,9 +95,25 @@ def _check_line(scenario: Scenario, p: np.ndarray, u: np.ndarray, tall: list
 
 
 def find_certificate(scenario: Scenario, directions: int = 72) -> Certificate | None:
-    """A cut certificate (module docstring) when one of the candidate lines is one."""
+    """A cut certificate (module docstring) when one of the candidate lines is one.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    directions : int
+        Candidate line directions through each anchor point (1 to 100000).
+
+    Returns
+    -------
+    Certificate or None
+    """
     require_instance(scenario, Scenario, "scenario")
-    directions = as_count(directions, "directions", minimum=1, maximum=100_000)
+    return _find_certificate(scenario, as_count(directions, "directions", minimum=1,
+                                                maximum=100_000))
+
+
+def _find_certificate(scenario: Scenario, directions: int = 72) -> Certificate | None:
+    """:func:`find_certificate` on validated inputs."""
     tall = _tall(scenario)
     a = np.pi * np.arange(directions) / directions
     dirs = np.column_stack([np.cos(a), np.sin(a)])

@@ -35,17 +35,71 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
-from ...errors import InvalidInputError, TautError
+from ...errors import PlanningError, TautError
 from ...sheet import simulate
+from ..._validate import require_instance
 from .. import _tol
+from .._options import RobustnessOptions, robustness_options
+from ..result import PlanResult
+from ._geometry import beneath_height
 from .verify import _sheet_slack
 from ..world import Scenario
 
 if TYPE_CHECKING:
     from ..formations.optimal import Formation
-    from ..result import PlanResult, Robustness
 
-__all__: list[str] = []
+__all__ = ["Robustness", "plan_robustness"]
+
+
+@dataclass(frozen=True, eq=False)
+class Robustness:
+    """Seeded Monte Carlo of a plan under robot position error (:func:`plan_robustness`).
+
+    Attributes
+    ----------
+    sigma : float
+        Position error, m (radius of the disc, or the standard deviation per axis).
+    noise : {"disc", "gaussian"}
+        Every robot displaced uniformly within a disc of radius ``sigma``, or by a normal
+        error of standard deviation ``sigma`` per axis, drawn independently per robot
+        every ``correlation`` seconds and linear in time in between.
+    trials : int
+    tear_probability : float
+        Fraction of trials in which some robot pair was beyond its sheet distance.
+    drop_probability : float
+        Fraction of trials in which the object's rest state ended in the quasi-static
+        replay and it fell by more than 5 mm (``MAX_OBJECT_STEP``) or reached the ground.
+    worst_extension : float
+        Largest (robot distance - sheet distance) seen, m (negative: never taut).
+    contact_probability : float
+        Fraction of trials in which the object touched an obstacle beneath the sheet or
+        the ground.
+    unsafe_probability : float
+        Fraction of trials in which the object came closer than the height safety to
+        them somewhere (the planner's rule; not by itself a failure).
+    collision_probability : float
+        Fraction of trials in which a robot's footprint touched a wall or an obstacle.
+    failure_probability : float
+        Fraction of trials with a tear, a drop, a contact or a collision.
+    worst_height_margin : float
+        Least object height above the obstacle beneath (or the ground) over the replays
+        that were not torn, m.
+    worst_clearance : float
+        Least robot-centre distance to a wall or obstacle over all trials, m.
+    """
+
+    sigma: float
+    noise: str
+    trials: int
+    tear_probability: float
+    drop_probability: float
+    worst_extension: float
+    contact_probability: float = 0.0
+    unsafe_probability: float = 0.0
+    collision_probability: float = 0.0
+    failure_probability: float = 0.0
+    worst_height_margin: float = float("nan")
+    worst_clearance: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -65,15 +119,6 @@ class Trial:
     @property
     def failed(self) -> bool:
         return self.torn or self.dropped or self.contact or self.collision
-
-
-def _beneath(scenario: Scenario, robots: np.ndarray) -> np.ndarray:
-    """Tallest obstacle under the robots' hull per sample, m (0 when none)."""
-    hulls = shapely.convex_hull(shapely.multipoints(robots))
-    out = np.zeros(len(robots))
-    for o in scenario.world.obstacles:
-        out = np.where(shapely.intersects(hulls, o.geometry), np.maximum(out, o.height), out)
-    return out
 
 
 def _clearance(scenario: Scenario, robots: np.ndarray) -> float:
@@ -97,12 +142,12 @@ def replay(scenario: Scenario, robots: np.ndarray, planned_object: np.ndarray) -
     if ext > 0:
         return Trial(True, False, False, False, collision, ext, np.nan, clear, np.nan)
     try:
-        sim = simulate(team.sheet, robots, team.hold_height, start=planned_object[0])
+        sim = simulate(team.carrier, robots, start=planned_object[0])
     except TautError:             # no rest state at the first sample: counted as a drop
         return Trial(False, True, False, False, collision, ext, np.nan, clear, np.nan)
     dropped = _dropped(sim.events)
     obj = np.asarray(sim.object)
-    margin = float(np.nanmin(obj[:, 2] - _beneath(scenario, robots)))
+    margin = float(np.nanmin(obj[:, 2] - beneath_height(scenario, robots)))
     dev = float(np.nanmax(np.linalg.norm(obj - planned_object, axis=1)))
     unsafe = margin < team.height_safety - _tol.GEOMETRY_TOL
     return Trial(False, dropped, margin <= 0.0, unsafe, collision, ext, margin, clear, dev)
@@ -129,35 +174,67 @@ def position_error(rng: np.random.Generator, times: np.ndarray, n: int, sigma: f
     return e[k] * (1 - f) + e[k + 1] * f
 
 
-def monte_carlo(scenario: Scenario, result: "PlanResult", sigma: float, trials: int, *,
-                noise: str = "disc", seed: int = 0, correlation: float = 1.0
-                ) -> "Robustness":
-    """Failure probabilities of ``result`` under robot position error ``sigma`` (m).
+def plan_robustness(result: PlanResult, sigma: float = _tol.POSITION_ACCURACY,
+                    trials: int = 200, *, noise: str = "disc", seed: int = 0,
+                    correlation: float = 1.0) -> Robustness:
+    """Probability of failure of a plan under robot position error: a seeded Monte Carlo
+    through the quasi-static simulation (module docstring).
+
+    Parameters
+    ----------
+    result : PlanResult
+        A successful plan of :func:`taut.plan.plan`.
+    sigma : float
+        Position error, m, in [0, 1].
+    trials : int
+        1 to 100000.
+    noise : {"disc", "gaussian"}
+        See :class:`Robustness`.
+    seed : int
+    correlation : float
+        Each robot's error is drawn every ``correlation`` seconds and interpolated
+        linearly in between, s (at most 3600).
 
     Returns
     -------
     Robustness
+
+    Raises
+    ------
+    InvalidInputError
+        An option out of its range (:func:`taut.plan._options.robustness_options`).
+    PlanningError
+        ``result`` is not a successful plan.
     """
-    from ..result import Robustness
-    if not (np.isfinite(sigma) and sigma >= 0):
-        raise InvalidInputError("sigma", "must be a finite length >= 0")
-    if int(trials) < 1:
-        raise InvalidInputError("trials", "must be at least 1")
-    if noise not in ("disc", "gaussian"):
-        raise InvalidInputError("noise", "must be 'disc' or 'gaussian'")
-    if not (np.isfinite(correlation) and correlation > 0):
-        raise InvalidInputError("correlation", "must be a positive time in s")
-    rng = np.random.default_rng(seed)
+    require_instance(result, PlanResult, "result")
+    options = robustness_options(sigma, trials, noise=noise, seed=seed,
+                                 correlation=correlation)
+    return monte_carlo(result, options)
+
+
+def monte_carlo(result: PlanResult, options: RobustnessOptions) -> Robustness:
+    """:func:`plan_robustness` on validated options (for front ends that validate them
+    before planning, such as ``taut plan --robustness``).
+
+    Raises
+    ------
+    PlanningError
+        ``result`` is not a successful plan.
+    """
+    if not result.success or result.scenario is None:
+        raise PlanningError("plan", "robustness needs a successful plan")
+    scenario, o = result.scenario, options
+    rng = np.random.default_rng(o.seed)
     R, times = np.asarray(result.robots), np.asarray(result.times)
-    out = [replay(scenario, R + position_error(rng, times, R.shape[1], sigma, noise,
-                                               float(correlation)),
-                  np.asarray(result.object)) for _ in range(int(trials))]
+    out = [replay(scenario, R + position_error(rng, times, R.shape[1], o.sigma, o.noise,
+                                               o.correlation),
+                  np.asarray(result.object)) for _ in range(o.trials)]
 
     def p(flag: str) -> float:
         return sum(getattr(t, flag) for t in out) / len(out)
 
     margins = [t.height_margin for t in out if np.isfinite(t.height_margin)]
-    return Robustness(float(sigma), noise, int(trials), p("torn"), p("dropped"),
+    return Robustness(o.sigma, o.noise, o.trials, p("torn"), p("dropped"),
                       max(t.extension for t in out), p("contact"), p("unsafe"),
                       p("collision"), p("failed"), min(margins, default=np.nan),
                       min(t.clearance for t in out))
@@ -208,7 +285,7 @@ def _drops(scenario: Scenario, robots: np.ndarray, start: np.ndarray) -> bool:
     it by more than ``MAX_OBJECT_STEP``?"""
     team = scenario.team
     try:
-        sim = simulate(team.sheet, robots, team.hold_height, start=start)
+        sim = simulate(team.carrier, robots, start=start)
     except TautError:
         return True
     return _dropped(sim.events)

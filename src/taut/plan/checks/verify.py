@@ -47,15 +47,16 @@ import numpy as np
 from numpy.typing import ArrayLike
 import shapely
 
-from ..._outcome import check_status, deprecated_alias
+from ..._outcome import check_status
 from ...errors import InvalidInputError, TautError
 from ...sheet import check_formations, forward_kinematics
 from ...sheet import simulate
 from .. import _tol
-from ._geometry import Shapes, pair_closest, prove_between, rigid_fits, shapes_of
+from ._geometry import Shapes, pair_closest, pair_slack, prove_between, rigid_fits, shapes_of
 from ..world import Scenario
 from ..._validate import (MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance,
     require_nonempty)
+from .._tol import MAX_SHEET_MARGIN_M
 
 __all__ = ["Verification", "verify_motion", "resample_motion"]
 
@@ -106,10 +107,6 @@ class Verification:
     def __post_init__(self) -> None:
         check_status(self.status)
 
-    ok = deprecated_alias("success", "ok")
-    reason = deprecated_alias("message", "reason",
-                              transform=lambda self, m: None if self.success else m)
-
 
 def _rigid_fit(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Rotation (2, 2) and translation (2,) best mapping points ``a`` onto ``b`` (Kabsch,
@@ -146,7 +143,7 @@ def _simulate_run(scenario: Scenario, robots: np.ndarray, start: np.ndarray,
         lo = np.floor(s).astype(int).clip(0, len(robots) - 2)
         f = (s - lo)[:, None, None]
         fine = robots[lo] * (1 - f) + robots[np.minimum(lo + 1, len(robots) - 1)] * f
-        sim = simulate(team.sheet, fine, team.hold_height, start=start)
+        sim = simulate(team.carrier, fine, start=start)
         bad = [e for e in sim.events if e.kind in ("jump", "lost")]
         if bad:
             e = bad[0]
@@ -176,7 +173,7 @@ def _model_states(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
     team = scenario.team
     size = team.sheet.size
     T = len(robots)
-    fk0 = forward_kinematics(team.sheet, robots[0], team.hold_height)
+    fk0 = forward_kinematics(team.carrier, robots[0])
     if not fk0.stable:
         return None, (), 0.0, "no stable rest state at the first sample", None
     lowest = fk0.lowest
@@ -266,10 +263,7 @@ def _least_gap(robots: np.ndarray, rigid: np.ndarray) -> float:
 
 def _sheet_slack(scenario: Scenario, robots: np.ndarray) -> tuple[float, int, int, int]:
     """Least (sheet distance - robot distance), m, and where (sample, i, j)."""
-    V = scenario.team.sheet.vertices
-    iu, ju = np.triu_indices(V.shape[0], 1)
-    slack = (np.linalg.norm(V[iu] - V[ju], axis=1)[None]
-             - np.linalg.norm(robots[:, iu] - robots[:, ju], axis=2))
+    slack, iu, ju = pair_slack(scenario, robots)
     t, p = np.unravel_index(int(np.argmin(slack)), slack.shape)
     return float(slack[t, p]), int(t), int(iu[p]), int(ju[p])
 
@@ -297,15 +291,25 @@ def verify_motion(scenario: Scenario, robots: ArrayLike, planned_object: ArrayLi
         ``success`` False with the first failed check in ``message``.
     """
     require_instance(scenario, Scenario, "scenario")
-    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
-    as_bounded(max_object_step, "max_object_step", MAX_SHEET_LENGTH, "m", positive=False)
+    sheet_margin = as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_MARGIN_M, "m",
+                              positive=False)
+    max_object_step = as_bounded(max_object_step, "max_object_step", MAX_SHEET_LENGTH, "m",
+                                 positive=False)
     robots = as_array(robots, "robots", shape=(None, scenario.team.sheet.n, 2))
     if _shape(planned_object) != (len(robots), 3):        # NaN marks unplanned samples
         raise InvalidInputError("planned_object", f"must have shape {len(robots)}x3")
     require_nonempty(robots, "robots")
+    return _verify_motion(scenario, np.asarray(robots, dtype=float),
+                          np.asarray(planned_object, dtype=float), sheet_margin,
+                          max_object_step)
+
+
+def _verify_motion(scenario: Scenario, robots: np.ndarray, planned: np.ndarray,
+                   sheet_margin: float, max_object_step: float = _tol.MAX_OBJECT_STEP
+                   ) -> Verification:
+    """:func:`verify_motion` on validated inputs: ``robots`` (T, N, 2) and ``planned``
+    (T, 3) float arrays, m."""
     team = scenario.team
-    robots = np.asarray(robots, dtype=float)
-    planned = np.asarray(planned_object, dtype=float)
     T, N = robots.shape[:2]
 
     def fail(why: str, obj=None, taut=(), slack=-np.inf) -> Verification:

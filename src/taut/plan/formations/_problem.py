@@ -145,8 +145,7 @@ def _curvature_constraint(team: Team, prob: _Problem, s: float):
     def curvature(z: np.ndarray) -> np.ndarray:
         vo, zo, th, w, _ = prob.dec.split(z)
         try:
-            c = ik_constraints(team.sheet, [0.0, 0.0, zo * s], team.hold_height, th, w,
-                               contact=vo * s)
+            c = ik_constraints(team.carrier, [0.0, 0.0, zo * s], th, w, contact=vo * s)
         except TautError:
             return np.array([-1.0])
         k = float(np.min(c.curvature))
@@ -158,7 +157,7 @@ def _nominal_ik(team: Team, heights: np.ndarray):
     """First IK solution at the sheet centroid among object ``heights`` (m)."""
     for zo in heights:
         try:
-            ik = inverse_kinematics(team.sheet, [0.0, 0.0, zo], team.hold_height)
+            ik = inverse_kinematics(team.carrier, [0.0, 0.0, zo])
         except TautError:              # e.g. the object at or above the hold height
             continue
         if ik.success:                 # unreachable / budget exhausted: try the next height
@@ -180,7 +179,7 @@ def _problem(team: Team, kind: str, height: float, diameter: float, width: float
     V = sheet.vertices / s
     iu, ju = np.triu_indices(N, 1)
     vd = np.linalg.norm(V[iu] - V[ju], axis=1) - sheet_margin / s
-    sep = max(2 * team.robot_radius, (diameter + 2 * team.side_safety) if crossing else 0.0)
+    sep = max(2 * team.robot_radius, (diameter + 2 * team.clearance) if crossing else 0.0)
     # Cheap necessary condition first: every pair gap is at most its sheet distance
     # (15c) and at least ``sep`` (15b), so a sheet pair closer than ``sep`` is infeasible.
     if np.any(vd <= 0) or np.any(vd < sep / s):
@@ -189,7 +188,7 @@ def _problem(team: Team, kind: str, height: float, diameter: float, width: float
     if start is None:
         return None, None
     prob = _Problem(V=V, zr=zr / s, z_lo=z_lo, z_hi=z_hi, sep=sep / s,
-                    ds=team.side_safety / s, w_ref=(width if width is not None else 4 * s) / s,
+                    ds=team.clearance / s, w_ref=(width if width is not None else 4 * s) / s,
                     r_max=1e6 if max_reach is None else (max_reach - team.clearance) / s,
                     vd2=vd ** 2 * (1 - _tol.STRICT_SLACK), rho0=start.reach / s, crossing=crossing,
                     weights=weights or (COMPACT if kind in ("compact", "narrow")

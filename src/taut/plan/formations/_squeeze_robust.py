@@ -1,5 +1,5 @@
 """Does a formation's rest state survive the robots' position error? (Our requirement on
-squeezed formations, :mod:`taut.plan.formations.squeezed`.)
+squeezed formations, :mod:`taut.plan.formations._squeezed`.)
 
 A formation with slack cables can be stable yet sit in so flat a valley of the potential
 that a few millimetres of robot error slide the object tens of centimetres, out of its taut

@@ -12,13 +12,14 @@ import numpy as np
 
 from .. import _tol
 from ...sheet import FKSolver
-from .squeezed import squeezed_formation
+from ._squeezed import _squeezed_formation
 from ._squeeze_robust import tolerates
 from ..checks.certificate import narrowest_cut
-from .optimal import MIN_DEPTH_FRACTION, Formation, optimal_formation
+from .optimal import MIN_DEPTH_FRACTION, Formation, _optimal_formation
 from ..result import compact_formation
 from ..world import Scenario
-from ..._validate import MAX_SHEET_LENGTH, as_bounded, require_instance
+from ..._validate import as_bounded, require_instance
+from .._tol import MAX_SHEET_MARGIN_M
 
 __all__ = ["formation_library"]
 
@@ -44,33 +45,57 @@ def _why_not_crossable(scenario: Scenario, h: float, ids: str) -> str:
     return f"obstacle {ids} ({h:.3g} m tall) cannot be crossed: {why}"
 
 
-def formation_library(scenario: Scenario, sheet_margin: float = 0.0) -> Library:
-    """The compact formation; the others (the narrow one when it differs, and the crossing
-    formations, one per obstacle-height class, eqs. 11-15, preferring one that fits the
-    widest passage); and why some height classes have none."""
+def formation_library(scenario: Scenario, *, sheet_margin: float = 0.0) -> Library:
+    """The formation library of the SE(2) planner for ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    sheet_margin : float
+        Every robot pair stays this far inside its sheet distance, m.
+
+    Returns
+    -------
+    compact : Formation
+        The most compact stable all-taut formation.
+    others : list of Formation
+        The narrow one when it differs, and the crossing formations, one per
+        obstacle-height class (eqs. 11-15), preferring one that fits the widest passage.
+    notes : list of str
+        Why some height classes have no crossing formation.
+
+    Raises
+    ------
+    PlanningError
+        The team cannot hold the object at all.
+    """
     require_instance(scenario, Scenario, "scenario")
-    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
+    margin = as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_MARGIN_M, "m", positive=False)
+    return _formation_library(scenario, margin)
+
+
+def _formation_library(scenario: Scenario, sheet_margin: float) -> Library:
+    """:func:`formation_library` on validated inputs."""
     world, team = scenario.world, scenario.team
     compact = compact_formation(scenario, sheet_margin)
     crossing, notes = [], []
     # Triangles use the compact formation: their narrow one (least width, object at the
     # height safety) lost the object under 5 mm of position error on all 26 triangles of
     # the two benchmark suites (seeds 2024 and 5000), e.g. 0.368 m against 0.486 m wide.
-    narrow = None if team.n <= 3 else optimal_formation(team, kind="narrow",
-                                                        width=world.width,
-                                                        sheet_margin=sheet_margin)
+    narrow = None if team.n <= 3 else _optimal_formation(team, "narrow", width=world.width,
+                                                         sheet_margin=sheet_margin)
     if (narrow is not None and _min_width(narrow) < _min_width(compact) - _tol.NARROWER_BY
             and _robust(team, narrow)):
         crossing.append(narrow)
     for h in _height_classes(scenario):
         group = [o for o in world.obstacles if o.height <= h]
         diameter = max(o.diameter for o in group)
-        f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
-                              width=world.width, max_reach=0.49 * world.width,
-                              sheet_margin=sheet_margin)
+        f = _optimal_formation(team, "crossing", height=h, diameter=diameter,
+                               width=world.width, max_reach=0.49 * world.width,
+                               sheet_margin=sheet_margin)
         if f is None:
-            f = optimal_formation(team, kind="crossing", height=h, diameter=diameter,
-                                  width=world.width, sheet_margin=sheet_margin)
+            f = _optimal_formation(team, "crossing", height=h, diameter=diameter,
+                                   width=world.width, sheet_margin=sheet_margin)
         ids = ", ".join(repr(o.id) for o in group if o.height == h)
         if f is None:
             notes.append(_why_not_crossable(scenario, h, ids))
@@ -90,7 +115,7 @@ def _robust(team, f: Formation) -> bool:
     5 mm, :func:`~taut.plan.formations._squeeze_robust.tolerates`)? A formation holding the object
     with the sheet nearly flat (every pair near its sheet distance) loses it under some.
     (Squeezed formations pass a stricter form of this check when they are designed.)"""
-    solver = FKSolver(team.sheet, team.hold_height)
+    solver = FKSolver(team.carrier)
     fk = solver.solve(np.ascontiguousarray(f.robots, dtype=float)).stable
     e = min(fk, key=lambda e: abs(e.height - f.object_height))
     return tolerates(solver, np.asarray(f.robots, dtype=float), e, 0.0, max_shift=np.inf)
@@ -104,7 +129,7 @@ def _library(scenario: Scenario, sheet_margin: float
              ) -> tuple[Formation, tuple[Formation, ...], tuple[str, ...]]:
     """:func:`formation_library`, memoised per scenario object (the optimisations of
     eqs. 11-15 dominate a plan's time; baselines and re-plans reuse them)."""
-    compact, others, notes = formation_library(scenario, sheet_margin)
+    compact, others, notes = _formation_library(scenario, sheet_margin)
     return compact, tuple(others), tuple(notes)
 
 
@@ -137,8 +162,8 @@ def _squeeze_width(scenario: Scenario, forms: list[Formation], allow_crossing: b
 
 @functools.lru_cache(maxsize=64)
 def _squeezed(scenario: Scenario, sheet_margin: float, width: float) -> Formation | None:
-    """:func:`~taut.plan.formations.squeezed.squeezed_formation` for ``width``, memoised."""
-    return squeezed_formation(scenario.team, sheet_margin=sheet_margin, width=width)
+    """:func:`~taut.plan.formations._squeezed.squeezed_formation` for ``width``, memoised."""
+    return _squeezed_formation(scenario.team, sheet_margin, width)
 
 
 def _with_squeezed(scenario: Scenario, forms: list[Formation], allow_crossing: bool,

@@ -59,6 +59,7 @@ from scipy.optimize import minimize
 from ...errors import TautError
 from ...sheet import forward_kinematics, formation_metrics, ik_constraints
 from .. import _tol
+from .._tol import MAX_SHEET_MARGIN_M
 from ._problem import (MIN_DEPTH_FRACTION, CostWeights, _curvature_constraint, _Decision,
     _nominal_ik, _problem)
 from ..world import Team
@@ -69,6 +70,7 @@ __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
 
 #: The formations :func:`optimal_formation` designs (its ``kind``).
 FormationKind = Literal["crossing", "compact", "narrow"]
+FORMATION_KINDS: tuple[str, ...] = ("crossing", "compact", "narrow")
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,9 +87,11 @@ class Formation:
         :math:`\\mathbf{v}_o` in the sheet frame.
     weights : ndarray, shape (N,)
         Load shares :math:`w_i`.
-    kind : {"crossing", "compact"}
+    kind : {"crossing", "compact", "narrow", "squeezed"}
+        What it was designed for (:func:`optimal_formation`'s ``kind``, or a squeezed
+        formation of :mod:`taut.plan.formations._squeezed`).
     size : float
-        :math:`S_f` of eq. (1) with :math:`\\delta_s` the team's side safety, m.
+        :math:`S_f` of eq. (1) with :math:`\\delta_s` the team's ``clearance``, m.
     max_height : float
         :math:`h_{max}` of eq. (2), m.
     min_distance : float
@@ -118,13 +122,13 @@ class Formation:
     def n(self) -> int:
         return int(self.robots.shape[0])
 
-    def placed(self, centre: ArrayLike, heading: ArrayLike) -> np.ndarray:
-        """Robots (..., N, 2) with the object's projection at ``centre`` (..., 2) and the
+    def placed(self, center: ArrayLike, heading: ArrayLike) -> np.ndarray:
+        """Robots (..., N, 2) with the object's projection at ``center`` (..., 2) and the
         formation turned by ``heading`` (...) radians."""
         h = np.asarray(heading, dtype=float)
         c, s = np.cos(h)[..., None], np.sin(h)[..., None]
         x, y = self.robots[:, 0], self.robots[:, 1]
-        p = np.asarray(centre, dtype=float)[..., None, :]
+        p = np.asarray(center, dtype=float)[..., None, :]
         out = np.empty(np.broadcast_shapes(c.shape[:-1] + x.shape, p.shape[:-1]) + (2,))
         out[..., 0] = c * x - s * y + p[..., 0]     # the hot path of the SE(2) search:
         out[..., 1] = s * x + c * y + p[..., 1]     # no stacking, no temporary (.., N, 2)
@@ -154,7 +158,13 @@ def crossing_pairs(formation: Formation, clearance: float) -> list[tuple[float, 
         :math:`|\\Delta|`.
     """
     require_instance(formation, Formation, "formation")
-    as_bounded(clearance, "clearance", MAX_SHEET_LENGTH, "m", positive=False)
+    clearance = as_bounded(clearance, "clearance", MAX_SHEET_LENGTH, "m", positive=False)
+    return _crossing_pairs(formation, clearance)
+
+
+def _crossing_pairs(formation: Formation, clearance: float
+                    ) -> list[tuple[float, float, float]]:
+    """:func:`crossing_pairs` on validated inputs."""
     p = formation.robots
     order = _hull_order(p)
     mids = (p[order] + p[np.roll(order, -1)]) / 2
@@ -195,8 +205,14 @@ def offset_crossings(formation: Formation, clearance: float, directions: int = 3
         Offset interval :math:`[e_{lo}, e_{hi}]` of the obstacle's path from the object, m.
     """
     require_instance(formation, Formation, "formation")
-    as_bounded(clearance, "clearance", MAX_SHEET_LENGTH, "m", positive=False)
+    clearance = as_bounded(clearance, "clearance", MAX_SHEET_LENGTH, "m", positive=False)
     directions = as_count(directions, "directions", minimum=1, maximum=100_000)
+    return _offset_crossings(formation, clearance, directions)
+
+
+def _offset_crossings(formation: Formation, clearance: float, directions: int = 36
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`offset_crossings` on validated inputs."""
     a = 2 * np.pi * np.arange(directions) / directions
     n = np.column_stack([-np.sin(a), np.cos(a)])
     proj = np.sort(formation.robots @ n.T, axis=0)          # (N, K)
@@ -245,25 +261,35 @@ def optimal_formation(team: Team, *, kind: FormationKind = "crossing", height: f
     Examples
     --------
     >>> import numpy as np
-    >>> from taut.sheet import Sheet
+    >>> from taut.sheet import Sheet, SheetTeam
     >>> from taut.plan import Team, optimal_formation
-    >>> team = Team(Sheet.regular(3, 1 / np.sqrt(3)), hold_height=0.5, robot_radius=0.15,
+    >>> team = Team(SheetTeam(Sheet.regular(3, 1 / np.sqrt(3)), 0.5), robot_radius=0.15,
     ...             height_safety=0.05, lateral_safety=0.05, speed=0.1, rotation_speed=0.3)
     >>> f = optimal_formation(team, kind="crossing", height=0.2, diameter=0.3)
     >>> round(f.max_height, 6), bool(f.max_diameter >= 0.3 - 1e-9)
     (0.2, True)
     """
     require_instance(team, Team, "team")
-    as_choice(kind, ("crossing", "compact", "narrow"), "kind")
-    as_bounded(height, "height", MAX_SHEET_LENGTH, "m", positive=False)
-    as_bounded(diameter, "diameter", MAX_SHEET_LENGTH, "m", positive=False)
-    as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m", positive=False)
+    as_choice(kind, FORMATION_KINDS, "kind")
+    height = as_bounded(height, "height", MAX_SHEET_LENGTH, "m", positive=False)
+    diameter = as_bounded(diameter, "diameter", MAX_SHEET_LENGTH, "m", positive=False)
+    sheet_margin = as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_MARGIN_M, "m",
+                              positive=False)
     if width is not None:
-        as_bounded(width, "width", MAX_SHEET_LENGTH, "m", positive=False)
+        width = as_bounded(width, "width", MAX_SHEET_LENGTH, "m", positive=False)
     if max_reach is not None:
-        as_bounded(max_reach, "max_reach", MAX_SHEET_LENGTH, "m", positive=False)
+        max_reach = as_bounded(max_reach, "max_reach", MAX_SHEET_LENGTH, "m", positive=False)
     if weights is not None:
         require_instance(weights, CostWeights, "weights")
+    return _optimal_formation(team, kind, height=height, diameter=diameter, width=width,
+                              max_reach=max_reach, weights=weights, sheet_margin=sheet_margin)
+
+
+def _optimal_formation(team: Team, kind: str, *, height: float = 0.0, diameter: float = 0.0,
+                       width: float | None = None, max_reach: float | None = None,
+                       weights: CostWeights | None = None, sheet_margin: float = 0.0
+                       ) -> Formation | None:
+    """:func:`optimal_formation` on validated inputs."""
     prob, start = _problem(team, kind, height, diameter, width, max_reach, weights,
                            float(sheet_margin))
     if prob is None:
@@ -299,17 +325,16 @@ def _finish(team: Team, z: np.ndarray, dec: _Decision, s: float, cost: float, ki
             ) -> Formation | None:
     """Re-derive the formation exactly from (v_o, z_o, angles) and accept it only when
     forward kinematics finds it as a stable all-taut equilibrium."""
-    sheet, zr = team.sheet, team.hold_height
     N = dec.n
     contact, zn, th, _, _ = dec.split(z)
     vo, zo = contact * s, zn * s
     try:
-        c = ik_constraints(sheet, [0.0, 0.0, zo], zr, th, contact=vo)
+        c = ik_constraints(team.carrier, [0.0, 0.0, zo], th, contact=vo)
     except TautError:
         return None
     robots = c.formation
     try:
-        fk = forward_kinematics(sheet, robots, zr)
+        fk = forward_kinematics(team.carrier, robots)
     except TautError:
         return None
     target = np.array([0.0, 0.0, zo])
@@ -318,7 +343,7 @@ def _finish(team: Team, z: np.ndarray, dec: _Decision, s: float, cost: float, ki
     if not match:
         return None
     e = match[0]
-    m = formation_metrics(robots, margin=team.side_safety, object_height=e.height,
+    m = formation_metrics(robots, margin=team.clearance, object_height=e.height,
                           height_margin=team.height_safety)
     reach = float(np.linalg.norm(robots - e.object[:2], axis=1).max()) + team.clearance
     robots = robots - e.object[:2]

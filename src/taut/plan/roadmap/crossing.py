@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _tol
-from ..formations.optimal import Formation, crossing_pairs, offset_crossings
+from ..formations.optimal import Formation, _crossing_pairs, _offset_crossings
 from ...sheet import forward_kinematics
 from .route import Leg, Route
 from ..world import Scenario
@@ -89,8 +89,8 @@ class Motion:
     ----------
     times : ndarray, shape (T,)
         s, increasing from 0.
-    centre : ndarray, shape (T, 2)
-        Object projection, m.
+    center : ndarray, shape (T, 2)
+        Object projection, m (named as :attr:`Obstacle.center <taut.plan.Obstacle>`).
     heading : ndarray, shape (T,)
         Formation rotation, rad (unwrapped).
     robots : ndarray, shape (T, N, 2)
@@ -100,7 +100,7 @@ class Motion:
     """
 
     times: np.ndarray
-    centre: np.ndarray
+    center: np.ndarray
     heading: np.ndarray
     robots: np.ndarray
     object: np.ndarray
@@ -113,7 +113,7 @@ class Motion:
     @property
     def path_length(self) -> float:
         """Planar length of the object's path, m."""
-        return float(np.linalg.norm(np.diff(self.centre, axis=0), axis=1).sum())
+        return float(np.linalg.norm(np.diff(self.center, axis=0), axis=1).sum())
 
 
 class _Builder:
@@ -172,7 +172,7 @@ def _fill_reforms(scenario: Scenario, robots: np.ndarray, obj: np.ndarray) -> No
     kinematics nearest to the previous state, sample by sample (in place)."""
     team = scenario.team
     for t in np.flatnonzero(np.isnan(obj[:, 2])):
-        fk = forward_kinematics(team.sheet, robots[t], team.hold_height)
+        fk = forward_kinematics(team.carrier, robots[t])
         if not fk.stable:
             return                              # verification will reject the plan
         prev = obj[t - 1]
@@ -184,7 +184,7 @@ def _straight_heading(f: Formation, clearance: float, direction: float, offset: 
     """Formation heading for a straight offset crossing that needs the least turn from
     ``current``: among 360 sampled headings, those for which the obstacle's path (offset
     ``offset`` from the object's path, world frame) keeps ``clearance`` from every robot."""
-    phi, lo, hi = offset_crossings(f, clearance, directions=360)
+    phi, lo, hi = _offset_crossings(f, clearance, directions=360)
     e = float(np.dot(offset, [-np.sin(direction), np.cos(direction)]))
     ok = (lo <= e) & (e <= hi)
     if not ok.any():
@@ -215,10 +215,15 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
     if legs is not None:
         legs = require_instances(legs, Leg, "legs")
     if isinstance(formation, Route):
-        forms, legs, first = formation.formations, formation.legs, formation.first
-    else:
-        forms, first = (formation,), 0
-    legs = legs or ()
+        return _motion_from_legs(scenario, formation.formations, formation.legs,
+                                 formation.first)
+    return _motion_from_legs(scenario, (formation,), legs or (), 0)
+
+
+def _motion_from_legs(scenario: Scenario, forms: tuple[Formation, ...],
+                      legs: tuple[Leg, ...], first: int) -> Motion:
+    """:func:`motion_from_legs` on validated inputs: the formations ``forms`` legs refer
+    to, starting in ``forms[first]``."""
     team = scenario.team
     b = _Builder(forms[first], team.speed, team.rotation_speed, scenario.start)
     records = []
@@ -247,7 +252,7 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
             records.append(CrossingRecord(o.id, np.array([t0, t1, t2, t2, b.t[-1]]), du, ang,
                                           _wrap(ang + np.pi), 0.0, "straight"))
             continue
-        pairs = crossing_pairs(f, o.mec_radius + team.clearance)
+        pairs = _crossing_pairs(f, o.mec_radius + team.clearance)
         best = abs(pairs[0][2])
         cands = [p for p in pairs if abs(abs(p[2]) - best) <= _tol.TURN_TIE]
         h = b.h[-1]
@@ -263,10 +268,10 @@ def motion_from_legs(scenario: Scenario, formation: Formation | Route,
         records.append(CrossingRecord(o.id, np.array([t0, t1, t2, t3, b.t[-1]]), du, a_in,
                                       a_out, turn))
     times = np.asarray(b.t)
-    centre = np.asarray(b.c)
+    center = np.asarray(b.c)
     robots = np.asarray(b.robots)
-    obj = np.column_stack([centre, np.asarray(b.z)])
+    obj = np.column_stack([center, np.asarray(b.z)])
     if np.isnan(obj[:, 2]).any():
         obj[np.isnan(obj[:, 2]), :2] = np.nan
         _fill_reforms(scenario, robots, obj)
-    return Motion(times, centre, np.asarray(b.h), robots, obj, tuple(records))
+    return Motion(times, center, np.asarray(b.h), robots, obj, tuple(records))

@@ -34,9 +34,9 @@ from shapely.geometry import Point
 from shapely.geometry.polygon import orient
 from shapely.ops import unary_union
 
-from ..._outcome import check_status, deprecated_alias
+from ..._outcome import check_status
 from .. import _tol
-from ..formations.optimal import Formation, crossing_pairs, offset_crossings
+from ..formations.optimal import Formation, _crossing_pairs, _offset_crossings
 from ..world import Obstacle, Scenario
 from ..._validate import as_flag, require_instance, require_instances
 
@@ -103,10 +103,6 @@ class Route:
     def __post_init__(self) -> None:
         check_status(self.status)
 
-    found = deprecated_alias("success", "found")
-    reason = deprecated_alias("message", "reason",
-                              transform=lambda self, m: None if self.success else m)
-
     @property
     def crossed(self) -> tuple[str, ...]:
         return tuple(str(leg.obstacle) for leg in self.legs if leg.kind == "cross")
@@ -125,8 +121,8 @@ def crossable(scenario: Scenario, formation: Formation, obstacle: Obstacle, *,
         return (f"obstacle {obstacle.id!r} is {obstacle.diameter:.3g} m wide, at most "
                 f"{max(formation.max_diameter, 0):.3g} m fits between the robots")
     c = obstacle.mec_radius + team.clearance
-    if not crossing_pairs(formation, c) and not (straight and len(offset_crossings(formation,
-                                                                                 c)[0])):
+    if not _crossing_pairs(formation, c) and not (straight
+                                                  and len(_offset_crossings(formation, c)[0])):
         return f"no side of the formation lets obstacle {obstacle.id!r} pass under the sheet"
     return None
 
@@ -215,14 +211,14 @@ class _Layer:
         c = o.mec_radius + team.clearance
         a = 2 * np.pi * np.arange(DIRECTIONS) / DIRECTIONS
         u = np.column_stack([np.cos(a), np.sin(a)])
-        pairs = crossing_pairs(formation, c)
+        pairs = _crossing_pairs(formation, c)
         if pairs:
             L = R + o.mec_radius + _EPS * max(R, 1.0)
             yield (o.mec_center - L * u, o.mec_center + L * u,
                    np.full(DIRECTIONS, 2 * L / v + abs(pairs[0][2]) / omega), None)
         if not straight:
             return
-        phi, lo, hi = offset_crossings(formation, c)
+        phi, lo, hi = _offset_crossings(formation, c)
         if not len(phi):
             return
         extent = float(np.linalg.norm(formation.robots, axis=1).max())
@@ -377,13 +373,18 @@ def find_route(scenario: Scenario, formation: Formation | Sequence[Formation], *
     """
     require_instance(scenario, Scenario, "scenario")
     if isinstance(formation, (list, tuple)):
-        require_instances(formation, Formation, "formation", min_count=1)
+        forms = list(require_instances(formation, Formation, "formation", min_count=1))
     else:
-        require_instance(formation, Formation, "formation")
-    allow_crossing = as_flag(allow_crossing, "allow_crossing")
-    straight_crossings = as_flag(straight_crossings, "straight_crossings")
+        forms = [require_instance(formation, Formation, "formation")]
+    return _find_route(scenario, forms,
+                       allow_crossing=as_flag(allow_crossing, "allow_crossing"),
+                       straight_crossings=as_flag(straight_crossings, "straight_crossings"))
+
+
+def _find_route(scenario: Scenario, forms: list[Formation], *, allow_crossing: bool,
+                straight_crossings: bool) -> Route:
+    """:func:`find_route` on validated inputs (one formation or more, in a list)."""
     team = scenario.team
-    forms = [formation] if isinstance(formation, Formation) else list(formation)
     layers = [_Layer(scenario, f, allow_crossing, straight_crossings) for f in forms]
     why = _ends_message(layers, scenario, min(f.reach for f in forms))
     if why is not None:

@@ -7,7 +7,7 @@ spacing. A* (:mod:`taut.plan._kernels.lattice`) searches the layers together: ri
 to the 26 lattice neighbours where the straight motion is *proved* valid, and in-place
 formation changes where they are valid for the geometry (every robot moving straight,
 obstacles under the hull low enough for the lowest object on the way) and for the
-quasi-static model (:func:`~taut.plan.se2.motion.change_profile`: no jump, the change ends
+quasi-static model (:func:`~taut.plan.se2._motion.change_profile`: no jump, the change ends
 in the new formation's rest state; the model is invariant under planar rigid motions, so
 one simulation per ordered pair of formations decides it everywhere). A change on the path
 found must also keep the object under the robots' position error
@@ -37,8 +37,8 @@ from .. import _tol
 from .._kernels.lattice import OFFSETS, lattice_astar
 from ._rrt import shortcut
 from .._kernels.clearance import motion_clear
-from .motion import Piece, change_profile
-from .space import PoseChecker
+from ._motion import Piece, change_profile
+from ._space import PoseChecker
 from ..checks.robustness import change_tolerates
 from ..formations.optimal import Formation
 from ..world import Scenario

@@ -3,8 +3,8 @@
 
 One formation's poses ``(x, y, psi)`` form OMPL's ``SE2StateSpace`` with the same position
 bounds as taut's own search; states are valid by
-:meth:`~taut.plan.se2.space.PoseChecker.valid` and motions by
-:meth:`~taut.plan.se2.space.PoseChecker.motion_valid` (a ``MotionValidator`` subclass,
+:meth:`~taut.plan.se2._space.PoseChecker.valid` and motions by
+:meth:`~taut.plan.se2._space.PoseChecker.motion_valid` (a ``MotionValidator`` subclass,
 so OMPL's collision-free motions are exactly the ones taut proves valid per interval).
 The distance is taut's ``|dp| + R |dpsi|`` (the SO(2) subspace weighted by the formation's
 radius ``R``), so OMPL's range is the same largest robot displacement per tree edge as
@@ -54,7 +54,7 @@ import numpy as np
 
 from ...errors import InvalidInputError
 from ._rrt import SearchOutcome, rrt_connect
-from .space import PoseChecker
+from ._space import PoseChecker
 from .._tol import MIN_ROTATION_WEIGHT
 
 __all__ = ["OMPL_SEARCHES", "Search", "SEARCHES", "engine", "ompl_search", "unwrap_shortest"]
@@ -279,12 +279,10 @@ def _solve_prm(ob: Any, planner: Any, pdef: Any, budget: _Budget) -> None:
 
 
 def engine(search: str) -> Callable[..., SearchOutcome] | None:
-    """The sampling search of ``plan(..., search=...)`` (None: taut's own RRT-Connect, also
-    the one ``"auto"`` and ``"lattice"`` name); raises InvalidInputError for an unknown
-    name or when OMPL is not installed."""
-    if not isinstance(search, str) or search not in SEARCHES:
-        raise InvalidInputError("search", f"must be one of {', '.join(map(repr, SEARCHES))}, "
-                                          f"got {search!r}")
+    """The sampling search of ``plan(..., search=...)`` for a name of :data:`SEARCHES`
+    (validated by :func:`taut.plan._options.plan_options`; None: taut's own RRT-Connect,
+    also the one ``"auto"`` and ``"lattice"`` name); raises InvalidInputError when OMPL is
+    not installed."""
     if search in ("auto", "lattice", "rrtconnect"):
         return None
     _modules()

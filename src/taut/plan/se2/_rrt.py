@@ -1,5 +1,5 @@
 """Seeded bidirectional RRT (RRT-Connect, Kuffner & LaValle 2000) in SE(2) with path
-shortcutting, on a :class:`~taut.plan.se2.space.PoseChecker`.
+shortcutting, on a :class:`~taut.plan.se2._space.PoseChecker`.
 
 States are ``(x, y, psi)``; the distance is the largest robot displacement bound
 ``|dp| + R |dpsi|`` (``R`` the formation's radius about the object), so one step moves no
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .space import PoseChecker
+from ._space import PoseChecker
 
 __all__ = ["SearchOutcome", "rrt_connect", "shortcut", "valid_headings"]
 

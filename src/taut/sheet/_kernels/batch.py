@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..._jit import jit
-from .small import (INFEASIBLE, _candidates, _frame, classify_survivors, feasible, similar_fit,
-    solve_formation)
+from .small import (INFEASIBLE, _candidates, _frame, append_rows, classify_survivors, feasible,
+    similar_fit, solve_formation)
 
 __all__ = ["solve_formations_ws", "solve_packed", "pack"]
 
@@ -82,16 +82,7 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
                  sol, taut, key, order, ang)
         if k < 0:
             return rows[:M], form[:M], b
-        if M + k > cap:
-            cap = max(2 * cap, M + k)
-            grown = np.empty((cap, W))
-            grown[:M] = rows[:M]
-            rows = grown
-            gform = np.empty(cap, dtype=np.int64)
-            gform[:M] = form[:M]
-            form = gform
-        rows[M:M + k] = buf[:k]
-        form[M:M + k] = b
+        rows, form = append_rows(rows, form, M, buf, k, b)
         M += k
     return rows[:M], form[:M], -1
 

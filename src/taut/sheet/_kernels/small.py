@@ -1,7 +1,7 @@
 """Compiled forward kinematics for small teams: every taut-set candidate of at most five
 cables, solved and classified in one numba function per formation.
 
-The same decisions as the numpy path (``fk._solve_as_given`` with a subset table, then
+The same decisions as the numpy path (``fk._solve._solve_as_given`` with a subset table, then
 ``_finalize.classify``), in the same order (docs/sheet_kinematics.md §1-§5):
 
 1. normalised frame (formation and sheet centred, lengths over the sheet size);
@@ -12,15 +12,15 @@ The same decisions as the numpy path (``fk._solve_as_given`` with a subset table
    exact taut set (``TAUT_TOL``);
 4. one row per taut set (the candidate that *is* the taut set preferred), ordered by
    taut-set size then taut set; the paper's projection test (``INSIDE_WEIGHT``,
-   ``ANGLE_TOL``); status from the weights' signs (``WEIGHT_TOL``) and the reduced
-   Hessian (``CURVATURE_TOL``).
+   ``ANGLE_TOL``); kind (stable, saddle, not an equilibrium) from the weights' signs
+   (``WEIGHT_TOL``) and the reduced Hessian (``CURVATURE_TOL``).
 
 Rows whose taut set is larger than their candidate (a weight *family*, e.g. Lemma 2) get
-status ``PENDING``: their weights need an LP, done by the caller in Python exactly as the
+kind ``PENDING``: their weights need an LP, done by the caller in Python exactly as the
 numpy path does. Every function here is plain Python over scalars and small arrays, so
 it also runs (slowly) without numba; ``jit`` compiles it when numba is installed.
 
-Output rows (float64, width ``8 + 3 N + 4``; see ``COL_*``): status, taut-set size,
+Output rows (float64, width ``8 + 3 N + 4``; see ``COL_*``): kind, taut-set size,
 object (3, user units), contact (2, user units), normalised depth, taut mask (N, 0/1),
 weights (N), cable lengths (N, user units), the normalised point ``x = (r_o, v_o)`` (4).
 """
@@ -35,15 +35,15 @@ from ..._jit import HAVE_NUMBA, jit
 from .linalg import _in_hull, _lu_solve, _reduced_min_eig, _singular_extremes
 from .._tol import CURVATURE_TOL, INSIDE_WEIGHT, MAX_CONDITION, SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL
 
-__all__ = ["HAVE_NUMBA", "solve_formation", "solve_formations", "lifted_points",
-           "similar_fit", "feasible", "row_width"]
+__all__ = ["HAVE_NUMBA", "solve_formation", "solve_formations", "append_rows",
+           "lifted_points", "similar_fit", "feasible", "row_width"]
 
-#: Row status values (the first three as in ``_kernel.STATUS_*``).
+#: Row kind codes (the first three as ``_lifted.KIND_*``; ``PENDING``: weights to resolve).
 STABLE, SADDLE, NOT_EQUILIBRIUM, PENDING = 0, 1, 2, 3
 #: Kernel return codes.
 OK, INFEASIBLE = 0, -1
 
-COL_STATUS, COL_TSIZE, COL_OBJECT, COL_CONTACT, COL_DEPTH, COL_TAUT = 0, 1, 2, 5, 7, 8
+COL_KIND, COL_TSIZE, COL_OBJECT, COL_CONTACT, COL_DEPTH, COL_TAUT = 0, 1, 2, 5, 7, 8
 
 
 def row_width(N: int) -> int:
@@ -314,6 +314,25 @@ def classify_survivors(order, r0, r1, key, C, Rn, P, table, sizes, sol, taut, an
 
 
 @jit
+def append_rows(rows, form, M, buf, k, b):
+    """Append ``buf[:k]``, the rows of formation ``b``, to ``rows`` (cap, W) and ``form``
+    (cap,) that hold ``M`` rows, doubling their capacity when full; returns the arrays
+    (new ones when they grew)."""
+    cap = rows.shape[0]
+    if M + k > cap:
+        cap = max(2 * cap, M + k)
+        grown = np.empty((cap, rows.shape[1]))
+        grown[:M] = rows[:M]
+        rows = grown
+        gform = np.empty(cap, dtype=np.int64)
+        gform[:M] = form[:M]
+        form = gform
+    rows[M:M + k] = buf[:k]
+    form[M:M + k] = b
+    return rows, form
+
+
+@jit
 def solve_formations(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     """:func:`solve_formation` for each of ``Rb`` (B, N, 2). Returns the rows (M, width)
     with their formation index ``form`` (M,), and the first infeasible formation's index
@@ -330,16 +349,7 @@ def solve_formations(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
         k, _, _ = solve_formation(Rb[b], Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf)
         if k < 0:
             return rows[:M], form[:M], b
-        if M + k > cap:
-            cap = max(2 * cap, M + k)
-            grown = np.empty((cap, W))
-            grown[:M] = rows[:M]
-            rows = grown
-            gform = np.empty(cap, dtype=np.int64)
-            gform[:M] = form[:M]
-            form = gform
-        rows[M:M + k] = buf[:k]
-        form[M:M + k] = b
+        rows, form = append_rows(rows, form, M, buf, k, b)
         M += k
     return rows[:M], form[:M], -1
 

@@ -81,7 +81,7 @@ def _every_subset(N: int, pairs: bool) -> "HullCandidates":
     return HullCandidates({s: combo_table(N, s) for s in sizes_for(N, pairs)}, False)
 
 
-def _facet_subsets(simplices: np.ndarray, N: int, pairs: bool, unique: bool = True
+def _facet_subsets(simplices: np.ndarray, N: int, pairs: bool, *, unique: bool = True
                    ) -> dict[int, np.ndarray]:
     """Every candidate-size subset of the simplices' vertex sets (size -> sorted rows),
     without repeats unless ``unique`` is False (repeats cost the compiled kernel less
@@ -390,7 +390,7 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
     if up_in_hull:
         upper = hull.equations[:, :d] @ up > -UPPER_NORMAL_TOL
         simplices = simplices[upper]
-    out = _facet_subsets(simplices, N, pairs, unique)
+    out = _facet_subsets(simplices, N, pairs, unique=unique)
     if not up_in_hull and d + 1 <= 5:
         # The whole point set is a face (exposed by a direction orthogonal to its hull):
         # add one affinely independent spanning subset of it.

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog, minimize
 
-from .._lifted import (STATUS_NOT_EQUILIBRIUM, STATUS_SADDLE, STATUS_STABLE, Frame, Solved,
+from .._lifted import (KIND_NOT_EQUILIBRIUM, KIND_SADDLE, KIND_STABLE, Frame, Solved,
     in_hull_2d, reduced_hessian_min_eig)
 from .._tol import CURVATURE_TOL, FAMILY_FTOL, FAMILY_RESIDUAL, INSIDE_WEIGHT, RANK_TOL, WEIGHT_TOL
 from .._util import q_hessian
@@ -19,7 +19,7 @@ class Classified:
     """Final solutions, flat over formations, in output order.
 
     ``form`` (K,), ``taut`` (K, N) bool, ``ro``/``vo`` (K, 2) normalised, ``depth`` (K,)
-    normalised, ``weights`` (K, N) (0 on slack cables), ``status`` (K,) int8.
+    normalised, ``weights`` (K, N) (0 on slack cables), ``kind`` (K,) int8 (``KIND_*``).
     """
 
     form: np.ndarray
@@ -28,7 +28,7 @@ class Classified:
     vo: np.ndarray
     depth: np.ndarray
     weights: np.ndarray
-    status: np.ndarray
+    kind: np.ndarray
 
 
 def _output_order(form: np.ndarray, taut: np.ndarray, tsize: np.ndarray,
@@ -115,7 +115,7 @@ def classify(frame: Frame, solved: Solved, taut: np.ndarray,
 
     Steps: keep one solution per (formation, taut set), preferring one whose candidate
     *is* the taut set, in output order; apply the paper's projection test; compute weights (unique
-    when the taut set is affinely independent, otherwise by LP/QP); status from the
+    when the taut set is affinely independent, otherwise by LP/QP); kind from the
     weights' signs and the reduced Hessian; sort by formation, taut-set size, taut set.
     ``projection_checked`` (M,) marks rows that already passed the projection test on
     their exact taut set; ``curvature`` (M,) holds rows' reduced-Hessian eigenvalues
@@ -166,11 +166,11 @@ def classify(frame: Frame, solved: Solved, taut: np.ndarray,
         weights[k] = 0.0
         weights[k, idx], min_w[k] = _weights_family(frame, int(form[k]), idx, x[k, :2], x[k, 2:])
         min_eig[k] = _min_eig_family(frame, int(form[k]), idx)
-    status = np.where(min_w < -WEIGHT_TOL, STATUS_NOT_EQUILIBRIUM,
-                      np.where(min_eig > CURVATURE_TOL, STATUS_STABLE, STATUS_SADDLE)
-                      ).astype(np.int8)
+    kind = np.where(min_w < -WEIGHT_TOL, KIND_NOT_EQUILIBRIUM,
+                    np.where(min_eig > CURVATURE_TOL, KIND_STABLE, KIND_SADDLE)
+                    ).astype(np.int8)
     return Classified(form, taut, x[:, :2], x[:, 2:], np.sqrt(solved.depth2[pick]), weights,
-                      status)
+                      kind)
 
 
 def taut_indices(taut: np.ndarray, tsize: np.ndarray, width: int

@@ -14,7 +14,6 @@ from ...errors import InvalidInputError
 from .._tol import ELIMINATION_RTOL
 from .._util import combo_table
 from .._lifted import Frame, Solved, height_ok, pad_groups, solve_candidates, taut_masks
-from .results import Funnel
 
 #: Refuse exhaustive searches larger than this many taut-set combinations.
 MAX_COMBINATIONS = 5_000_000
@@ -102,7 +101,3 @@ def _combos_uncached(N: int, k: int) -> np.ndarray:
     from itertools import combinations
     return np.array(list(combinations(range(N), k)), dtype=np.intp).reshape(-1, k)
 
-
-def funnel_from(counts: dict[str, int], force_closure: int) -> Funnel:
-    return Funnel(counts["combinations"], counts["form_closure"], counts["cqp_feasible"],
-                  counts["height_feasible"], force_closure)

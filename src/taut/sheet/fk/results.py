@@ -1,4 +1,9 @@
-"""Result objects of sheet forward kinematics: frozen, with named fields."""
+"""Result objects of sheet forward kinematics: frozen, with named fields.
+
+Both results follow taut's outcome convention (:mod:`taut._outcome`): ``success`` when a
+formation holds the object in at least one stable state, ``status`` ``"ok"`` or
+``"infeasible"``, and a ``message`` saying what was found or why not.
+"""
 
 from __future__ import annotations
 
@@ -8,16 +13,18 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._units import GRAVITY
 from ..._validate import as_array
 from ...errors import InvalidInputError
-from ..model import Sheet
+from .._lifted import KIND_NAMES, KIND_NOT_EQUILIBRIUM, KIND_STABLE
+from ..model import Sheet, check_formation
+from ._solve import explain_no_equilibrium
 
-__all__ = ["Equilibrium", "Funnel", "FKResult", "BatchFKResult", "Status", "GRAVITY"]
+__all__ = ["Equilibrium", "Funnel", "FKResult", "BatchFKResult", "EquilibriumKind"]
 
-#: Gravitational acceleration used for tensions, m/s^2 (as in the FK paper).
-GRAVITY = 9.81
 
-Status = Literal["stable", "saddle", "not_equilibrium"]
+#: What a rest state found by forward kinematics is (:attr:`Equilibrium.kind`).
+EquilibriumKind = Literal["stable", "saddle", "not_equilibrium"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,7 +50,7 @@ class Equilibrium:
         the state is an equilibrium (None otherwise: no tensions can hold it there).
     cable_lengths : ndarray, shape (k,)
         Lengths :math:`l_i = |\\mathbf{v}_i - \\mathbf{v}_o|` of the taut cables.
-    status : {"stable", "saddle", "not_equilibrium"}
+    kind : {"stable", "saddle", "not_equilibrium"}
         ``stable``: strict local minimum of the object's height (all weights positive and
         positive-definite reduced Hessian). ``saddle``: an equilibrium that is not a strict
         minimum. ``not_equilibrium``: passes the paper's force-closure test (projection
@@ -57,17 +64,17 @@ class Equilibrium:
     weights: np.ndarray
     tensions: np.ndarray | None
     cable_lengths: np.ndarray
-    status: Status
+    kind: EquilibriumKind
 
     @property
     def stable(self) -> bool:
         """True when the state is a strict local minimum of the potential energy."""
-        return self.status == "stable"
+        return self.kind == "stable"
 
     @property
     def is_equilibrium(self) -> bool:
         """True unless the exact force-closure test fails."""
-        return self.status != "not_equilibrium"
+        return self.kind != "not_equilibrium"
 
     @property
     def height(self) -> float:
@@ -77,7 +84,7 @@ class Equilibrium:
     def __repr__(self) -> str:
         taut = "{" + ",".join(str(i + 1) for i in self.taut) + "}"
         p = ", ".join(f"{c:.6g}" for c in self.object)
-        return f"Equilibrium(taut={taut} (1-based), object=({p}), status={self.status!r})"
+        return f"Equilibrium(taut={taut} (1-based), object=({p}), kind={self.kind!r})"
 
 
 @dataclass(frozen=True)
@@ -99,12 +106,12 @@ class Funnel:
 
 def _equilibrium(taut: tuple[int, ...], obj: np.ndarray, contact: np.ndarray,
                  weights: np.ndarray, tensions: np.ndarray | None, lengths: np.ndarray,
-                 status: str) -> Equilibrium:
+                 kind: str) -> Equilibrium:
     """An :class:`Equilibrium` without the dataclass ``__init__`` (the hot path of
     :class:`FKResult`; fields as in the class)."""
     e = object.__new__(Equilibrium)
     e.__dict__.update(taut=taut, object=obj, contact=contact, weights=weights,
-                      tensions=tensions, cable_lengths=lengths, status=status)
+                      tensions=tensions, cable_lengths=lengths, kind=kind)
     return e
 
 
@@ -124,10 +131,18 @@ class FKResult:
         The FK method used.
     sheet, formation, hold_height, mass
         The inputs (formation as an (N, 2) array).
+    success : bool
+        At least one stable state: the formation holds the object.
+    status : {"ok", "infeasible"}
+        ``"ok"`` exactly when ``success``.
+    message : str
+        One line: how many states were found and how many are stable; without any state,
+        why (e.g. the states the object would reach below the floor, FK paper eq. 15).
     """
 
     _equilibria: tuple[Equilibrium, ...] | None
     _rows: np.ndarray | None
+    _message: str | None
     funnel: Funnel | None
     method: str
     sheet: Sheet
@@ -138,20 +153,20 @@ class FKResult:
     def __init__(self, equilibria: tuple[Equilibrium, ...], funnel: Funnel | None,
                  method: str, sheet: Sheet, formation: np.ndarray, hold_height: float,
                  mass: float | None) -> None:
-        self.__dict__.update(_equilibria=tuple(equilibria), _rows=None, funnel=funnel,
-                             method=method, sheet=sheet, formation=formation,
+        self.__dict__.update(_equilibria=tuple(equilibria), _rows=None, _message=None,
+                             funnel=funnel, method=method, sheet=sheet, formation=formation,
                              hold_height=hold_height, mass=mass)
 
     @classmethod
     def _from_rows(cls, rows: np.ndarray, method: str, sheet: Sheet, formation: np.ndarray,
                    hold_height: float, mass: float | None) -> "FKResult":
         """A result whose equilibria are built on access from kernel rows (layout of
-        ``_small_kernel``: status, taut-set size, object, contact, depth, taut mask,
+        ``_kernels.small``: kind, taut-set size, object, contact, depth, taut mask,
         weights, lengths, ...)."""
         self = object.__new__(cls)
-        self.__dict__.update(_equilibria=None, _rows=rows, funnel=None, method=method,
-                             sheet=sheet, formation=formation, hold_height=hold_height,
-                             mass=mass)
+        self.__dict__.update(_equilibria=None, _rows=rows, _message=None, funnel=None,
+                             method=method, sheet=sheet, formation=formation,
+                             hold_height=hold_height, mass=mass)
         return self
 
     def __setattr__(self, name: str, value: object) -> None:
@@ -173,20 +188,54 @@ class FKResult:
             return ()
         N = self.sheet.n
         scale = self.sheet.size
-        names = ("stable", "saddle", "not_equilibrium")
         force = None if self.mass is None else self.mass * GRAVITY
         out = []
         for row in rows:
             idx = np.flatnonzero(row[8:8 + N])
             w = row[8 + N + idx]
             lengths = row[8 + 2 * N + idx]
-            st = int(row[0])
+            kind = int(row[0])
             tensions = None
-            if force is not None and st != 2:
+            if force is not None and kind != KIND_NOT_EQUILIBRIUM:
                 tensions = w * force * (lengths / scale) / row[7]
             out.append(_equilibrium(tuple(idx.tolist()), row[2:5].copy(), row[5:7].copy(),
-                                    w, tensions, lengths, names[st]))
+                                    w, tensions, lengths, KIND_NAMES[kind]))
         return tuple(out)
+
+    @property
+    def success(self) -> bool:
+        """At least one stable state (the formation holds the object)."""
+        rows = self._rows
+        if self._equilibria is None and rows is not None:
+            return bool(np.any(rows[:, 0] == KIND_STABLE))
+        return any(e.stable for e in self.equilibria)
+
+    @property
+    def status(self) -> str:
+        """``"ok"`` when :attr:`success`, else ``"infeasible"`` (no stable state)."""
+        return "ok" if self.success else "infeasible"
+
+    @property
+    def message(self) -> str:
+        """What was found, or why there is no stable state (one line; the reason for a
+        result without any state is worked out on first access)."""
+        msg = self._message
+        if msg is None:
+            msg = self._describe()
+            self.__dict__["_message"] = msg
+        return msg
+
+    def _describe(self) -> str:
+        eqs = self.equilibria
+        if not eqs:
+            return "no equilibrium: " + explain_no_equilibrium(
+                self.sheet, self.formation, self.hold_height)
+        stable = sum(e.stable for e in eqs)
+        if stable:
+            return f"{len(eqs)} solution(s), {stable} stable"
+        saddle = sum(e.kind == "saddle" for e in eqs)
+        return (f"no stable state: {len(eqs)} solution(s), {saddle} saddle, "
+                f"{len(eqs) - saddle} not an equilibrium")
 
     @property
     def stable(self) -> tuple[Equilibrium, ...]:
@@ -218,8 +267,8 @@ class FKResult:
         Examples
         --------
         >>> import taut.sheet as ts
-        >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
-        >>> res = ts.forward_kinematics(sheet, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]], 1.0)
+        >>> team = ts.SheetTeam(ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]]), 1.0)
+        >>> res = ts.forward_kinematics(team, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]])
         >>> e = res.closest_stable([0.45, 0.45, 0.5])
         >>> e is not None and e.stable
         True
@@ -249,7 +298,10 @@ class BatchFKResult:
     """Forward kinematics of ``B`` formations of one sheet, as padded arrays.
 
     Row ``b`` holds ``count[b]`` solutions in slots ``0..count[b]-1`` (same order as
-    :class:`FKResult`); later slots are padding (``valid`` False, NaN positions).
+    :class:`FKResult`); later slots are padding (``valid`` False, NaN positions). A
+    formation the sheet cannot span (a robot pair farther apart than its sheet vertices)
+    has no solutions, ``feasible`` False and ``status`` ``"infeasible"``; the other rows
+    are answered as usual.
 
     Attributes
     ----------
@@ -264,8 +316,20 @@ class BatchFKResult:
     tensions : ndarray, shape (B, K, N), or None
         Tensions in N (0 for slack cables, NaN for the taut cables of non-equilibria)
         when a mass was given.
-    status : ndarray of int8, shape (B, K)
-        0 stable, 1 saddle, 2 not_equilibrium, -1 padding.
+    kind : ndarray of int8, shape (B, K)
+        What each solution is (:attr:`Equilibrium.kind`): 0 stable, 1 saddle,
+        2 not_equilibrium, -1 padding.
+    feasible : ndarray of bool, shape (B,)
+        The sheet can span formation ``b`` (the FK paper's ``FormationFeasible``).
+    success : ndarray of bool, shape (B,)
+        Formation ``b`` is feasible and has at least one stable state.
+    status : ndarray of str, shape (B,)
+        ``"ok"`` where ``success``, else ``"infeasible"``.
+    message : str
+        One line over the batch: how many formations hold the object, and the first
+        formation the sheet cannot span.
+    sheet, formations, hold_height, mass, method
+        The inputs (formations as a (B, N, 2) array) and the FK method used.
     """
 
     count: np.ndarray
@@ -275,7 +339,11 @@ class BatchFKResult:
     contact: np.ndarray
     weights: np.ndarray
     tensions: np.ndarray | None
+    kind: np.ndarray
+    feasible: np.ndarray
+    success: np.ndarray
     status: np.ndarray
+    message: str
     sheet: Sheet
     formations: np.ndarray
     hold_height: float
@@ -285,27 +353,36 @@ class BatchFKResult:
     @property
     def stable(self) -> np.ndarray:
         """Bool (B, K): which solutions are stable."""
-        return self.status == 0
+        return self.kind == KIND_STABLE
 
     def __len__(self) -> int:
         return int(self.count.shape[0])
 
     def result(self, b: int) -> FKResult:
-        """The solutions of formation ``b`` as an :class:`FKResult`."""
-        from .._lifted import STATUS_NAMES
+        """The solutions of formation ``b`` as an :class:`FKResult`.
 
+        Raises
+        ------
+        InfeasibleFormationError
+            Formation ``b`` is not feasible (as :func:`~taut.sheet.forward_kinematics`
+            raises for it).
+        """
+        if not self.feasible[b]:
+            check_formation(self.sheet, self.formations[b])        # raises with the pair
         eqs = []
         for k in range(int(self.count[b])):
             idx = np.flatnonzero(self.taut[b, k])
+            kind = int(self.kind[b, k])
             eqs.append(Equilibrium(
                 taut=tuple(int(i) for i in idx),
                 object=self.object[b, k].copy(),
                 contact=self.contact[b, k].copy(),
                 weights=self.weights[b, k, idx].copy(),
-                tensions=(None if self.tensions is None or self.status[b, k] == 2
+                tensions=(None if self.tensions is None or kind == KIND_NOT_EQUILIBRIUM
                           else self.tensions[b, k, idx].copy()),
                 cable_lengths=np.linalg.norm(self.sheet.vertices[idx] - self.contact[b, k], axis=1),
-                status=STATUS_NAMES[int(self.status[b, k])],  # type: ignore[arg-type]
+                kind=KIND_NAMES[kind],  # type: ignore[arg-type]
             ))
         return FKResult(tuple(eqs), None, self.method, self.sheet, self.formations[b].copy(),
                         self.hold_height, self.mass)
+

@@ -6,8 +6,9 @@ candidate subset tables, pair limits for the formation check) is computed once; 
 robots run the compiled kernel of ``_small_kernel`` (numba): every candidate of at most
 five cables up to ``COMPILED_MAX_N`` robots, the upper-hull faces above. Larger teams, the
 exhaustive method, and every team when numba is missing or ``backend="numpy"``, run the
-vectorised numpy path of :mod:`taut.sheet.fk.forward`. Both give the same equilibria (tested
-against each other; docs/sheet_fk_solver.md).
+numpy engine (:mod:`taut.sheet.fk._numpy`). Both give the same equilibria (tested
+against each other; docs/sheet_fk_solver.md). An engine: it never imports the front end
+(:mod:`taut.sheet.fk.forward`).
 """
 
 from __future__ import annotations
@@ -16,25 +17,25 @@ import importlib.util
 import os
 import weakref
 from types import ModuleType
-from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import as_array, as_positive, require_nonempty
+from ..._validate import as_array, as_choice, require_nonempty
 from ...errors import InvalidInputError
 from ._candidates import hull_candidates, padded_small_subsets
 from ._finalize import _min_eig_family, _weights_family
 from .._lifted import Frame, pad_groups
 from .._tol import CURVATURE_TOL, GEOMETRY_RTOL, SCREEN_SLACK, SNAP_MIN, SNAP_TOL, WEIGHT_TOL
-from .forward import (Method, _check_mass, _check_method, _check_sheet, _forward_numpy,
-    _forward_numpy_batch)
-from ._batch_result import batch_result
+from ._numpy import forward_numpy, forward_numpy_batch
+from .._options import BACKENDS, METHODS, Backend, Method
+from ._batch_result import batch_from_rows
 from ._similar import similar_copy
-from ..model import Sheet, check_formation, check_formations, check_hold_height
+from ..model import Sheet, check_formation, check_formations, feasible_formations
 from .results import BatchFKResult, FKResult
+from ..team import SheetTeam, require_team
 
-__all__ = ["FKSolver", "Backend", "COMPILED_MAX_N", "HAVE_NUMBA"]
+__all__ = ["FKSolver", "COMPILED_MAX_N", "HAVE_NUMBA"]
 
 #: numba importable (and not disabled by the environment variable TAUT_DISABLE_NUMBA).
 #: The kernel module (and numba) is imported on the first solver that uses it, so that
@@ -61,9 +62,6 @@ def _batch_kernel() -> ModuleType:
     return bk
 
 
-Backend = Literal["auto", "numba", "numpy"]
-_BACKENDS = ("auto", "numba", "numpy")
-
 #: Up to this team size the default method ("fast") gives the compiled kernel every
 #: subset of at most five cables (one cached table); above it, the upper-hull faces of
 #: each formation (Qhull) -- every subset costs O(N^5) and loses from N ~ 13 on
@@ -74,14 +72,14 @@ KERNEL_MAX_N = 30
 
 
 class FKSolver:
-    """Forward kinematics of one sheet at one hold height, for many formations.
+    """Forward kinematics of one sheet team (sheet, hold height, object mass), for many
+    formations.
 
     Parameters
     ----------
-    sheet : Sheet or array_like, shape (N, 2)
-        The sheet (vertices in the sheet frame, any length unit).
-    hold_height : float
-        Height :math:`z_r` of the holding points (> 0), same unit.
+    team : SheetTeam
+        The sheet (vertices in the sheet frame, any length unit), the height :math:`z_r`
+        of the holding points (same unit) and the object mass (kg, for the tensions).
     method : {"fast", "exhaustive", "subsets"}
         As in :func:`~taut.sheet.forward_kinematics`.
     backend : {"auto", "numba", "numpy"}
@@ -91,6 +89,12 @@ class FKSolver:
 
     Attributes
     ----------
+    team : SheetTeam
+        The team solved for.
+    sheet : Sheet
+        ``team.sheet``.
+    hold_height : float
+        ``team.hold_height``.
     backend : str
         The backend actually used, ``"numba"`` or ``"numpy"``.
 
@@ -98,8 +102,8 @@ class FKSolver:
     --------
     >>> import numpy as np
     >>> import taut.sheet as ts
-    >>> sheet = ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]])
-    >>> solver = ts.FKSolver(sheet, 1.0)
+    >>> team = ts.SheetTeam(ts.Sheet([[0, 0], [1, 0], [1, 1], [0, 1]]), 1.0)
+    >>> solver = ts.FKSolver(team)
     >>> res = solver.solve([[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]])
     >>> [e.taut for e in res.stable]
     [(0, 1, 2, 3)]
@@ -110,19 +114,18 @@ class FKSolver:
     [1, 1]
     """
 
-    __slots__ = ("sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
+    __slots__ = ("team", "sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
                  "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
                  "_fpack", "_ipack", "_out_shape",
                  "__weakref__")
 
-    def __init__(self, sheet: Sheet | ArrayLike, hold_height: float, *,
-                 method: Method = "fast", backend: Backend = "auto") -> None:
-        self.sheet = sheet = _check_sheet(sheet)  # type: ignore[arg-type]
-        self.hold_height = check_hold_height(hold_height)
-        self.method = _check_method(method)
-        if not isinstance(backend, str) or backend not in _BACKENDS:
-            raise InvalidInputError("backend", f"must be one of {', '.join(_BACKENDS)}; "
-                                               f"got {backend!r}")
+    def __init__(self, team: SheetTeam, *, method: Method = "fast",
+                 backend: Backend = "auto") -> None:
+        self.team = require_team(team)
+        self.sheet = sheet = team.sheet
+        self.hold_height = team.hold_height
+        self.method = as_choice(method, METHODS, "method")
+        backend = as_choice(backend, BACKENDS, "backend")  # type: ignore[assignment]
         N = sheet.n
         fits = method != "exhaustive" and N <= KERNEL_MAX_N
         if backend == "numba":
@@ -163,19 +166,16 @@ class FKSolver:
                 f"method={self.method!r}, backend={self.backend!r})")
 
     # -- one formation -------------------------------------------------------------------
-    def solve(self, formation: ArrayLike, *, mass: float | None = None,
-              check: bool = True) -> FKResult:
+    def solve(self, formation: ArrayLike, *, check: bool = True) -> FKResult:
         """Every rest state of the object for one formation (as
-        :func:`~taut.sheet.forward_kinematics`).
+        :func:`~taut.sheet.forward_kinematics`; tensions in N when the team has a mass).
 
         Parameters
         ----------
         formation : array_like, shape (N, 2)
             Robot positions, same unit as the sheet.
-        mass : float, optional
-            Object mass in kg for the tensions (N).
         check : bool
-            Validate ``formation`` and ``mass`` (shape, finite, no pair farther apart than
+            Validate ``formation`` (shape, finite, no pair farther apart than
             its sheet vertices). ``False`` skips the Python-side checks for trusted loops
             (pass a C-contiguous float64 (N, 2) array); a torn or non-finite formation
             still raises.
@@ -185,12 +185,11 @@ class FKSolver:
         InvalidInputError, InfeasibleFormationError
             As :func:`~taut.sheet.forward_kinematics`.
         """
+        mass = self.team.mass
         if self.backend != "numba":
-            return _forward_numpy(self.sheet, formation, self.hold_height, mass, self.method)
+            return forward_numpy(self.sheet, formation, self.hold_height, mass, self.method)
         if check:
             R = _formation_array(formation, self.sheet)
-            if mass is not None:
-                mass = as_positive(mass, "mass")
         else:
             R = np.array(formation, dtype=np.float64, order="C")
         if self._hull:
@@ -201,10 +200,10 @@ class FKSolver:
             if not near and ((stable and not pending) or k == 0):
                 rows = out[:k]
             else:
-                rows = None if k < 0 else self._finish(R, out[:k], stable, pending, near)
+                rows = None if k < 0 else self._finish(R, out[:k], stable, pending, near=near)
         if rows is None:
             check_formation(self.sheet, R)          # raises with the usual message
-            return _forward_numpy(self.sheet, R, self.hold_height, mass, self.method)
+            return forward_numpy(self.sheet, R, self.hold_height, mass, self.method)
         return FKResult._from_rows(rows, self.method, self.sheet, R, self.hold_height, mass)
 
     def _rows(self, R: np.ndarray) -> np.ndarray | None:
@@ -215,7 +214,7 @@ class FKSolver:
             return None
         return self._finish(R, *found, 0)
 
-    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int,
+    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int, *,
                 near: bool | None = None) -> np.ndarray:
         """Rows of ``R`` after the kernel: weight families resolved (``pending`` rows),
         snapped to a similar copy of the sheet next to one, whether or not a state is stable
@@ -259,7 +258,7 @@ class FKSolver:
         return table, (table >= 0).sum(axis=1)
 
     def _resolve_families(self, R: np.ndarray, rows: np.ndarray) -> int:
-        """Weights and status of rows whose taut set is larger than their candidate (LP,
+        """Weights and kind of rows whose taut set is larger than their candidate (LP,
         as ``_finalize.classify``); returns the number of stable rows."""
         N = self.sheet.n
         frame = Frame.build(self.sheet.vertices, R[None], self.hold_height, self._scale)
@@ -277,8 +276,8 @@ class FKSolver:
                       else sk.STABLE if min_eig > CURVATURE_TOL else sk.SADDLE)
         return int(np.count_nonzero(rows[:, 0] == sk.STABLE))
 
-    def _snap(self, R: np.ndarray, screened: bool = False) -> np.ndarray | None:
-        """``fk._snap_near_similar`` for one formation: the rows of the similar copy of
+    def _snap(self, R: np.ndarray, *, screened: bool = False) -> np.ndarray | None:
+        """``_solve._snap_near_similar`` for one formation: the rows of the similar copy of
         the sheet when ``R`` is within ``SNAP_TOL`` of one and the copy has a stable state,
         whether or not ``R`` itself shows one (docs/sheet_fk_solver.md; ``screened``: the
         cheap screen, ``_snap_screen``, already passed)."""
@@ -297,14 +296,13 @@ class FKSolver:
         return found[0]
 
     # -- many formations -----------------------------------------------------------------
-    def solve_batch(self, formations: ArrayLike, *, mass: float | None = None,
-                    check: bool = True) -> BatchFKResult:
-        """Forward kinematics of ``B`` formations (leading axis) of this sheet.
+    def solve_batch(self, formations: ArrayLike, *, check: bool = True) -> BatchFKResult:
+        """Forward kinematics of ``B`` formations (leading axis) of this team.
 
         Parameters
         ----------
         formations : array_like, shape (B, N, 2)
-        mass, check
+        check
             As in :meth:`solve`.
 
         Returns
@@ -312,43 +310,66 @@ class FKSolver:
         BatchFKResult
             As :func:`~taut.sheet.forward_kinematics_batch`.
         """
+        mass = self.team.mass
         if self.backend != "numba" or self.method == "exhaustive":
-            return _forward_numpy_batch(self.sheet, formations, self.hold_height, mass,
+            return forward_numpy_batch(self.sheet, formations, self.hold_height, mass,
                                         self.method)
         N = self.sheet.n
         if check:
             Rb = require_nonempty(as_array(formations, "formations", ndim=3), "formations")
             if Rb.shape[1:] != (N, 2):
                 check_formations(self.sheet, Rb)    # raises the shape error
-            mass = _check_mass(mass)
         else:
             Rb = np.asarray(formations, dtype=np.float64)
         Rb = np.ascontiguousarray(Rb)
         if self._hull:
             return self._solve_batch_hull(Rb, mass)
-        rows, form, bad = bk.solve_formations_ws(
+        feasible = np.ones(len(Rb), dtype=bool)
+        rows, form, bad = self._kernel_batch(Rb)
+        if bad < 0:
+            rows, form = self._fix_batch(Rb, rows, form)
+            return batch_from_rows(self.sheet, Rb, self.hold_height, mass, self.method,
+                                   feasible, rows, form)
+        # A formation the kernel rejects: the model's check decides which (and raises for
+        # a non-finite one); the kernel solves the others.
+        feasible = feasible_formations(self.sheet, Rb)
+        ok = np.flatnonzero(feasible)
+        rows, form, bad = np.zeros((0, self._width)), np.zeros(0, np.int64), -1
+        if len(ok):
+            rows, form, bad = self._kernel_batch(Rb[ok])
+        if bad >= 0 or len(ok) == len(Rb):          # a borderline formation: numpy decides
+            return forward_numpy_batch(self.sheet, Rb, self.hold_height, mass, self.method)
+        rows, form = self._fix_batch(Rb[ok], rows, form)
+        return batch_from_rows(self.sheet, Rb, self.hold_height, mass, self.method, feasible,
+                               rows, ok[form])
+
+    def _kernel_batch(self, Rb: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """Kernel rows of formations ``Rb`` (B, N, 2), their formation indices, and the
+        index of the first formation the kernel finds infeasible (-1: none)."""
+        Rb = np.ascontiguousarray(Rb)
+        return bk.solve_formations_ws(
             Rb, self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
             self.hold_height, self._lim2)
-        if bad >= 0:
-            check_formations(self.sheet, Rb)        # raises with the step index
-            return _forward_numpy_batch(self.sheet, Rb, self.hold_height, mass, self.method)
-        rows, form = self._fix_batch(Rb, rows, form)
-        return batch_result(self, Rb, rows, form, mass)
 
     def _solve_batch_hull(self, Rb: np.ndarray, mass: float | None) -> BatchFKResult:
         """Batch of larger teams: one hull and one kernel call per formation."""
         parts, forms = [], []
+        feasible = np.ones(len(Rb), dtype=bool)
         for b in range(len(Rb)):
             rows = self._rows(Rb[b])
             if rows is None:
-                check_formations(self.sheet, Rb)    # raises with the step index
-                return _forward_numpy_batch(self.sheet, Rb, self.hold_height, mass,
-                                            self.method)
+                if feasible_formations(self.sheet, Rb[b:b + 1])[0]:
+                    # The kernel and the model's check disagree (borderline): numpy decides.
+                    return forward_numpy_batch(self.sheet, Rb, self.hold_height, mass,
+                                               self.method)
+                feasible[b] = False
+                continue
             parts.append(rows)
             forms.append(np.full(len(rows), b, dtype=np.int64))
         rows = np.vstack(parts) if parts else np.zeros((0, self._width))
         form = np.concatenate(forms) if forms else np.zeros(0, np.int64)
-        return batch_result(self, Rb, rows, form, mass)
+        return batch_from_rows(self.sheet, Rb, self.hold_height, mass, self.method, feasible,
+                               rows, form)
 
     def _fix_batch(self, Rb: np.ndarray, rows: np.ndarray, form: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
@@ -404,22 +425,22 @@ def _formation_array(formation: ArrayLike, sheet: Sheet) -> np.ndarray:
 
 # -- cached solvers for the functional front end ------------------------------------------
 
-_SOLVERS: "weakref.WeakKeyDictionary[Sheet, dict[tuple[float, str], FKSolver]]" = (
-    weakref.WeakKeyDictionary())
-#: Solvers kept per sheet (distinct hold heights and methods) by ``cached_solver``.
+_SOLVERS: ("weakref.WeakKeyDictionary[Sheet, dict[tuple[float, float | None, str], "
+            "FKSolver]]") = weakref.WeakKeyDictionary()
+#: Solvers kept per sheet (distinct hold heights, masses and methods) by ``cached_solver``.
 _PER_SHEET = 16
 
 
-def cached_solver(sheet: Sheet, hold_height: float, method: Method) -> FKSolver:
-    """The :class:`FKSolver` for ``(sheet, hold_height, method)``, built once and reused
-    (``sheet`` already a validated :class:`Sheet`; ``hold_height`` a validated float)."""
-    per = _SOLVERS.get(sheet)
+def cached_solver(team: SheetTeam, method: Method) -> FKSolver:
+    """The :class:`FKSolver` for ``team`` (a validated :class:`SheetTeam`) and ``method``,
+    built once per sheet, hold height, mass and method, and reused."""
+    per = _SOLVERS.get(team.sheet)
     if per is None:
-        per = _SOLVERS[sheet] = {}
-    key = (hold_height, method)
+        per = _SOLVERS[team.sheet] = {}
+    key = (team.hold_height, team.mass, method)
     solver = per.get(key)
     if solver is None:
         if len(per) >= _PER_SHEET:
             per.clear()
-        solver = per[key] = FKSolver(sheet, hold_height, method=method)
+        solver = per[key] = FKSolver(team, method=method)
     return solver

@@ -42,7 +42,8 @@ from scipy.optimize import linprog
 
 from .._tol import CERTIFICATE_MIN_MARGIN, RELAX_COS_SLACK
 
-__all__ = ["BranchProof", "branch_proof", "verify_branch_proof", "pair_angle_limits"]
+__all__ = ["BranchProof", "branch_proof", "verify_branch_proof", "pair_angle_limits",
+           "pair_cosine_limits"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -61,11 +62,21 @@ class BranchProof:
     boxes: int
 
 
+def pair_cosine_limits(V: np.ndarray, rho: np.ndarray) -> np.ndarray:
+    """c_ij (N, N): the smallest admissible cos(theta_i - theta_j); +inf on the diagonal
+    is replaced by 1 (a robot is at distance 0 from itself)."""
+    D2 = np.sum((V[:, None, :] - V[None, :, :]) ** 2, axis=2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = (rho[:, None] ** 2 + rho[None, :] ** 2 - D2) / (2 * rho[:, None] * rho[None, :])
+    c = np.where(np.isfinite(c), c, -1.0)
+    np.fill_diagonal(c, 1.0)
+    return c
+
+
 def pair_angle_limits(V: np.ndarray, rho: np.ndarray) -> np.ndarray:
     """:math:`\\alpha_{ik}` (N, N), radians in [0, pi]: the largest admissible circular
     angle between cables i and k, from the cosine limits loosened by RELAX_COS_SLACK
     (0 on the diagonal)."""
-    from ._certificate import pair_cosine_limits
     c = pair_cosine_limits(V, rho) - RELAX_COS_SLACK
     alpha = np.arccos(np.clip(c, -1.0, 1.0))
     np.fill_diagonal(alpha, 0.0)

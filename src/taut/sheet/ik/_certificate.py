@@ -49,14 +49,13 @@ from typing import Literal
 import numpy as np
 from scipy.optimize import linprog
 
-from ._branch import BranchProof, branch_proof, verify_branch_proof
+from ._branch import BranchProof, branch_proof, pair_cosine_limits, verify_branch_proof
 from .._tol import (CERTIFICATE_MIN_MARGIN, DEPTH_RTOL, MULTIPLIER_SUM_TOL, RELAX_COS_SLACK,
     SPACING_MARGIN)
 
 __all__ = ["IKCertificate", "CertificateKind", "depth_certificate", "radial_certificate",
            "triangle_certificate", "closure_lp_certificate", "verify_certificate",
-           "closure_branch_certificate",
-           "pair_cosine_limits"]
+           "closure_branch_certificate"]
 
 CertificateKind = Literal["depth", "radial_spacing", "triangle", "closure_lp",
                           "closure_branch"]
@@ -91,17 +90,6 @@ class IKCertificate:
     direction: np.ndarray | None = field(default=None, repr=False)
     margin: float = 0.0
     proof: BranchProof | None = field(default=None, repr=False)
-
-
-def pair_cosine_limits(V: np.ndarray, rho: np.ndarray) -> np.ndarray:
-    """c_ij (N, N): the smallest admissible cos(theta_i - theta_j); +inf on the diagonal
-    is replaced by 1 (a robot is at distance 0 from itself)."""
-    D2 = np.sum((V[:, None, :] - V[None, :, :]) ** 2, axis=2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        c = (rho[:, None] ** 2 + rho[None, :] ** 2 - D2) / (2 * rho[:, None] * rho[None, :])
-    c = np.where(np.isfinite(c), c, -1.0)
-    np.fill_diagonal(c, 1.0)
-    return c
 
 
 def depth_certificate(depth: float, lengths: np.ndarray, hold_height: float

@@ -62,12 +62,13 @@ from ._search import Candidate, check_solution, curvature, joint_optimise, multi
 from ._weights import closure_directions, maxent_weights
 from .._tol import (CONTACT_INSET_RTOL, DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_BRANCH_BOXES,
     EARLY_SEARCHES, REFERENCE_MIN_RADIUS, VERIFY_RTOL)
-from ..fk.forward import _check_mass, _check_sheet, forward_kinematics
-from ..model import Sheet, check_hold_height
-from ..fk.results import GRAVITY
+from ..fk.solver import cached_solver
+from ..model import Sheet
+from ..._units import GRAVITY
+from ..team import SheetTeam, as_sheet, require_team
 
-__all__ = ["IKResult", "IKConstraints", "IKCertificate", "inverse_kinematics",
-           "formation_from_angles", "ik_constraints", "contact_weights"]
+__all__ = ["inverse_kinematics", "formation_from_angles", "ik_constraints",
+           "contact_weights"]
 
 
 # --------------------------------------------------------------------------- target
@@ -96,12 +97,11 @@ def _contact(sheet: Sheet, contact: object | None) -> np.ndarray:
     return vo
 
 
-def _target(sheet: Sheet, object_position: object, hold_height: float, contact: object
-            ) -> _Target:
-    """Validate a target; the object must be above the ground and the contact strictly
-    inside the sheet (anything else is malformed input)."""
+def _target(team: SheetTeam, object_position: object, contact: object) -> _Target:
+    """Validate a target for a (validated) team; the object must be above the ground and
+    the contact strictly inside the sheet (anything else is malformed input)."""
+    sheet, z = team.sheet, team.hold_height
     p = as_array(object_position, "object_position", shape=(3,))
-    z = check_hold_height(hold_height)
     vo = _contact(sheet, contact)
     if not p[2] > 0.0:
         raise InvalidInputError("object_position", f"object height {p[2]:.6g} is not "
@@ -140,12 +140,12 @@ def contact_weights(sheet: Sheet, contact: ArrayLike | None = None) -> np.ndarra
     >>> contact_weights(Sheet([[0, 0], [2, 0], [0, 2]]), [0.5, 0.5]).round(6)
     array([0.5 , 0.25, 0.25])
     """
-    sheet = _check_sheet(sheet)
+    sheet = as_sheet(sheet)
     return maxent_weights(sheet.vertices, _contact(sheet, contact), sheet.size)
 
 
-def formation_from_angles(sheet: Sheet, object_position: ArrayLike, hold_height: float,
-                          angles: ArrayLike, *, contact: ArrayLike | None = None) -> np.ndarray:
+def formation_from_angles(team: SheetTeam, object_position: ArrayLike, angles: ArrayLike, *,
+                          contact: ArrayLike | None = None) -> np.ndarray:
     """Robot positions from the cable angles (planning paper eq. 10).
 
     :math:`\\mathbf{r}_i = \\mathbf{r}_o + \\sqrt{l_i^2 - d^2}\\,(\\cos\\theta_i, \\sin\\theta_i)`
@@ -154,11 +154,10 @@ def formation_from_angles(sheet: Sheet, object_position: ArrayLike, hold_height:
 
     Parameters
     ----------
-    sheet : Sheet
+    team : SheetTeam
+        The sheet and the holding height :math:`z_r`.
     object_position : array_like, shape (3,)
-        Target :math:`(x_o, y_o, z_o)`.
-    hold_height : float
-        :math:`z_r`.
+        Target :math:`(x_o, y_o, z_o)`, same length unit as the sheet.
     angles : array_like, shape (..., N)
         :math:`\\theta_i` in radians (any leading batch axes).
     contact : array_like, shape (2,), optional
@@ -174,14 +173,18 @@ def formation_from_angles(sheet: Sheet, object_position: ArrayLike, hold_height:
         Object not above the ground or not below some cable's full length (no all-taut
         placement), contact outside the sheet, bad angles.
     """
-    sheet = _check_sheet(sheet)
-    t = _target(sheet, object_position, hold_height, contact)
+    team = require_team(team)
+    return _formation(_target(team, object_position, contact), angles, team.n)
+
+
+def _formation(t: _Target, angles: ArrayLike, n: int) -> np.ndarray:
+    """:func:`formation_from_angles` of a validated target of an ``n``-robot team."""
     cert = depth_certificate(t.d, t.lengths, t.z)
     if cert is not None:
         raise InvalidInputError("object_position", cert.message)
     th = as_array(angles, "angles")
-    if th.ndim < 1 or th.shape[-1] != sheet.n:
-        raise InvalidInputError("angles", f"last axis must have length {sheet.n} (one angle "
+    if th.ndim < 1 or th.shape[-1] != n:
+        raise InvalidInputError("angles", f"last axis must have length {n} (one angle "
                                 "per robot)")
     rho = t.rho * t.scale
     return t.p[:2] + rho[:, None] * np.stack([np.cos(th), np.sin(th)], axis=-1)
@@ -198,9 +201,9 @@ def _least_squares_weights(V: np.ndarray, vo: np.ndarray, rel: np.ndarray) -> np
     return np.asarray((np.linalg.pinv(E) @ rhs[..., None])[..., 0])
 
 
-def ik_constraints(sheet: Sheet, object_position: ArrayLike, hold_height: float,
-                   angles: ArrayLike, weights: ArrayLike | None = None, *,
-                   contact: ArrayLike | None = None) -> IKConstraints:
+def ik_constraints(team: SheetTeam, object_position: ArrayLike, angles: ArrayLike,
+                   weights: ArrayLike | None = None, *, contact: ArrayLike | None = None
+                   ) -> IKConstraints:
     """Evaluate the all-taut stable-equilibrium conditions for given angles (eq. 10).
 
     Parameters
@@ -216,10 +219,10 @@ def ik_constraints(sheet: Sheet, object_position: ArrayLike, hold_height: float,
     -------
     IKConstraints
     """
-    sheet = _check_sheet(sheet)
-    t = _target(sheet, object_position, hold_height, contact)
-    R = formation_from_angles(sheet, t.p, hold_height, angles, contact=t.vo)
-    V, N = sheet.vertices, sheet.n
+    team = require_team(team)
+    t = _target(team, object_position, contact)
+    R = _formation(t, angles, team.n)
+    V, N = team.sheet.vertices, team.n
     rel = R - t.p[:2]                                     # (..., N, 2)
     if weights is None:
         w = _least_squares_weights(V, t.vo, rel)
@@ -239,13 +242,15 @@ def ik_constraints(sheet: Sheet, object_position: ArrayLike, hold_height: float,
 
 # --------------------------------------------------------------------------- IK stages
 
-def _verified(sheet: Sheet, t: _Target, R: np.ndarray) -> bool:
+def _verified(team: SheetTeam, t: _Target, R: np.ndarray) -> bool:
     """Forward kinematics of the world formation ``R`` (N, 2) has a stable equilibrium
     with every cable taut at the target (within VERIFY_RTOL of the sheet size).
 
-    The one place IK calls forward kinematics (a hook for a prepared FK solver)."""
+    The one place IK calls forward kinematics: the team's cached FK solver (the engine
+    behind :func:`~taut.sheet.forward_kinematics`)."""
+    sheet = team.sheet
     try:
-        fk = forward_kinematics(sheet, R, t.z)
+        fk = cached_solver(team, "fast").solve(R)
     except InvalidInputError:                # pragma: no cover - rounding at the limit
         return False
     tol = VERIFY_RTOL * sheet.size
@@ -331,21 +336,21 @@ def _failure(sheet: Sheet, t: _Target, status: str, message: str,
                     message, cert, runs)
 
 
-def inverse_kinematics(sheet: Sheet, object_position: ArrayLike, hold_height: float, *,
+def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
                        contact: ArrayLike | None = None, heading: float = 0.0,
-                       reference: ArrayLike | None = None, mass: float | None = None,
-                       budget: int = DEFAULT_BUDGET, seed: int = 0,
-                       branch_boxes: int = DEFAULT_BRANCH_BOXES) -> IKResult:
+                       reference: ArrayLike | None = None, budget: int = DEFAULT_BUDGET,
+                       seed: int = 0, branch_boxes: int = DEFAULT_BRANCH_BOXES) -> IKResult:
     """Robot formation that holds the object stably at ``object_position`` with every
     virtual cable taut (planning paper eq. 10; docs/sheet_kinematics.md §6).
 
     Parameters
     ----------
-    sheet : Sheet
+    team : SheetTeam
+        The sheet, the holding height :math:`z_r` and, optionally, the object mass (kg)
+        for the tensions (N).
     object_position : array_like, shape (3,)
-        Target :math:`\\mathbf{p}_o = (x_o, y_o, z_o)`, :math:`z_o > 0`.
-    hold_height : float
-        :math:`z_r` (> 0).
+        Target :math:`\\mathbf{p}_o = (x_o, y_o, z_o)`, :math:`z_o > 0`, same length unit
+        as the sheet.
     contact : array_like, shape (2,), optional
         Where the object sits on the sheet, :math:`\\mathbf{v}_o` (sheet frame), strictly
         inside the sheet. Default: the sheet's area centroid.
@@ -356,8 +361,6 @@ def inverse_kinematics(sheet: Sheet, object_position: ArrayLike, hold_height: fl
     reference : array_like, shape (N, 2), optional
         A formation to stay close to (e.g. the current one): the solution then minimises
         :math:`\\sum|\\mathbf{r}_i - \\mathbf{r}^{ref}_i|^2`.
-    mass : float, optional
-        Object mass (kg) for the tensions.
     budget : int
         Multi-start searches (step 4) before giving up with ``budget_exhausted``.
     seed : int
@@ -380,18 +383,18 @@ def inverse_kinematics(sheet: Sheet, object_position: ArrayLike, hold_height: fl
 
     Examples
     --------
-    >>> from taut.sheet import Sheet, inverse_kinematics
+    >>> from taut.sheet import Sheet, SheetTeam, inverse_kinematics
     >>> square = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
-    >>> r = inverse_kinematics(square, [0.3, -0.2, 0.4], 1.0)
+    >>> r = inverse_kinematics(SheetTeam(square, 1.0), [0.3, -0.2, 0.4])
     >>> r.success, r.status, r.weights.round(3).tolist()
     (True, 'ok', [0.25, 0.25, 0.25, 0.25])
-    >>> far = inverse_kinematics(square, [0, 0, 0.05], 2.0)       # deeper than the cables
+    >>> far = inverse_kinematics(SheetTeam(square, 2.0), [0, 0, 0.05])   # deeper than the cables
     >>> far.status, far.certificate.kind
     ('unreachable', 'depth')
     """
-    sheet = _check_sheet(sheet)
-    mass = _check_mass(mass)
-    t = _target(sheet, object_position, hold_height, contact)
+    team = require_team(team)
+    sheet = team.sheet
+    t = _target(team, object_position, contact)
     heading = as_finite_scalar(heading, "heading")
     budget = int(as_nonnegative(budget, "budget"))
     branch_boxes = int(as_nonnegative(branch_boxes, "branch_boxes"))
@@ -402,16 +405,17 @@ def inverse_kinematics(sheet: Sheet, object_position: ArrayLike, hold_height: fl
             or radial_certificate(t.V, t.rho, t.scale))
     if cert is not None:
         return _failure(sheet, t, "unreachable", cert.message, cert, 0)
-    return _search(sheet, t, heading, ref_n, mass, (budget, branch_boxes), seed)
+    return _search(team, t, heading, ref_n, (budget, branch_boxes), seed)
 
 
-def _search(sheet: Sheet, t: _Target, heading: float, ref_n: np.ndarray | None,
-            mass: float | None, budgets: tuple[int, int], seed: int) -> IKResult:
+def _search(team: SheetTeam, t: _Target, heading: float, ref_n: np.ndarray | None,
+            budgets: tuple[int, int], seed: int) -> IKResult:
     """Steps 1-4 of the module docstring on a target with real reaches."""
+    sheet, mass = team.sheet, team.mass
     w = maxent_weights(sheet.vertices, t.vo, t.scale)
     phi = _preferred_directions(t, heading, ref_n)
     best, _, runs = _construct(t, w, phi, ref_n)
-    if best is not None and _verified(sheet, t, t.p[:2] + t.scale * (
+    if best is not None and _verified(team, t, t.p[:2] + t.scale * (
             t.rho[:, None] * np.column_stack([np.cos(best.angles), np.sin(best.angles)]))):
         return _success(sheet, t, best, mass, runs)
     cert = _certify(t, w)
@@ -421,7 +425,7 @@ def _search(sheet: Sheet, t: _Target, heading: float, ref_n: np.ndarray | None,
 
     def accept(th: np.ndarray, wt: np.ndarray) -> bool:
         ok, R, *_ = check_solution(t.V, t.rho, wt, th)
-        return ok and _verified(sheet, t, t.p[:2] + t.scale * R)
+        return ok and _verified(team, t, t.p[:2] + t.scale * R)
 
     budget, boxes = budgets
     early = min(budget, EARLY_SEARCHES)

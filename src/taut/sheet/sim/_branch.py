@@ -23,12 +23,12 @@ from .._lifted import Frame
 from .._tol import (ARRIVAL_ACTIVE_TOL, ARRIVAL_RTOL, CONTINUATION_RTOL, DEGENERATE_STEP,
     EVENT_STEP_TOL, SUBSETS_UP_TO)
 from ..._jit import HAVE_NUMBA
-from ..fk.forward import forward_kinematics, forward_kinematics_batch
-from ..model import Sheet
+from ..fk.solver import cached_solver
 from .results import EventKind, SimulationEvent
 from ..fk.results import Equilibrium, FKResult
 from ._support import (SetSolution, State, branch, from_equilibrium, members, nearest,
     neighbour_sets, solve_support_one, solve_taut_sets)
+from ..team import SheetTeam
 
 __all__ = ["State", "Tracker", "solve_taut_sets", "branch", "fk_result", "fk_stable",
            "fk_stable_batch", "from_equilibrium", "nearest", "resolve_step", "make_event",
@@ -50,14 +50,16 @@ FKMethod = Literal["fast", "exhaustive", "subsets"]
 
 
 class Tracker:
-    """Follows the object's branch on one sheet at one hold height (module docstring).
+    """Follows the object's branch for one sheet team (module docstring).
 
     ``single_fast`` switches the one-formation re-solve of :meth:`valid_at` to
     :func:`solve_support_one` (same tests, no batching overhead; used by the stepping
     :class:`Simulator`)."""
 
-    def __init__(self, sheet: Sheet, z: float, *, single_fast: bool = False,
+    def __init__(self, team: SheetTeam, *, single_fast: bool = False,
                  compiled: bool | None = None):
+        self.team = team
+        sheet, z = team.sheet, team.hold_height
         self.sheet, self.z = sheet, z
         self.N = sheet.n
         self.single_fast = single_fast
@@ -160,9 +162,9 @@ class Tracker:
         method can miss states, so small teams use the complete 'subsets' method and
         larger ones fall back to it when 'fast' finds none."""
         method: FKMethod = "subsets" if self.N <= SUBSETS_UP_TO else "fast"
-        stable = fk_stable(self.sheet, R, self.z, method)
+        stable = fk_stable(self.team, R, method)
         if not stable and method == "fast":
-            stable = fk_stable(self.sheet, R, self.z, "subsets")
+            stable = fk_stable(self.team, R, "subsets")
         return stable
 
     def _neighbour_continuation(self, R: np.ndarray, before: State, cont_tol: float
@@ -288,7 +290,7 @@ def resolve_step(tracker: Tracker, state: State, R0: np.ndarray, R1: np.ndarray,
         state, s0 = new, hi
         if s0 >= 1.0:
             return state
-    stable = fk_stable(tracker.sheet, R1, tracker.z, "fast")  # pragma: no cover - safeguard
+    stable = fk_stable(tracker.team, R1, "fast")  # pragma: no cover - safeguard
     if not stable:                                            # pragma: no cover
         events.append(make_event(step, 1.0, "lost", state, None))
         return None
@@ -297,20 +299,20 @@ def resolve_step(tracker: Tracker, state: State, R0: np.ndarray, R1: np.ndarray,
 
 
 # ------------------------------------------------------------------ forward-kinematics hooks
-# The only places simulation calls full forward kinematics (a prepared FK solver for the
-# fixed sheet and hold height can replace these three bodies).
+# The only places simulation calls full forward kinematics: the team's cached FK solver
+# (the engine behind :func:`forward_kinematics`; the team is validated already).
 
-def fk_result(sheet: Sheet, R: np.ndarray, z: float, method: FKMethod = "fast") -> FKResult:
+def fk_result(team: SheetTeam, R: np.ndarray, method: FKMethod = "fast") -> FKResult:
     """Forward kinematics of one formation R (N, 2)."""
-    return forward_kinematics(sheet, R, z, method=method)
+    return cached_solver(team, method).solve(R)
 
 
-def fk_stable(sheet: Sheet, R: np.ndarray, z: float, method: FKMethod = "fast"
+def fk_stable(team: SheetTeam, R: np.ndarray, method: FKMethod = "fast"
               ) -> tuple[Equilibrium, ...]:
     """Stable equilibria of one formation R (N, 2)."""
-    return fk_result(sheet, R, z, method).stable
+    return fk_result(team, R, method).stable
 
 
-def fk_stable_batch(sheet: Sheet, R: np.ndarray, z: float) -> np.ndarray:
+def fk_stable_batch(team: SheetTeam, R: np.ndarray) -> np.ndarray:
     """Bool (B,): formation ``R[b]`` (B, N, 2) has a stable equilibrium."""
-    return np.asarray(forward_kinematics_batch(sheet, R, z).stable.any(axis=1))
+    return np.asarray(cached_solver(team, "fast").solve_batch(R).stable.any(axis=1))

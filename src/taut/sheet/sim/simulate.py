@@ -43,42 +43,36 @@ loops (set robot velocities or formations, step, read the object).
 
 from __future__ import annotations
 
-from typing import Literal
-
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import as_array
+from ..._validate import as_array, as_choice
 from ...errors import InvalidInputError, InvalidTrajectoryError
 from ._branch import (State, Tracker, fk_result, fk_stable_batch, from_equilibrium, make_event,
     members, nearest, resolve_step)
 from ..._jit import HAVE_NUMBA
 from .results import EventKind, SimulationEvent, SimulationResult, SimulatorState
-from ..fk.forward import _check_mass, _check_sheet
-from ..model import Sheet, check_formations, check_hold_height
-from ..fk.results import GRAVITY
+from .._options import BACKENDS, Backend
+from ..model import Sheet, check_formations
+from ..._units import GRAVITY
+from ..team import SheetTeam, require_team
 
-__all__ = ["SimulationEvent", "SimulationResult", "SimulatorState", "simulate", "EventKind"]
-
-
-Backend = Literal["auto", "numba", "numpy"]
+__all__ = ["simulate"]
 
 
 def _compiled(backend: object) -> bool:
     """Whether ``backend`` selects the compiled branch follower (as ``FKSolver``'s
     ``backend``: ``"numba"`` without numba installed is an error)."""
-    if not isinstance(backend, str) or backend not in ("auto", "numba", "numpy"):
-        raise InvalidInputError("backend", f"must be one of auto, numba, numpy; got "
-                                           f"{backend!r}")
+    backend = as_choice(backend, BACKENDS, "backend")
     if backend == "numba" and not HAVE_NUMBA:
         raise InvalidInputError("backend", "numba is not installed (pip install numba)")
     return backend != "numpy" and HAVE_NUMBA
 
 
-def _initial_state(sheet: Sheet, R: np.ndarray, z: float, start: object | None,
-                   field: str) -> State:
+def _initial_state(team: SheetTeam, R: np.ndarray, start: object | None, field: str
+                   ) -> State:
     """The stable state of formation R nearest to ``start`` (3,) (default: the lowest)."""
-    fk0 = fk_result(sheet, R, z)
+    fk0 = fk_result(team, R)
     if not fk0.stable:
         raise InvalidTrajectoryError(field, "no stable rest state for the object at step 0")
     if start is None:
@@ -87,7 +81,7 @@ def _initial_state(sheet: Sheet, R: np.ndarray, z: float, start: object | None,
     else:
         p = as_array(start, "start", shape=(3,))
         first = min(fk0.stable, key=lambda e: float(np.linalg.norm(e.object - p)))
-    return from_equilibrium(first, sheet, R, z)
+    return from_equilibrium(first, team.sheet, R, team.hold_height)
 
 
 class _Record:
@@ -125,18 +119,18 @@ def _tensions(sheet: Sheet, z: float, mass: float | None, contact: np.ndarray,
         return np.where(taut, weights * mass * GRAVITY * lengths / depth[..., None], 0.0)
 
 
-def _recover(sheet: Sheet, R: np.ndarray, z: float, t: int, chunk: int
+def _recover(team: SheetTeam, R: np.ndarray, t: int, chunk: int
              ) -> tuple[State | None, int]:
     """First step >= t (within ``chunk`` steps) with a stable state: (its lowest state,
     step), or (None, end of the chunk)."""
     end = min(len(R), t + chunk)
-    found = np.flatnonzero(fk_stable_batch(sheet, R[t:end], z))
+    found = np.flatnonzero(fk_stable_batch(team, R[t:end]))
     if not len(found):
         return None, end
     t += int(found[0])
-    lowest = fk_result(sheet, R[t], z).lowest
+    lowest = fk_result(team, R[t]).lowest
     assert lowest is not None
-    return from_equilibrium(lowest, sheet, R[t], z), t
+    return from_equilibrium(lowest, team.sheet, R[t], team.hold_height), t
 
 
 def _follow(tracker: Tracker, R: np.ndarray, state: State, t: int, chunk: int,
@@ -158,13 +152,12 @@ def _run(tracker: Tracker, R: np.ndarray, state: State, rec: _Record,
          ) -> None:
     """The driver loop: chunked branch following, events resolved step by step."""
     T = len(R)
-    sheet, z = tracker.sheet, tracker.z
     motion = np.abs(np.diff(R, axis=0)).max(axis=(1, 2)) if T > 1 else np.zeros(0)
     t, chunk = 1, 64
     cur: State | None = state
     while t < T:
         if cur is None:                                    # lost: look for a rest state
-            cur, t_found = _recover(sheet, R, z, t, chunk)
+            cur, t_found = _recover(tracker.team, R, t, chunk)
             if cur is None:
                 t, chunk = t_found, min(4 * chunk, 4096)
                 continue
@@ -198,24 +191,21 @@ def _outcome(events: list[SimulationEvent] | tuple[SimulationEvent, ...], lost_n
                                f"rest state){'; recovered later' if back else ''}")
 
 
-def simulate(sheet: Sheet, formations: ArrayLike, hold_height: float, *,
-             start: ArrayLike | None = None, mass: float | None = None,
+def simulate(team: SheetTeam, formations: ArrayLike, *, start: ArrayLike | None = None,
              backend: Backend = "auto") -> SimulationResult:
     """Quasi-static simulation of the object along a time series of formations.
 
     Parameters
     ----------
-    sheet : Sheet
+    team : SheetTeam
+        The sheet, the holding height :math:`z_r` and, optionally, the object mass (kg)
+        for the tensions :math:`F_i = w_i m g l_i / d` (N).
     formations : array_like, shape (T, N, 2)
         Robot positions at each step (world frame, sheet units). Steps should be small
         enough that no branch appears and vanishes between two samples.
-    hold_height : float
-        :math:`z_r` (> 0).
     start : array_like, shape (3,), optional
         Reference object position: the simulation starts at the stable equilibrium of
         ``formations[0]`` nearest to it (default: the lowest).
-    mass : float, optional
-        Object mass (kg) for the tensions :math:`F_i = w_i m g l_i / d`.
     backend : {"auto", "numba", "numpy"}
         Branch following by the compiled support solve (``"auto"``: when numba is
         installed) or by the numpy path; both give the same states.
@@ -237,30 +227,29 @@ def simulate(sheet: Sheet, formations: ArrayLike, hold_height: float, *,
     Examples
     --------
     >>> import numpy as np
-    >>> from taut.sheet import Sheet, simulate
+    >>> from taut.sheet import Sheet, SheetTeam, simulate
     >>> square = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
     >>> R0 = 0.8 * square.vertices
     >>> path = R0 + np.linspace(0, 0.5, 11)[:, None, None] * [1.0, 0.0]   # slide along x
-    >>> res = simulate(square, path, 1.5)
+    >>> res = simulate(SheetTeam(square, 1.5), path)
     >>> res.success, res.status, len(res), res.events
     (True, 'ok', 11, ())
     >>> bool(np.allclose(res.object[-1] - res.object[0], [0.5, 0, 0]))
     True
     """
-    sheet = _check_sheet(sheet)
-    mass = _check_mass(mass)
-    _compiled(backend)
-    z = check_hold_height(hold_height)
+    team = require_team(team)
+    sheet, z, mass = team.sheet, team.hold_height, team.mass
+    compiled = _compiled(backend)
     R = check_formations(sheet, as_array(formations, "formations", ndim=3))
     T, N = R.shape[:2]
     if T == 0:
         raise InvalidInputError("formations", "needs at least one step")
-    state = _initial_state(sheet, R[0], z, start, "formations")
+    state = _initial_state(team, R[0], start, "formations")
     rec = _Record(T, N)
     rec.store(0, state)
     events: list[SimulationEvent] = []
     crossings: dict[int, tuple[float, np.ndarray]] = {}
-    _run(Tracker(sheet, z, compiled=_compiled(backend)), R, state, rec, events, crossings)
+    _run(Tracker(team, compiled=compiled), R, state, rec, events, crossings)
     tensions = _tensions(sheet, z, mass, rec.con, rec.obj, rec.wts, rec.taut)
     taut_sets = tuple(tuple(int(i) for i in np.flatnonzero(row)) for row in rec.taut)
     events += _taut_changes(taut_sets, rec.obj, events, crossings)

@@ -13,9 +13,10 @@ from ...errors import InvalidInputError, InvalidTrajectoryError
 from . import _branch
 from ._branch import State, Tracker, fk_result, from_equilibrium, make_event, resolve_step
 from .results import SimulationEvent, SimulatorState
-from ..fk.forward import _check_mass, _check_sheet
-from ..model import GEOMETRY_RTOL, Sheet, check_formation, check_hold_height
-from .simulate import Backend, _compiled, _initial_state, _tensions
+from ..model import GEOMETRY_RTOL, check_formation
+from .._options import Backend
+from .simulate import _compiled, _initial_state, _tensions
+from ..team import SheetTeam, require_team
 
 __all__ = ["Simulator"]
 
@@ -31,21 +32,28 @@ class Simulator:
 
     Parameters
     ----------
-    sheet : Sheet
-    hold_height : float
-        :math:`z_r` (> 0).
+    team : SheetTeam
+        The sheet, the holding height :math:`z_r` and, optionally, the object mass (kg)
+        for the tensions (N).
     formation : array_like, shape (N, 2)
         Initial robot positions (sheet units).
     start : array_like, shape (3,), optional
         Reference object position: the simulator starts at the stable state of
         ``formation`` closest to it (default: the lowest).
-    mass : float, optional
-        Object mass (kg) for the tensions.
     dt : float
         Default time step (s) of :meth:`step` with velocities (1/30, as the peers').
     backend : {"auto", "numba", "numpy"}
         As in :func:`simulate`: the compiled branch follower (one compiled call per step
         without events) or the numpy path; both give the same states.
+
+    Attributes
+    ----------
+    team : SheetTeam
+        The team simulated.
+    dt : float
+        The default time step, s.
+    initial : SimulatorState
+        The state before the first step.
 
     Raises
     ------
@@ -58,9 +66,9 @@ class Simulator:
     Examples
     --------
     >>> import numpy as np
-    >>> from taut.sheet import Sheet, Simulator
+    >>> from taut.sheet import Sheet, SheetTeam, Simulator
     >>> square = Sheet([[1, 1], [-1, 1], [-1, -1], [1, -1]])
-    >>> sim = Simulator(square, 1.5, 0.8 * square.vertices)
+    >>> sim = Simulator(SheetTeam(square, 1.5), 0.8 * square.vertices)
     >>> v = np.tile([0.3, 0.0], (4, 1))                  # every robot at 0.3 units/s in x
     >>> for _ in range(10):
     ...     state = sim.step(velocities=v, dt=0.1)
@@ -70,22 +78,18 @@ class Simulator:
     True
     """
 
-    def __init__(self, sheet: Sheet, hold_height: float, formation: ArrayLike, *,
-                 start: ArrayLike | None = None, mass: float | None = None,
-                 dt: float = 1.0 / 30.0, backend: Backend = "auto") -> None:
-        self.sheet = _check_sheet(sheet)
-        self.mass = _check_mass(mass)
-        self.hold_height = check_hold_height(hold_height)
+    def __init__(self, team: SheetTeam, formation: ArrayLike, *,
+                 start: ArrayLike | None = None, dt: float = 1.0 / 30.0,
+                 backend: Backend = "auto") -> None:
+        self.team = team = require_team(team)
+        sheet = team.sheet
         self.dt = as_positive(dt, "dt")
-        R = check_formation(self.sheet, as_array(formation, "formation",
-                                                 shape=(self.sheet.n, 2)))
-        self._tracker = Tracker(self.sheet, self.hold_height, single_fast=True,
-                                compiled=_compiled(backend))
-        limit = self.sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * self.sheet.size
+        R = check_formation(sheet, as_array(formation, "formation", shape=(sheet.n, 2)))
+        self._tracker = Tracker(team, single_fast=True, compiled=_compiled(backend))
+        limit = sheet.side_lengths() * (1 + GEOMETRY_RTOL) + GEOMETRY_RTOL * sheet.size
         self._limit2 = np.ascontiguousarray(limit * limit)          # (N, N)
-        self._iu, self._ju = np.triu_indices(self.sheet.n, 1)
-        self._cur: State | None = _initial_state(self.sheet, R, self.hold_height, start,
-                                                 "formation")
+        self._iu, self._ju = np.triu_indices(sheet.n, 1)
+        self._cur: State | None = _initial_state(team, R, start, "formation")
         self._R = R.copy()
         self._velocities = np.zeros_like(R)
         self._steps, self._time = 0, 0.0
@@ -104,7 +108,7 @@ class Simulator:
         return self._velocities.copy()
 
     def _snapshot(self, events: tuple[SimulationEvent, ...]) -> SimulatorState:
-        s, N = self._cur, self.sheet.n
+        s, N = self._cur, self.team.n
         if s is None:
             return SimulatorState(self._steps, self._time, self._R.copy(), np.full(3, np.nan),
                                   np.full(2, np.nan), (), np.zeros(N), None, events, False,
@@ -113,10 +117,11 @@ class Simulator:
         obj[:2] = s.ro
         obj[2] = s.z
         ten = None
-        if self.mass is not None:
+        team = self.team
+        if team.mass is not None:
             taut = np.zeros(N, dtype=bool)
             taut[list(s.taut)] = True
-            ten = _tensions(self.sheet, self.hold_height, self.mass, s.vo, obj, s.w, taut)
+            ten = _tensions(team.sheet, team.hold_height, team.mass, s.vo, obj, s.w, taut)
         message = self._messages.get(s.taut)
         if message is None:
             if len(self._messages) > 1024:
@@ -132,7 +137,7 @@ class Simulator:
         if formation is not None and velocities is not None:
             raise InvalidInputError("formation", "give a formation or velocities, not both")
         step_dt = self.dt if dt is None else as_positive(dt, "dt")
-        N = self.sheet.n
+        N = self.team.n
         if formation is None and self._tracker.compiled:
             # The control-loop path: velocities checked and applied in one compiled call
             # (a non-finite or tearing result takes the validating path below).
@@ -155,7 +160,7 @@ class Simulator:
             R1 = self._R + self._velocities * step_dt
         gap = R1[self._iu] - R1[self._ju]
         if np.any(np.einsum("pk,pk->p", gap, gap) > self._limit2[self._iu, self._ju]):
-            check_formation(self.sheet, R1)      # raises with the pair named (and the step)
+            check_formation(self.team.sheet, R1)   # raises with the pair named (and the step)
         return R1, step_dt, float(np.abs(R1 - self._R).max())
 
     def step(self, formation: ArrayLike | None = None, *, velocities: ArrayLike | None = None,
@@ -188,9 +193,10 @@ class Simulator:
         events: list[SimulationEvent] = []
         before = self._cur
         if before is None:
-            lowest = fk_result(self.sheet, R1, self.hold_height).lowest
+            lowest = fk_result(self.team, R1).lowest
             if lowest is not None:
-                self._cur = from_equilibrium(lowest, self.sheet, R1, self.hold_height)
+                self._cur = from_equilibrium(lowest, self.team.sheet, R1,
+                                             self.team.hold_height)
                 events.append(make_event(self._steps, 0.0, "recovered", None, self._cur))
         else:
             crossings: dict[int, tuple[float, np.ndarray]] = {}

@@ -17,9 +17,9 @@ from typing import Any
 import numpy as np
 
 from ...errors import SweepError, TautError
-from . import Columns, Task, register
+from ..task import Columns, Task
 
-__all__: list[str] = []
+__all__ = ["CDPR_WORKSPACE", "CDPR_DEPLOYMENT", "variant"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -29,10 +29,7 @@ class _Context:
     grid: tuple[int, int, int]
 
 
-def _prepare(spec: Any) -> _Context:
-    from ..file import base_model
-
-    robot = base_model(spec)
+def _prepare(spec: Any, robot: Any) -> _Context:
     opts = dict(spec.options)
     box = opts.get("box")
     if box is None:
@@ -59,7 +56,7 @@ def _defaults(ctx: _Context) -> dict[str, float]:
             "t_max": float(np.max(robot.t_max)), "stabilisers": 0.0}
 
 
-def variant(robot: Any, separation: float, payload: float, t_max: float,
+def variant(robot: Any, separation: float, payload: float, t_max: float, *,
             stabilisers: bool) -> Any:
     """The robot with its two mobile bases ``separation`` m apart, payload mass and cable
     ``t_max`` replaced (stabilisers deployed when asked)."""
@@ -93,7 +90,7 @@ def _run_workspace(ctx: _Context, cols: Columns, seeds: np.ndarray) -> Columns:
     for k in range(b):
         try:
             robot = variant(ctx.robot, cols["base_separation"][k], cols["payload"][k],
-                            cols["t_max"][k], bool(cols["stabilisers"][k]))
+                            cols["t_max"][k], stabilisers=bool(cols["stabilisers"][k]))
             lo, hi = np.asarray(robot.bounds, float)
             inside = np.all((points >= lo) & (points <= hi), axis=1)
             feas = np.zeros(len(points), bool)
@@ -127,19 +124,15 @@ def _run_deployment(ctx: _Context, cols: Columns, seeds: np.ndarray) -> Columns:
             box[1, 2] = cols["z_max"][k]
         try:
             robot = variant(ctx.robot, np.nan, cols["payload"][k], cols["t_max"][k],
-                            bool(cols["stabilisers"][k]))
+                            stabilisers=bool(cols["stabilisers"][k]))
             res = plan_deployment(robot, box)
         except SweepError:
             raise
         except TautError as exc:
             out["message"][k] = str(exc)
             continue
-        ok = bool(getattr(res, "success", getattr(res, "feasible", False)))
-        out["success"][k] = ok
-        out["status"][k] = str(getattr(res, "status", "ok" if ok else "infeasible"))
-        margin = getattr(res, "margin", None)
-        out["margin"][k] = np.nan if margin is None else float(margin)
-        out["message"][k] = str(getattr(res, "message", getattr(res, "reason", "")) or "")
+        out["success"][k], out["status"][k] = bool(res.success), str(res.status)
+        out["margin"][k], out["message"][k] = float(res.margin), str(res.message)
     return out
 
 
@@ -149,7 +142,7 @@ _MODEL_PARAMETERS = {
     "stabilisers": "1 to deploy the bases' stabilisers, 0 not to",
 }
 
-register(Task(
+CDPR_WORKSPACE = Task(
     name="cdpr_workspace",
     summary="wrench-feasible fraction of a workspace grid, with and without tipping",
     parameters={"base_separation": "distance between the two mobile bases' frames, m",
@@ -165,9 +158,9 @@ register(Task(
     needs_base="cdpr model",
     prepare=_prepare,
     run=_run_workspace,
-))
+)
 
-register(Task(
+CDPR_DEPLOYMENT = Task(
     name="cdpr_deployment",
     summary="whether base placements exist that make a workspace box wrench-feasible",
     parameters={"z_max": "top of the workspace box, m (default: the box's)",
@@ -181,4 +174,4 @@ register(Task(
     needs_base="cdpr model",
     prepare=_prepare,
     run=_run_deployment,
-))
+)

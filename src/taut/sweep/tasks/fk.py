@@ -20,11 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InfeasibleFormationError
-from ...sheet import Sheet, forward_kinematics_batch
-from . import Columns, Task, register
+from ...sheet import SheetTeam, forward_kinematics_batch
+from ..task import Columns, Task
 
-__all__ = ["transform_formations"]
+__all__ = ["FK_STABILITY_MAP", "transform_formations"]
 
 #: Relative slack of the pre-filter of infeasible formations (the solver's own check
 #: decides; this only keeps clearly infeasible formations out of the batch).
@@ -33,19 +32,13 @@ _FEASIBLE_RTOL = 1e-9
 
 @dataclass(frozen=True, eq=False)
 class _Context:
-    sheet: Sheet
+    team: SheetTeam          # the scenario's (its hold height and mass are the defaults)
     formation: np.ndarray
-    hold_height: float
-    mass: float | None
     limits: np.ndarray       # (N, N) sheet distances
 
 
-def _prepare(spec: Any) -> _Context:
-    from ..file import base_model
-
-    sc = base_model(spec)
-    return _Context(sc.sheet, np.asarray(sc.formation, float), float(sc.hold_height),
-                    sc.mass, sc.sheet.side_lengths())
+def _prepare(spec: Any, sc: Any) -> _Context:
+    return _Context(sc.team, np.asarray(sc.formation, float), sc.team.sheet.side_lengths())
 
 
 def transform_formations(formation: np.ndarray, cols: Columns, seeds: np.ndarray,
@@ -79,37 +72,27 @@ def transform_formations(formation: np.ndarray, cols: Columns, seeds: np.ndarray
 
 def _feasible(ctx: _Context, forms: np.ndarray) -> np.ndarray:
     d = np.linalg.norm(forms[:, :, None, :] - forms[:, None, :, :], axis=-1)
-    slack = _FEASIBLE_RTOL * ctx.sheet.size
+    slack = _FEASIBLE_RTOL * ctx.team.sheet.size
     return np.all(d <= ctx.limits * (1 + _FEASIBLE_RTOL) + slack, axis=(1, 2))
 
 
 def _solve_group(ctx: _Context, forms: np.ndarray, hold: float, mass: float | None,
                  out: Columns, rows: np.ndarray) -> None:
-    try:
-        res = forward_kinematics_batch(ctx.sheet, forms, hold, mass=mass)
-    except InfeasibleFormationError:
-        # A borderline formation the pre-filter let through: solve one by one.
-        for k, r in enumerate(rows):
-            try:
-                one = forward_kinematics_batch(ctx.sheet, forms[k:k + 1], hold, mass=mass)
-            except InfeasibleFormationError:
-                out["feasible"][r] = False
-                continue
-            _store_all(one, out, np.array([r]))
-        return
+    res = forward_kinematics_batch(SheetTeam(ctx.team.sheet, hold, mass), forms)
+    out["feasible"][rows] = res.feasible      # a borderline formation the pre-filter let through
     _store_all(res, out, rows)
 
 
 def _store_all(res: Any, out: Columns, rows: np.ndarray) -> None:
     """Every row of a batch at once: counts, and the lowest stable state of each formation."""
-    status = res.status                                   # (B, K), -1 padding
-    out["n_equilibria"][rows] = np.sum((status == 0) | (status == 1), axis=1)
-    out["n_stable"][rows] = np.sum(status == 0, axis=1)
-    out["n_saddle"][rows] = np.sum(status == 1, axis=1)
+    kind = res.kind                                       # (B, K), -1 padding
+    out["n_equilibria"][rows] = np.sum((kind == 0) | (kind == 1), axis=1)
+    out["n_stable"][rows] = np.sum(kind == 0, axis=1)
+    out["n_saddle"][rows] = np.sum(kind == 1, axis=1)
     out["n_states"][rows] = res.count
-    if status.shape[1] == 0:
+    if kind.shape[1] == 0:
         return
-    z = np.where(status == 0, res.object[..., 2], np.inf)
+    z = np.where(kind == 0, res.object[..., 2], np.inf)
     low = np.argmin(z, axis=1)
     b = np.flatnonzero(np.isfinite(z[np.arange(len(low)), low]))
     if b.size == 0:
@@ -156,11 +139,11 @@ def _run(ctx: _Context, cols: Columns, seeds: np.ndarray) -> Columns:
 def _defaults(ctx: _Context) -> dict[str, float]:
     """Values of parameters that are not swept; hold height and mass are the scenario's."""
     return {"scale": 1.0, "stretch": 1.0, "stretch_angle": 0.0, "rotation": 0.0,
-            "jitter": 0.0, "hold_height": ctx.hold_height,
-            "mass": -1.0 if ctx.mass is None else float(ctx.mass)}
+            "jitter": 0.0, "hold_height": ctx.team.hold_height,
+            "mass": -1.0 if ctx.team.mass is None else float(ctx.team.mass)}
 
 
-FK_STABILITY_MAP = register(Task(
+FK_STABILITY_MAP = Task(
     name="fk_stability_map",
     summary="rest states of a sheet scenario over formation scale, stretch and heading",
     parameters={
@@ -188,5 +171,5 @@ FK_STABILITY_MAP = register(Task(
     needs_base="sheet scenario",
     prepare=_prepare,
     run=_run,
-))
+)
 

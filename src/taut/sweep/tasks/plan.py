@@ -19,18 +19,9 @@ from typing import Any
 import numpy as np
 
 from ...errors import SweepError, TautError
-from . import Columns, Task, register
+from ..task import Columns, Task
 
-__all__: list[str] = []
-
-
-def _status(res: Any) -> tuple[bool, str, str]:
-    ok = bool(res.success)
-    status = str(getattr(res, "status", "ok" if ok else "no_route"))
-    message = getattr(res, "message", None)
-    if message is None:
-        message = getattr(res, "reason", "")
-    return ok, status, str(message or "")
+__all__ = ["PLAN_SUITE", "PLAN_ROBUSTNESS"]
 
 
 def _run_suite(ctx: Any, cols: Columns, seeds: np.ndarray) -> Columns:
@@ -45,12 +36,12 @@ def _run_suite(ctx: Any, cols: Columns, seeds: np.ndarray) -> Columns:
         n = int(cols["n_robots"][k])
         try:
             sc = generate_scenario(int(cols["scenario_seed"][k]), n if n > 0 else None)
-            res = plan(sc, baseline=bool(cols["baseline"][k]))
+            res = plan(sc, baseline="se2" if cols["baseline"][k] else None)
         except TautError as exc:
             out["message"][k] = str(exc)
             continue
-        ok, status, message = _status(res)
-        out["success"][k], out["status"][k], out["message"][k] = ok, status, message
+        ok = bool(res.success)
+        out["success"][k], out["status"][k], out["message"][k] = ok, res.status, res.message
         out["n_robots_used"][k] = sc.team.n
         if ok:
             out["path_length"][k] = float(res.path_length)
@@ -67,15 +58,12 @@ class _PlanContext:
     object: np.ndarray       # (T, 3) m
 
 
-def _prepare_robustness(spec: Any) -> _PlanContext:
-    from ..file import base_model
+def _prepare_robustness(spec: Any, sc: Any) -> _PlanContext:
     from ...plan import plan
 
-    sc = base_model(spec)
     res = plan(sc)
     if not res.success:
-        _, _, message = _status(res)
-        raise SweepError("base", f"the base scenario has no plan to perturb ({message})")
+        raise SweepError("base", f"the base scenario has no plan to perturb ({res.message})")
     return _PlanContext(sc, np.asarray(res.times, float), np.asarray(res.robots, float),
                         np.asarray(res.object, float))
 
@@ -98,7 +86,7 @@ def _run_robustness(ctx: _PlanContext, cols: Columns, seeds: np.ndarray) -> Colu
     return out
 
 
-register(Task(
+PLAN_SUITE = Task(
     name="plan_suite",
     summary="the planner (or the baseline) over seeded generated corridors",
     parameters={"scenario_seed": "seed of taut.plan.generate_scenario",
@@ -111,11 +99,11 @@ register(Task(
     defaults=lambda ctx: {"scenario_seed": 0.0, "n_robots": 0.0, "baseline": 0.0},
     default_chunk=1,
     needs_base="",
-    prepare=lambda spec: None,
+    prepare=lambda spec, base: None,
     run=_run_suite,
-))
+)
 
-register(Task(
+PLAN_ROBUSTNESS = Task(
     name="plan_robustness",
     summary="one plan replayed under seeded robot position noise",
     parameters={"sigma": "standard deviation of the position noise per coordinate (drawn "
@@ -133,4 +121,4 @@ register(Task(
     needs_base="plan scenario",
     prepare=_prepare_robustness,
     run=_run_robustness,
-))
+)

@@ -47,9 +47,10 @@ from ..._validate import MAX_SHEET_LENGTH, as_bounded, require_instance
 from ...errors import InvalidInputError, TautError
 from ...sheet import Equilibrium, FKSolver, formation_metrics
 from .. import _tol
+from .._tol import MAX_SHEET_MARGIN_M
 from ._problem import MIN_DEPTH_FRACTION
 from ._squeeze_robust import convex_hull, hull_inset, tolerates
-from .optimal import Formation, optimal_formation
+from .optimal import Formation, _optimal_formation
 from ..world import Team
 
 __all__ = ["squeezed_formation"]
@@ -315,8 +316,8 @@ def _start_robots(team: Team, sheet_margin: float, start: Formation | None) -> n
     """The start's robots (N, 2), m: ``start``, else the narrow all-taut formation (the
     compact one for three robots), else a contracted copy of the sheet."""
     if start is None:
-        start = optimal_formation(team, kind="narrow" if team.n > 3 else "compact",
-                                  sheet_margin=sheet_margin)
+        start = _optimal_formation(team, "narrow" if team.n > 3 else "compact",
+                                   sheet_margin=sheet_margin)
     if start is not None:
         return np.array(start.robots, dtype=float)
     V = team.sheet.vertices
@@ -348,7 +349,7 @@ def _finish(team: Team, solver: FKSolver, lim: _Limits, cand: _Candidate) -> For
         e, robots, w = c.state, np.array(c.robots), np.zeros(team.n)
         robots.setflags(write=False)
         w[list(e.taut)] = e.weights
-        m = formation_metrics(robots, margin=team.side_safety, object_height=e.height,
+        m = formation_metrics(robots, margin=team.clearance, object_height=e.height,
                               height_margin=team.height_safety)
         reach = float(np.linalg.norm(robots - e.object[:2], axis=1).max()) + team.clearance
         # max_height 0: a slack cable's stretch of sheet sags and may hang below the object
@@ -392,20 +393,28 @@ def squeezed_formation(team: Team, *, sheet_margin: float = 0.0, width: float | 
         formation passes over no obstacle). None when no formation meets the requirements.
     """
     require_instance(team, Team, "team")
-    sheet_margin = as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "m",
+    sheet_margin = as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_MARGIN_M, "m",
                               positive=False)
     if width is not None:
         width = as_bounded(width, "width", MAX_SHEET_LENGTH, "m", positive=False)
-    inset = team.robot_radius if inset is None else as_bounded(
-        inset, "inset", MAX_SHEET_LENGTH, "m", positive=False)
+    if inset is not None:
+        inset = as_bounded(inset, "inset", MAX_SHEET_LENGTH, "m", positive=False)
     if start is not None:
         require_instance(start, Formation, "start")
         if start.n != team.n:
             raise InvalidInputError("start", f"has {start.n} robots, the team {team.n}")
+    return _squeezed_formation(team, sheet_margin, width, inset, start)
+
+
+def _squeezed_formation(team: Team, sheet_margin: float, width: float | None = None,
+                        inset: float | None = None, start: Formation | None = None
+                        ) -> Formation | None:
+    """:func:`squeezed_formation` on validated inputs."""
+    inset = team.robot_radius if inset is None else inset
     lim = _limits(team, sheet_margin, inset)
     if lim is None:
         return None
-    solver = FKSolver(team.sheet, team.hold_height)
+    solver = FKSolver(team.carrier)
     R0 = _start_robots(team, sheet_margin, start) / lim.s * np.array([1.0, START_SQUEEZE])
     u0 = np.append(R0.ravel(), np.abs(R0[:, 1]).max())
     goal = width if width is not None else 2 * inset + _tol.SQUEEZE_WIDTH_TOL

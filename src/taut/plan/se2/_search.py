@@ -1,7 +1,7 @@
 """The SE(2) search over a library of formations (issue 14's planner, our construction).
 
 For each formation of the library the team is a rigid body in SE(2); a seeded RRT-Connect
-(:mod:`taut.plan.se2._rrt`) searches its valid poses (:mod:`taut.plan.se2.space`) from every
+(:mod:`taut.plan.se2._rrt`) searches its valid poses (:mod:`taut.plan.se2._space`) from every
 valid heading at the start to every valid heading at the goal, and the path is shortcut.
 Low obstacles may pass under the sheet between any two robots at any heading, with turns
 anywhere: Algorithm 2's turn-cross-turn is one motion among those the search can produce.
@@ -11,7 +11,7 @@ states valid for both where the in-place change from ``A`` to ``B`` keeps every 
 sampled (the robots move straight, every robot clear of walls and obstacles, the hull over
 obstacles low enough for both formations); the search runs from the start to any of them
 in ``A`` and on from the one reached to the goal in ``B``. The quasi-static simulation
-then checks each change (:mod:`taut.plan.se2.motion`).
+then checks each change (:mod:`taut.plan.se2._motion`).
 
 All candidates are deterministic for a given ``seed``: the budget that decides success is
 an iteration count per search (samples drawn), independent of the machine's load; an
@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._rrt import SearchOutcome, rrt_connect, shortcut, valid_headings
-from .motion import Piece
-from .space import PoseChecker, morph_valid
+from ._motion import Piece
+from ._space import PoseChecker, morph_valid
 from ..formations.optimal import Formation
 from ..world import Scenario
 

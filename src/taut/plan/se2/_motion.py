@@ -132,7 +132,7 @@ def _simulate_change(scenario: Scenario, a: np.ndarray, b: np.ndarray, start: np
     s = np.arange(0, k + 1) / k
     robots = a[None] + s[:, None, None] * (b - a)[None]
     try:
-        sim = simulate(team.sheet, robots, team.hold_height, start=start)
+        sim = simulate(team.carrier, robots, start=start)
     except TautError as exc:
         return f"formation change has no rest state ({exc.problem})"
     bad = [e for e in sim.events if e.kind in ("jump", "lost")]
