@@ -41,7 +41,9 @@ def page(browser_paths):
         yield d
 
 
-def wait_for(d, script, timeout=20.0):
+def wait_for(d, script, timeout=60.0):
+    """Wait for the page; generous, because what is tested is the outcome, not the time
+    (on a loaded 2-core machine a first FK with a cold numba cache can take tens of s)."""
     from taut.app.browser import wait_for as wait
     return wait(d, script, timeout)
 
