@@ -11,8 +11,9 @@ Measures, in one process on this machine:
   tendons), time to mesh and compile one state's model, wall time of ``replay_equilibria`` over every state, and the largest height /
   lateral differences physics vs taut (tied point load and released ball); the spacings
   are interleaved and repeated, medians and ranges quoted;
-* on random teams (``taut.sheet.random.random_team``, 3-8 robots, sheets about 2 units
-  across, hold height 1.6): the distribution of the differences, the sheet's sideways pull
+* on random teams (``taut.sheet.random.random_team``, 3-8 robots, sheets 500-1000 mm
+  across, hold heights 0.8-1.5 sheet radii: issue 31's sample), failed simulations, the
+  distribution of the differences, the sheet's sideways pull
   at stable and at non-equilibrium states, how often physics holds a state taut does not
   call stable and vice versa, and the wall time per team.
 
@@ -32,7 +33,7 @@ from taut.io import load_sheet_scenario
 from taut.physics import replay_equilibria
 from taut.physics._mesh import sheet_mesh
 from taut.physics._sheet_model import build_sheet_sim
-from taut.sheet import SheetTeam, forward_kinematics
+from taut.sheet import Sheet, SheetTeam, forward_kinematics
 from taut.sheet import random_team
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -75,7 +76,7 @@ def spacing_table(meshes: list[int], repeats: int) -> list[dict]:
         m = sheet_mesh(sc.team.sheet.vertices, mesh)
         walls = np.array([w for w, _ in runs])
         r = runs[-1][1]
-        stable = [s for s in r.states if s.status == "stable"]
+        stable = [s for s in r.states if s.kind == "stable" and s.success]
         out.append({
             "example": name, "mesh": mesh, "spacing": m.spacing, "nodes": len(m.nodes),
             "tendons": builds[(name, mesh)][0][1],
@@ -86,26 +87,38 @@ def spacing_table(meshes: list[int], repeats: int) -> list[dict]:
             "tied_lateral_max": max(_lateral(s.tied_difference) for s in stable),
             "released_dz_max": max(abs(s.difference[2]) for s in stable),
             "released_lateral_max": max(_lateral(s.difference) for s in stable),
-            "agree": bool(r.success),
+            "agree": bool(r.success), "failed": sum(not s.success for s in r.states),
         })
     return out
 
 
 def random_study(teams: int, seed: int) -> dict:
+    """The issue-31 sample: N = 3-8, sheets 500-1000 mm across (largest vertex distance),
+    hold heights 0.8-1.5 sheet radii (largest vertex distance from the vertices'
+    centroid); teams with no rest state (taut: infeasible) are redrawn."""
     rng = np.random.default_rng(seed)
     states, walls = [], []
-    for k in range(teams):
+    k = 0
+    while k < teams:
         n = int(rng.integers(3, 9))
         sheet, R = random_team(n, rng)
+        s = rng.uniform(500.0, 1000.0) / float(np.max(sheet.side_lengths()))
+        sheet, R = Sheet(sheet.vertices * s), R * s
+        radius = float(np.max(np.linalg.norm(sheet.vertices - sheet.vertices.mean(0), axis=1)))
+        team = SheetTeam(sheet, rng.uniform(0.8, 1.5) * radius)
+        if not forward_kinematics(team, R).equilibria:
+            continue
         width = float(np.max(sheet.side_lengths()))
         t0 = time.perf_counter()
-        r = replay_equilibria(SheetTeam(sheet, 1.6), R)
+        r = replay_equilibria(team, R)
         walls.append((n, time.perf_counter() - t0, len(r.states)))
-        for s in r.states:
-            states.append({"team": k, "n": n, "status": s.status, "held": s.held,
-                           "sliding": s.sliding,
-                           "tied": (s.tied_difference / width).tolist(),
-                           "released": (s.difference / width).tolist()})
+        for st in r.states:
+            states.append({"team": k, "n": n, "kind": st.kind, "held": st.held,
+                           "sliding": st.sliding, "status": st.status,
+                           "tied": (st.tied_difference / width).tolist(),
+                           "released": (st.difference / width).tolist(),
+                           "released_dz_mm": float(st.difference[2])})
+        k += 1
     return {"states": states, "walls": walls}
 
 
@@ -136,11 +149,14 @@ def main() -> None:
               f"{r['released_lateral_max']:.1f} | {r['agree']} |")
     study = random_study(a.teams, a.seed)
     st = study["states"]
-    stable = [s for s in st if s["status"] == "stable"]
-    noneq = [s for s in st if s["status"] == "not_equilibrium"]
+    stable = [s for s in st if s["kind"] == "stable" and s["status"] == "ok"]
+    noneq = [s for s in st if s["kind"] == "not_equilibrium"]
+    print(f"\nfailed simulations: {sum(s['status'] != 'ok' for s in st)} of {len(st)}; "
+          f"stable states whose released object settled more than 5 mm in height from "
+          f"taut's: {sum(abs(s['released_dz_mm']) > 5 for s in stable)} of {len(stable)}")
     print(f"\nrandom teams: {a.teams}, states: {len(st)} ({len(stable)} stable, "
           f"{len(noneq)} not an equilibrium, "
-          f"{sum(s['status'] == 'saddle' for s in st)} saddle)")
+          f"{sum(s['kind'] == 'saddle' for s in st)} saddle)")
     print("differences at stable states, per mille of the sheet's width (x1000):")
     print("  tied |dz|       :", _pct([abs(s["tied"][2]) for s in stable]))
     print("  tied lateral    :", _pct([np.hypot(*s["tied"][:2]) for s in stable]))
@@ -152,8 +168,8 @@ def main() -> None:
           f" not-equilibrium min {sl_ne.min():.3f} (median {np.median(sl_ne):.3f})"
           if len(sl_ne) else "")
     print(f"physics holds a state taut does not call stable: "
-          f"{sum(s['held'] and s['status'] != 'stable' for s in st)} of "
-          f"{sum(s['status'] != 'stable' for s in st)}")
+          f"{sum(s['held'] and s['kind'] != 'stable' for s in st)} of "
+          f"{sum(s['kind'] != 'stable' for s in st)}")
     print(f"taut stable but physics does not hold: {sum(not s['held'] for s in stable)} "
           f"of {len(stable)}")
     w = np.array([(n, t, k) for n, t, k in study["walls"]])

@@ -36,9 +36,10 @@ def sheet_table(name: str, path: Path, figure: str) -> None:
     for s in r.states:
         label = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
         fmt = lambda d: ", ".join(f"{v:+.1f}" for v in d)  # noqa: E731
-        print(f"| {label} | {s.predicted[2]:.1f} | {s.status.replace('_', ' ')} | "
+        released = fmt(s.difference) if s.success else f"FAILED: {s.message}"
+        print(f"| {label} | {s.predicted[2]:.1f} | {s.kind.replace('_', ' ')} | "
               f"{'held' if s.held else 'not held'} | {s.sliding:.3f} | "
-              f"{fmt(s.tied_difference)} | {fmt(s.difference)} | {s.time:.1f} |")
+              f"{fmt(s.tied_difference)} | {released} | {s.time:.1f} |")
     fig = plot_equilibria_check(r, sc.formation, sc.team.hold_height, HERE / figure, units="mm",
                                 title=name)
     plt.close(fig)

@@ -51,6 +51,28 @@ def test_triangle_json_and_figure(capsys, triangle, tmp_path):
     data = json.loads(out)
     assert data["success"] and data["status"] == "ok"
     (state,) = data["states"]
-    assert state["taut"] == [0, 1, 2] and state["status"] == "stable" and state["held"]
+    assert state["taut"] == [0, 1, 2] and state["kind"] == "stable" and state["held"]
+    assert state["success"] and state["status"] == "ok"
     assert abs(state["tied_difference"][2]) <= 5.0
+    assert png.stat().st_size > 10_000
+
+
+def test_a_failed_simulation_is_shown_as_failed(capsys, triangle, tmp_path, monkeypatch):
+    # A settling budget too short for the tied sheet to come to rest: every state's check
+    # fails ("not_converged"); the table says FAILED instead of a displacement, the JSON
+    # has nulls, the figure names it and the command exits 1.
+    pytest.importorskip("mujoco")
+    from taut.physics import _tol
+    monkeypatch.setattr(_tol, "MAX_SETTLE_TIME", 0.1)
+    code, out, err = run(capsys, "physics", triangle)
+    assert code == 1, err
+    assert "FAILED (not converged)" in out and "1 of 1 simulation(s) failed" in out
+    assert "failed: {1,2,3}: the tied sheet was still moving" in out
+    png = tmp_path / "tri.png"
+    code, out, _ = run(capsys, "physics", triangle, "--json", "--plot", png)
+    data = json.loads(out)
+    assert code == 1 and not data["success"] and data["status"] == "not_converged"
+    (state,) = data["states"]
+    assert state["status"] == "not_converged" and not state["success"]
+    assert state["settled"] == [None, None, None] and state["moved"] is None
     assert png.stat().st_size > 10_000

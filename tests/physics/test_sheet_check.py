@@ -31,12 +31,13 @@ def _assert_agrees(team, R, *, heights_mm=True):
     assert [s.taut for s in result.states] == [e.taut for e in fk.equilibria]
     scale = 1.0 if heights_mm else width / 1000.0
     for s in result.states:
-        if s.status == "stable":
+        assert s.success and s.status == "ok", s.message     # released object on the sheet
+        if s.kind == "stable":
             assert s.held, s
             for diff in (s.tied_difference, s.difference):
                 assert abs(diff[2]) <= HEIGHT_TOL * scale, s
                 assert np.hypot(*diff[:2]) <= LATERAL_FRACTION * width, s
-        elif s.status == "not_equilibrium":
+        elif s.kind == "not_equilibrium":
             assert not s.held, s
     assert result.success and result.status == "ok"
     return result
@@ -70,7 +71,7 @@ def test_free_drop_finds_the_triangle_state():
 def test_fk_paper_example1():
     sc = load_sheet_scenario(EXAMPLES / "example1.yaml")
     result = _assert_agrees(sc.team, sc.formation)
-    status = {s.taut: s.status for s in result.states}
+    status = {s.taut: s.kind for s in result.states}
     assert status == {(0, 1, 2): "stable", (0, 2, 3): "stable",
                       (0, 1, 2, 3): "not_equilibrium"}
 

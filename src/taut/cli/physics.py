@@ -19,16 +19,18 @@ def format_check(check: Any, *, name: str | None, units: str | None) -> str:
             f"released dx, dy, dz{u}", "agrees", "s")
     rows = [head]
     for s in check.states:
+        released = (", ".join(f"{v:+.1f}" for v in s.difference) if s.success
+                    else f"FAILED ({s.status.replace('_', ' ')})")
         rows.append(("{" + ",".join(str(i + 1) for i in s.taut) + "}",
-                     s.status.replace("_", " "), "held" if s.held else "not held",
+                     s.kind.replace("_", " "), "held" if s.held else "not held",
                      f"{s.sliding:.3f}", ", ".join(f"{v:+.1f}" for v in s.tied_difference),
-                     ", ".join(f"{v:+.1f}" for v in s.difference),
-                     "yes" if s.agrees else "NO", f"{s.time:.1f}"))
+                     released, "yes" if s.agrees else "NO", f"{s.time:.1f}"))
     widths = [max(len(r[c]) for r in rows) for c in range(len(head))]
     lines = [name] if name else []
     lines.append(f"MuJoCo check, mesh {check.mesh}, ball radius {check.ball:.3g}{u}: "
                  f"{check.message}")
     lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    lines += [f"failed: {s.message}" for s in check.states if not s.success]
     return "\n".join(lines)
 
 
@@ -48,7 +50,8 @@ def register(app: typer.Typer) -> None:
                                            "sheet's widest vertex pair (default 10)."),
     ) -> None:
         """Check taut's rest states in MuJoCo: tie the object at each state's contact
-        point, settle, release; exit 1 when physics disagrees with taut."""
+        point, settle, release; exit 1 when physics disagrees with taut or a simulation
+        failed (the object left the sheet, diverged or did not settle)."""
         from ..io.serialize import equilibria_check_to_dict, to_json
         from ..io.sheet_scenario import load_sheet_scenario
 

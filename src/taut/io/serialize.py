@@ -308,14 +308,18 @@ def deployment_to_dict(robot: CableRobot, res: DeploymentResult) -> dict[str, An
 
 def equilibria_check_to_dict(check: Any) -> dict[str, Any]:
     """JSON-ready form of an :class:`~taut.physics.EquilibriaCheck` (0-based taut sets,
-    scenario units)."""
+    lengths in scenario units, ``time_s`` in s, ``sliding`` and ``hold_tolerance`` as
+    fractions of the object's weight; per state ``kind`` is taut's verdict and
+    ``status``/``message`` the simulation's outcome, with ``settled``, ``difference`` and
+    ``moved`` null when it failed)."""
     def f(a: np.ndarray) -> list[float]:
         return [float(x) for x in np.asarray(a).ravel()]
 
     return {
         "success": bool(check.success), "status": check.status, "message": check.message,
         "mesh": check.mesh, "ball_radius": check.ball, "hold_tolerance": check.hold_tolerance,
-        "states": [{"taut": list(s.taut), "status": s.status, "held": s.held,
+        "states": [{"taut": list(s.taut), "kind": s.kind, "held": s.held,
+                    "success": bool(s.success), "status": s.status, "message": s.message,
                     "agrees": s.agrees, "predicted": f(s.predicted), "tied": f(s.tied),
                     "settled": f(s.settled), "difference": f(s.difference),
                     "tied_difference": f(s.tied_difference), "sliding": float(s.sliding),

@@ -7,15 +7,16 @@ import numpy as np
 from .._units import GRAVITY
 from . import _tol
 from ._sheet_model import SheetSim
-from ._surface import clearance_lift, surface_below
+from ._surface import surface_below
 
 __all__ = ["ramp", "settle_phase", "ball_position", "node_positions", "release",
-           "object_on_sheet"]
+           "object_on_sheet", "left_sheet", "sliding_force"]
 
 
 def ball_position(sim: SheetSim) -> np.ndarray:
-    """Ball centre, shape (3,), simulation metres."""
-    return np.array(sim.data.qpos[sim.ball_qpos:sim.ball_qpos + 3])
+    """Ball centre, shape (3,), simulation metres (as of the last kinematics pass, like
+    :func:`node_positions`)."""
+    return np.array(sim.data.xpos[sim.ball_body])
 
 
 def node_positions(sim: SheetSim) -> np.ndarray:
@@ -47,12 +48,14 @@ def _speeds(sim: SheetSim) -> tuple[float, float]:
 
 
 def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None,
-                 frames: list | None = None, speed: float = _tol.SETTLE_SPEED
-                 ) -> tuple[bool, float]:
+                 frames: list | None = None, speed: float = _tol.SETTLE_SPEED,
+                 watch: bool = False) -> tuple[str, float]:
     """Step until the ball is slower than ``speed`` and every node slower than ten times
-    that (checked every ``CHECK_INTERVAL``), or ``max_time`` passes.
+    that (checked every ``CHECK_INTERVAL``), or ``max_time`` passes; with ``watch``, stop
+    as soon as the ball has left the sheet (:func:`left_sheet`).
 
-    Returns (converged, simulated time taken in s)."""
+    Returns (outcome, simulated time taken in s); outcome is ``"settled"``,
+    ``"moving"`` (time limit), ``"diverged"`` (non-finite state) or ``"left"``."""
     import mujoco
 
     m, d = sim.model, sim.data
@@ -66,11 +69,25 @@ def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None,
         if frames is not None:
             frames.append(node_positions(sim))
         if not np.all(np.isfinite(d.qpos)):
-            return False, d.time - t0
+            return "diverged", d.time - t0
+        if watch and left_sheet(sim):
+            return "left", d.time - t0
         vb, vn = _speeds(sim)
         if vb < speed and vn < speed * 10:
-            return True, d.time - t0
-    return False, d.time - t0
+            return "settled", d.time - t0
+    return "moving", d.time - t0
+
+
+def left_sheet(sim: SheetSim) -> bool:
+    """The untied ball is off the sheet: no sheet triangle lies straight below its centre,
+    or its centre is lower than the sheet's lowest node (it went through; a ball on the
+    sheet is always above that node, the sheet being a surface over its nodes)."""
+    if sim.tie >= 0 and sim.data.eq_active[sim.tie]:
+        return False
+    nodes = node_positions(sim)
+    ball = ball_position(sim)
+    return (ball[2] < float(nodes[:, 2].min())
+            or surface_below(nodes, sim.mesh.triangles, ball) is None)
 
 
 def object_on_sheet(sim: SheetSim) -> tuple[np.ndarray, np.ndarray] | None:
@@ -116,19 +133,12 @@ def sliding_force(sim: SheetSim) -> np.ndarray:
 
 
 def release(sim: SheetSim) -> None:
-    """Untie the ball: put it on the sheet straight above its contact node (as low as it
-    goes without touching the sheet), at rest, with contacts on from now on."""
+    """Let a ball held over one place (``xy_lock``) go where it is, at rest."""
     import mujoco
 
     m, d = sim.model, sim.data
-    if sim.tie < 0:
+    if not sim.xy_lock:
         return
-    nodes = node_positions(sim)
-    apex = nodes[sim.mesh.contact]
-    lift = clearance_lift(nodes, sim.mesh.triangles, apex, sim.ball_offset)
-    d.eq_active[sim.tie] = 0
-    d.qpos[sim.ball_qpos:sim.ball_qpos + 3] = apex + [0.0, 0.0, lift]
-    d.qpos[sim.ball_qpos + 3:sim.ball_qpos + 7] = (1.0, 0.0, 0.0, 0.0)
+    d.eq_active[list(sim.xy_lock)] = 0
     d.qvel[sim.ball_dof:sim.ball_dof + 6] = 0.0
-    m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     mujoco.mj_forward(m, d)

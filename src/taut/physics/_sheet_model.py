@@ -60,6 +60,7 @@ class SheetSim:
     ball_geom: int
     tie: int                       # equality id of the tie (-1: none)
     tendon_pairs: np.ndarray       # (P, 2) node pair of each tendon, in tendon order
+    xy_lock: tuple[int, ...] = ()  # equality ids locking the ball's x and y slides
 
 
 def _node_positions(mesh: SheetMesh, Q: np.ndarray, t: np.ndarray, hold: float,
@@ -86,9 +87,9 @@ def _add_nodes(spec: Any, body_pos: np.ndarray, corners: set[int], dt: float) ->
             b.inertia = [mass * 1e-4] * 3
             b.explicitinertial = True
             b.gravcomp = 1.0
-            for axis in ((1, 0, 0), (0, 1, 0), (0, 0, 1)):
-                b.add_joint(type=mujoco.mjtJoint.mjJNT_SLIDE, axis=list(axis),
-                            damping=damping)
+            for c, axis in zip("xyz", ((1, 0, 0), (0, 1, 0), (0, 0, 1))):
+                b.add_joint(name=f"node{k}_{c}", type=mujoco.mjtJoint.mjJNT_SLIDE,
+                            axis=list(axis), damping=damping)
         b.add_site(name=f"s{k}", size=[1e-3, 0, 0])
         # Flex vertices may not carry joint damping: the flex uses a jointless child.
         b.add_body(name=f"v{k}")
@@ -106,12 +107,19 @@ def _add_tendons(spec: Any, pairs: np.ndarray, rest: np.ndarray) -> None:
 
 def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray,
                     hold_height: float, *, ball_radius: float, ball_start: np.ndarray | None,
-                    tie: bool, corner_tendons: bool, timestep: float = _tol.TIMESTEP
-                    ) -> SheetSim:
+                    tie: bool, corner_tendons: bool, timestep: float = _tol.TIMESTEP,
+                    hold_xy: bool = False, pin_contact: bool = False) -> SheetSim:
     """Compile the model (reason for length: one linear recipe, step by step).
 
-    ``ball_start`` (3,) in scenario units; with ``tie`` the ball is connected to the
-    contact node (its lowest point on the node) and starts above it.
+    ``ball_start`` (3,) in scenario units; with ``tie`` the ball's centre is connected to
+    the contact node and contacts are off (a point load). With ``hold_xy`` (and no tie)
+    the ball moves on three slide joints and a ball joint instead of a free joint, and
+    its two horizontal slides are locked (equality constraints ``xy_lock``) until
+    :func:`taut.physics._run.release`: the ball presses the sheet down straight below its
+    start with contacts on, so the sheet forms its pocket under the ball (a ball put on a
+    sheet shaped by a point load can miss the pocket: it may be a narrow fold). With
+    ``pin_contact`` the mesh's contact node is also kept straight below the ball until
+    then.
     """
     import mujoco
 
@@ -170,14 +178,37 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     else:
         start = np.append(goal[:, :2].mean(axis=0), hold_height * scale + 2 * offset)
     ball = spec.worldbody.add_body(name="ball", pos=start.tolist())
-    ball.add_joint(name="ball", type=mujoco.mjtJoint.mjJNT_FREE,
-                   damping=_tol.BALL_MASS / _tol.BALL_DAMPING_TIME)
+    ball_damping = _tol.BALL_MASS / _tol.BALL_DAMPING_TIME
+    if hold_xy:
+        for name, axis in (("x", (1, 0, 0)), ("y", (0, 1, 0)), ("z", (0, 0, 1))):
+            ball.add_joint(name=f"ball_{name}", type=mujoco.mjtJoint.mjJNT_SLIDE,
+                           axis=list(axis), damping=ball_damping)
+        ball.add_joint(name="ball_turn", type=mujoco.mjtJoint.mjJNT_BALL,
+                       damping=ball_damping)
+        for name in ("ball_x", "ball_y"):          # slide stays at 0: xy stays at start
+            spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, objtype=mujoco.mjtObj.mjOBJ_JOINT,
+                              name1=name, data=[0.0] * 12,
+                              solref=list(_tol.SOLREF), solimp=list(_tol.SOLIMP))
+        if pin_contact and mesh.contact is not None and mesh.contact not in corners:
+            # The contact node is kept straight below the ball (its x and y slides follow
+            # the ball's, whose are locked): the sheet forms with taut's contact point
+            # under the object instead of sliding to another pocket.
+            k = mesh.contact
+            for i, c in enumerate("xy"):
+                shift = float(start[i] - pos[k, i])     # qpos0 of both slides is 0
+                spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT,
+                                  objtype=mujoco.mjtObj.mjOBJ_JOINT,
+                                  name1=f"node{k}_{c}", name2=f"ball_{c}",
+                                  data=[shift, 1.0] + [0.0] * 10,
+                                  solref=list(_tol.SOLREF), solimp=list(_tol.SOLIMP))
+    else:
+        ball.add_joint(name="ball", type=mujoco.mjtJoint.mjJNT_FREE, damping=ball_damping)
     ball.add_geom(name="ball", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r, 0, 0],
                   mass=_tol.BALL_MASS, contype=1, conaffinity=1, condim=1,
                   solref=list(_tol.SOLREF), solimp=list(_tol.SOLIMP), rgba=[0.9, 0.3, 0.2, 1.0])
     if tie:
         # Tied, the ball's centre is pinned to the contact node and contacts are off
-        # (a point load, as in the model); release puts it on the sheet.
+        # (a point load, as in the model).
         spec.add_equality(type=mujoco.mjtEq.mjEQ_CONNECT, objtype=mujoco.mjtObj.mjOBJ_BODY,
                           name1="ball", name2=f"node{mesh.contact}", data=[0.0] * 12,
                           solref=list(_tol.SOLREF), solimp=list(_tol.SOLIMP))
@@ -199,6 +230,7 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     sim = SheetSim(model, data, mesh, scale, node_qpos, node_body, mocap,
                    pos[corners].copy(), goal, bb, int(model.jnt_qposadr[jid]),
                    int(model.jnt_dofadr[jid]), offset, model.geom("ball").id,
-                   0 if tie else -1, pairs)
+                   0 if tie else -1, pairs,
+                   tuple(range(model.neq)) if hold_xy and not tie else ())
     mujoco.mj_forward(model, data)
     return sim

@@ -12,7 +12,7 @@ import numpy as np
 
 from . import _tol
 
-__all__ = ["point_triangle_distance", "surface_below", "clearance_lift"]
+__all__ = ["point_triangle_distance", "surface_below"]
 
 
 def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -68,22 +68,3 @@ def surface_below(nodes: np.ndarray, triangles: np.ndarray, point: np.ndarray
         return None
     k = int(np.flatnonzero(hit)[np.argmax(z[hit])])
     return float(z[k]), k, np.array([1 - u[k] - v[k], u[k], v[k]])
-
-
-def clearance_lift(nodes: np.ndarray, triangles: np.ndarray, apex: np.ndarray,
-                   radius: float) -> float:
-    """Smallest height ``h >= 0`` at which a ball of ``radius`` centred at
-    ``apex + h e_z`` touches no triangle deeper than rounding (bisection, 40 halvings)."""
-    A, B, C = (nodes[triangles[:, k]] for k in range(3))
-
-    def clear(h: float) -> bool:
-        return bool(np.min(point_triangle_distance(apex + [0.0, 0.0, h], A, B, C))
-                    >= radius * (1 - _tol.CLEARANCE_REL))
-
-    lo, hi = 0.0, radius
-    while not clear(hi):
-        lo, hi = hi, 2 * hi
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if clear(mid) else (mid, hi)
-    return hi

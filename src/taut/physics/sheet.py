@@ -20,14 +20,18 @@ from ..errors import InvalidInputError
 from ..sheet import Equilibrium, Sheet, SheetTeam, check_formation, forward_kinematics
 from ..sheet.team import require_team
 from . import _run, _tol
-from ._mesh import sheet_mesh
+from ._mesh import SheetMesh, sheet_mesh
 from ._sheet_model import build_sheet_sim
 
 __all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "replay_equilibria",
            "DEFAULT_MESH"]
 
 #: Default mesh: spacings across the sheet's widest vertex pair (about 156 mm on the FK
-#: paper's Example 1 sheet, 1.56 m across; see the speed/accuracy table in the README).
+#: paper's Example 1 sheet, 1.56 m across). examples/physics/README.md's convergence
+#: table: the tied height's ~1 mm bias does not change from mesh 7 to 16; the released
+#: height (ball radius 0.05 spacings) is within 2.6 mm at 10 and falls as the mesh refines,
+#: at a cost that grows fast (Example 1: 4.4 s at 10, 9.4 s at 13; at 16 a rolling
+#: released ball took over 5 minutes and did not settle within its budget).
 DEFAULT_MESH = 10
 
 
@@ -78,14 +82,15 @@ class StateCheck:
     ----------
     taut : tuple of int
         The state's taut cables (0-based), as taut reported them.
-    status : str
+    kind : str
         taut's verdict: ``"stable"``, ``"saddle"`` or ``"not_equilibrium"``.
     predicted : ndarray, shape (3,)
         taut's object position.
     tied : ndarray, shape (3,)
         Where the object settled tied to the sheet at taut's contact point.
     settled : ndarray, shape (3,)
-        Where it came to rest after being released there.
+        Where it came to rest after being released there (NaN when the run failed: see
+        ``status``).
     held : bool
         The simulated sheet holds the object at taut's contact point: its tendons' net pull
         on the tied contact node, resolved in the flat sheet, is at most ``hold_tolerance``
@@ -93,22 +98,31 @@ class StateCheck:
     sliding : float
         That net pull divided by the object's weight (0 at an exact equilibrium).
     difference : ndarray, shape (3,)
-        ``settled - predicted`` (ball radius accounted for), scenario units.
+        ``settled - predicted`` (ball radius accounted for), scenario units (NaN when the
+        run failed).
     moved : float
-        Distance between where the object was tied and where the released ball rests.
+        Distance between where the object was tied and where the released ball rests
+        (NaN when the run failed).
     tied_difference : ndarray, shape (3,)
         ``tied - predicted``.
     agrees : bool
         ``held`` for a stable state, not held for a non-equilibrium (saddles: always).
+        Read from the tied run: it stands when only the release failed, not when the
+        tied run itself did not settle (``message`` says which).
     time : float
         Wall-clock seconds spent on this state (build and simulation).
     nodes : ndarray, shape (M, 3)
         The tied, settled sheet's node positions, scenario units (for figures).
     triangles : ndarray of int, shape (T, 3)
+    success, status, message
+        The simulation's own outcome (:mod:`taut._outcome`): ``"ok"`` when the tied run
+        came to rest and the released object settled on the sheet; ``"diverged"`` when
+        the object left the sheet (fell through or off it) or the state became
+        non-finite; ``"not_converged"`` when a run was still moving at its time limit.
     """
 
     taut: tuple[int, ...]
-    status: str
+    kind: str
     predicted: np.ndarray
     tied: np.ndarray
     settled: np.ndarray
@@ -121,6 +135,9 @@ class StateCheck:
     time: float
     nodes: np.ndarray
     triangles: np.ndarray
+    success: bool
+    status: str
+    message: str
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,8 +145,10 @@ class EquilibriaCheck:
     """Every rest state taut reports for one formation, checked in MuJoCo.
 
     ``success`` is true when every state's physics verdict agrees with taut's (stable
-    states held, states that are not equilibria not held; saddles either way);
-    ``status`` is ``"ok"`` or ``"unverified"`` (taut's answer failed the physics check).
+    states held, states that are not equilibria not held; saddles either way) and every
+    state's simulation succeeded; ``status`` is ``"ok"``, ``"unverified"`` (taut's answer
+    failed the physics check) or else the first failed state's status (``"diverged"``,
+    ``"not_converged"``: the check could not be completed).
     ``hold_tolerance`` is the sliding pull, as a fraction of the object's weight, up to
     which the object counts as held.
     """
@@ -204,15 +223,18 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
     _run.ramp(sim)
     rows: list | None = [] if trace else None
     frames: list | None = [] if trace else None
-    converged, t = _run.settle_phase(sim, max_t, rows, frames)
-    found = _run.object_on_sheet(sim)
+    outcome, t = _run.settle_phase(sim, max_t, rows, frames, watch=True)
+    converged = outcome == "settled"
+    found = None if outcome in ("left", "diverged") else _run.object_on_sheet(sim)
     nodes = _run.node_positions(sim) / sim.scale
     tr = None if rows is None else np.array(rows) / [1.0, *[sim.scale] * 3]
     fr = None if frames is None else np.array(frames) / sim.scale
     if found is None:
         nan = np.full(3, np.nan)
         return SettleResult(nan, nan[:2], t, False, nodes, m.triangles, tr, fr, False,
-                            check_status("diverged"), "the ball fell off the sheet")
+                            check_status("diverged"),
+                            "the simulation diverged (non-finite state)" if outcome == "diverged"
+                            else f"the ball left the sheet after {t:.2f} s (fell through or off)")
     pos, contact = found
     status = "ok" if converged else "not_converged"
     msg = (f"settled at ({pos[0]:.4g}, {pos[1]:.4g}, {pos[2]:.4g}) after {t:.2f} s"
@@ -221,32 +243,88 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
                         check_status(status), msg)
 
 
+def _release_over(sheet: Sheet, R: np.ndarray, z: float, m: SheetMesh, xy: np.ndarray,
+                  radius: float, *, corner_tendons: bool
+                  ) -> tuple[str, float, tuple[np.ndarray, np.ndarray] | None]:
+    """Hold the ball over ``xy`` (scenario units) while it presses the sheet down, let it
+    go, and settle: (outcome of :func:`taut.physics._run.settle_phase`, simulated seconds
+    after release, the object's place on the sheet or None).
+
+    When the mesh has a contact node, it is first kept under the ball (the sheet forms
+    with taut's contact point under the object); if the ball slips off the sheet that
+    way (a pinned non-equilibrium can tilt the sheet away under it), the sheet is formed
+    again without the pin."""
+    start = np.array([*xy, z + 2 * (_tol.FLEX_RADIUS * m.spacing + radius)])
+    for pin in ((True, False) if m.contact is not None else (False,)):
+        sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=start,
+                              tie=False, corner_tendons=corner_tendons, hold_xy=True,
+                              pin_contact=pin)
+        _run.ramp(sim)
+        outcome, _ = _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, watch=True)
+        if outcome not in ("left", "diverged"):
+            break
+    else:
+        return outcome, 0.0, None
+    _run.release(sim)
+    outcome, t = _run.settle_phase(sim, _tol.RELEASE_TIME, watch=True)
+    found = _run.object_on_sheet(sim)
+    if outcome == "settled" and found is None:
+        outcome = "left"
+    return outcome, t, found
+
+
 def _replay_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
                   tol: float, *, corner_tendons: bool) -> StateCheck:
     import time
 
     t0 = time.perf_counter()
     m = sheet_mesh(sheet.vertices, div, contact=eq.contact)
+    # Tied: a point load at the contact node, contacts off (the model's object).
     sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=None,
                           tie=True, corner_tendons=corner_tendons)
     _run.ramp(sim)
-    _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
+    tied_run, _ = _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
     tied_at = _run.object_on_sheet(sim)
     assert tied_at is not None                                         # tied: always on
     tied = tied_at[0]
     nodes = _run.node_positions(sim) / sim.scale
     sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * GRAVITY))
-    _run.release(sim)
-    _run.settle_phase(sim, _tol.RELEASE_TIME)
-    found = _run.object_on_sheet(sim)
-    settled = found[0] if found is not None else _run.ball_position(sim) / sim.scale
-    held = sliding <= tol
+    # Released: a second model, the ball held over taut's object position while it presses
+    # the sheet down from the flat start (contacts on), so the sheet forms its pocket under
+    # the ball; then let go. (A ball put on the point-loaded sheet can miss the pocket: the
+    # slack sheet around a point load may fold into a narrow crease.)
     pred = np.asarray(eq.object, dtype=float)
-    status = str(eq.kind)
-    agrees = status == "saddle" or held == (status == "stable")
-    return StateCheck(tuple(eq.taut), status, pred, tied, settled, held,
+    outcome, t_rel, found = _release_over(sheet, R, z, m, pred[:2], radius,
+                                          corner_tendons=corner_tendons)
+    held = sliding <= tol
+    kind = str(eq.kind)
+    agrees = kind == "saddle" or held == (kind == "stable")
+    label = "{" + ",".join(str(i + 1) for i in eq.taut) + "}"
+    if tied_run == "diverged":
+        status, message = "diverged", f"{label}: the tied run diverged (non-finite state)"
+    elif tied_run != "settled":
+        status = "not_converged"
+        message = f"{label}: the tied sheet was still moving after {_tol.MAX_SETTLE_TIME:g} s"
+    elif outcome == "left":
+        when = f"{t_rel:.1f} s after release" if t_rel > 0 else "while it was being placed"
+        status, message = "diverged", f"{label}: the object left the sheet {when}"
+    elif outcome == "diverged":
+        status, message = "diverged", f"{label}: the released run diverged (non-finite state)"
+    elif outcome == "moving":
+        status = "not_converged"
+        message = f"{label}: the released object was still moving after {t_rel:.1f} s simulated"
+    else:
+        status, message = "ok", f"{label}: released object settled after {t_rel:.1f} s"
+    ok = status == "ok"
+    if ok:
+        assert found is not None
+        settled = found[0]
+    else:
+        settled = np.full(3, np.nan)
+    return StateCheck(tuple(eq.taut), kind, pred, tied, settled, held,
                       sliding, settled - pred, float(np.linalg.norm(settled - tied)),
-                      tied - pred, agrees, time.perf_counter() - t0, nodes, m.triangles)
+                      tied - pred, agrees, time.perf_counter() - t0, nodes, m.triangles,
+                      ok, check_status(status), message)
 
 
 def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT_MESH,
@@ -257,8 +335,12 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
 
     For each state of :func:`taut.sheet.forward_kinematics`: the object is tied to the
     simulated sheet at taut's contact point :math:`\\mathbf{v}_o` and settled under gravity
-    (``tied``), then released there and settled again (``settled``); ``held`` says whether
-    it stayed put.
+    as a point load (``tied``; ``held`` is read from the sheet's pull on it there). Then,
+    in a second model, a ball held over taut's object position presses the sheet down
+    from the flat start (contacts on) and is let go (``settled``). Each state's
+    ``status`` says whether its runs succeeded: ``"diverged"`` when the object left the
+    sheet or the state became non-finite, ``"not_converged"`` when a run was still moving
+    at its time limit; ``settled`` is then NaN.
 
     Parameters
     ----------
@@ -270,8 +352,9 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     ball : float, optional
         Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings).
     hold_tolerance : float, optional
-        A released object that moves less than this is held (default one ball radius
-        ``HOLD_FRACTION`` of the sheet's width), scenario units.
+        The object counts as held when the sheet's net sideways pull on the tied object is
+        at most this fraction of its weight (dimensionless; default ``HOLD_FRACTION`` =
+        0.05).
     corner_tendons : bool
         Add a tendon from every node to every held corner (makes the tied point load
         nearly exact; see the README's table).
@@ -295,13 +378,21 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
         if progress is not None:
             progress(k + 1, len(fk.equilibria))
     bad = [s for s in states if not s.agrees]
-    ok = not bad
-    if ok:
-        msg = f"physics agrees with taut on all {len(states)} state(s)"
-    else:
+    failed = [s for s in states if not s.success]
+    if bad:
         s = bad[0]
         taut = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
-        msg = (f"{len(bad)} of {len(states)} state(s) disagree; first: {taut} ({s.status}) "
-               f"was {'held' if s.held else 'left'} in physics")
-    return EquilibriaCheck(tuple(states), tol, div, radius, ok,
-                           check_status("ok" if ok else "unverified"), msg)
+        status = "unverified"
+        msg = (f"{len(bad)} of {len(states)} state(s) disagree; first: {taut} ({s.kind}) "
+               f"was {'held' if s.held else 'not held'} in physics")
+    elif failed:
+        status = failed[0].status
+        msg = (f"{len(failed)} of {len(states)} simulation(s) failed; first: "
+               f"{failed[0].message}")
+    else:
+        status = "ok"
+        msg = f"physics agrees with taut on all {len(states)} state(s)"
+    if bad and failed:
+        msg += f"; {len(failed)} simulation(s) failed"
+    return EquilibriaCheck(tuple(states), tol, div, radius, status == "ok",
+                           check_status(status), msg)

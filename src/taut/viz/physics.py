@@ -37,8 +37,9 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
                           path: str | Path | None = None, *, units: str | None = None,
                           title: str | None = None) -> Any:
     """One 3D panel per state: the simulated sheet settled with the object tied at taut's
-    contact point, taut's object position (coloured by taut's status) and the released
-    ball's rest position (black cross). Returns the figure; saves it when ``path``."""
+    contact point, taut's object position (coloured by taut's verdict) and the released
+    ball's rest position (black cross; a failed release is named in red in the panel's
+    title instead). Returns the figure; saves it when ``path``."""
     n = max(len(check.states), 1)
     cols = min(n, 3)
     rows = math.ceil(n / cols)
@@ -47,15 +48,19 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
     for k, s in enumerate(check.states):
         ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
         _draw_sheet(ax, s.nodes, s.triangles, np.asarray(formation), hold_height)
-        ax.scatter(*s.predicted, s=60, color=KIND_COLOURS.get(s.status, "k"),
+        ax.scatter(*s.predicted, s=60, color=KIND_COLOURS.get(s.kind, "k"),
                    edgecolor="k", depthshade=False, label="taut")
-        ax.scatter(*s.settled, s=50, marker="x", color="k", depthshade=False,
-                   label="physics, released")
+        if s.success:
+            ax.scatter(*s.settled, s=50, marker="x", color="k", depthshade=False,
+                       label="physics, released")
+            released = f"released dz = {s.difference[2]:+.1f}{u}"
+        else:
+            released = f"run FAILED ({s.status.replace('_', ' ')}): see the message"
         label = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
         verdict = "held" if s.held else "not held"
-        ax.set_title(f"{label} taut: {s.status.replace('_', ' ')}; physics: {verdict}\n"
-                     f"tied dz = {s.tied_difference[2]:+.1f}{u}, pull {s.sliding:.2f} mg",
-                     fontsize=8)
+        ax.set_title(f"{label} taut: {s.kind.replace('_', ' ')}; physics: {verdict}\n"
+                     f"tied dz = {s.tied_difference[2]:+.1f}{u}, pull {s.sliding:.2f} mg\n"
+                     f"{released}", fontsize=8, color="k" if s.success else "tab:red")
         ax.tick_params(labelsize=6)
     if title:
         fig.suptitle(title, fontsize=10)
