@@ -3,7 +3,9 @@
 Measures, in one run on this machine (interleaved repeats, median and min-max spread):
   * simulated seconds per wall second at a 1 kHz control rate for the velocity and torque
     controllers, numba backend (the compiled loop) and numpy backend (the reference loop), for
-    the whole call (set-up: reference tensions, context, initial equilibrium) and the loop;
+    the whole call (set-up: reference tensions, context, initial equilibrium) and the loop,
+    with the default encoder sensing (pose by cable forward kinematics every step) and, on
+    the numba backend, with the ideal pose (the ratio is the cost of the estimator);
   * a batched Monte Carlo over 100 seeded 5 mm exit-error plants (one compiled loop over all
     plants) against 100 single runs extrapolated from 10, and its statistics.
 Run: ``python bench/bench_cdpr_control.py [--repeats 3] [--runs 100]`` (numba, a dependency of taut).
@@ -17,8 +19,8 @@ import time
 
 import numpy as np
 
-from taut.cdpr import (ModelErrors, TorqueController, VelocityController, monte_carlo,
-                       pick_and_place, simulate, with_stabilisers)
+from taut.cdpr import (ModelErrors, Sensing, TorqueController, VelocityController,
+                       monte_carlo, pick_and_place, simulate, with_stabilisers)
 from taut.cdpr.control.simulate import _loop_numba, _prepare
 from taut.io.cdpr_model import load_cdpr_model
 
@@ -57,7 +59,10 @@ def main() -> None:
             loop_t[name].append(timed(lambda: _loop_numba(setup, c, 1, 1))[0])
             for eng in ("numba", "numpy"):
                 dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, backend=eng))
-                rates.setdefault((name, eng), []).append(sim_s / dt)
+                rates.setdefault((name, eng + " encoders"), []).append(sim_s / dt)
+            dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, backend="numba",
+                                           sensing=Sensing(ideal_pose=True)))
+            rates.setdefault((name, "numba ideal pose"), []).append(sim_s / dt)
     print(f"FASTKIT pick-and-place, {ref.duration:.2f} s + 1 s pre-roll = {sim_s:.2f} s "
           "simulated at 1 kHz (median of", args.repeats, "interleaved runs)")
     print(f"  set-up of one run (reference tensions, context, equilibrium): "
@@ -65,7 +70,7 @@ def main() -> None:
           f"{1e3 * max(setup_t):.0f}]")
     print("  real-time factor (simulated s per wall s, whole call):")
     for (name, eng), xs in rates.items():
-        print(f"    {name:8s} {eng:6s} {fmt(xs)}")
+        print(f"    {name:8s} {eng:17s} {fmt(xs)}")
     for name in ctls:
         print(f"    {name:8s} numba loop only {fmt([sim_s / x for x in loop_t[name]])}")
     # Monte Carlo

@@ -131,6 +131,7 @@ Control
    BaseMotion -- base poses over time (deployment, eq. 8)
    DynamicsModel -- elastic cables and winches (Table 1)
    ModelErrors -- seeded errors of the plant against the model
+   Sensing -- what the controller measures (encoders by default)
    Reference -- a platform trajectory
    pick_and_place -- straight moves between waypoints
    reference_from_samples -- a trajectory from sampled poses
@@ -176,6 +177,7 @@ from .control.simulate import (Backend, BaseMotion, ControlResult, MonteCarloRes
     monte_carlo, simulate)
 from .control.dynamics import DynamicsModel
 from .control.model_errors import ModelErrors
+from .control.sensing import Sensing
 from .control.references import Reference, pick_and_place, reference_from_samples
 from .control.controllers import CONTROLLERS, Controller, TorqueController, VelocityController
 from .control.monitors import ControlEvent
@@ -209,6 +211,6 @@ __all__ = [
     "OBJECTIVES",
     # Control
     "simulate", "ControlResult", "monte_carlo", "MonteCarloResult", "Backend", "BaseMotion",
-    "DynamicsModel", "ModelErrors", "Reference", "pick_and_place", "reference_from_samples",
-    "Controller", "VelocityController", "TorqueController", "CONTROLLERS", "ControlEvent",
+    "DynamicsModel", "ModelErrors", "Sensing", "Reference", "pick_and_place",
+    "reference_from_samples", "Controller", "VelocityController", "TorqueController", "CONTROLLERS", "ControlEvent",
 ]

@@ -253,3 +253,10 @@ INTERP_TENSION_TOL = 1e-6
 #: Default ``certificate_tol`` of :func:`taut.cdpr.tallest_workspace` (m): the height
 #: resolution of the certified upper limit.
 TALLEST_CERTIFICATE_TOL = 1e-3
+
+#: Gauss-Newton iterations of the controller's pose estimate from measured cable lengths
+#: (simulation with encoder sensing): per control step, warm-started from the previous
+#: estimate (the platform moves <= 2 mm per 1 ms step, where Gauss-Newton converges
+#: quadratically: two iterations leave < 1e-9 m), and at the first step from the reference.
+SENSING_FK_ITERATIONS = 2
+SENSING_FK_FIRST_ITERATIONS = 30

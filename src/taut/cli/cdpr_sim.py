@@ -67,6 +67,14 @@ def add_simulate(sub: typer.Typer) -> None:
         control_rate: Optional[float] = typer.Option(
             None, "--control-rate", help="Controller rate, Hz (default: the library's, "
                                          "taut.cdpr.simulate)."),
+        tension_gain: Optional[float] = typer.Option(
+            None, "--tension-gain", help="Velocity control with tension feedback, 1/s "
+                                         "(default: the library's, 0 = pure velocity "
+                                         "control; the tension is estimated from the drive "
+                                         "torques)."),
+        ideal_pose: bool = typer.Option(False, "--ideal-pose", help="Give the controller "
+                                        "the true platform pose (default: estimated from "
+                                        "the encoders, as on FASTKIT)."),
         stabilisers: bool = typer.Option(False, "--stabilisers",
                                          help="Deploy the stabilisers of mobile bases."),
         as_json: bool = typer.Option(False, "--json", help="Print the result as JSON "
@@ -102,8 +110,12 @@ def add_simulate(sub: typer.Typer) -> None:
             ref = read_reference_csv(robot, reference)  # type: ignore[arg-type]
         errs = ModelErrors(**given(exit_offset=None if exit_error is None else exit_error * 1e-3,
                                    seed=seed))
-        ctl = CONTROLLERS[controller]()
-        run = _run(robot, ref, ctl, errs, control_rate, dyn)
+        if tension_gain is not None and controller != "velocity":
+            raise InvalidInputError("--tension-gain", "applies to --controller velocity")
+        ctl = CONTROLLERS[controller](**given(tension_gain=tension_gain))
+        from ..cdpr import Sensing
+        run = _run(robot, ref, ctl, errs, control_rate, dyn,
+                   Sensing(ideal_pose=True) if ideal_pose else None)
         if json_out is not None:
             write_json(control_result_to_dict(run), json_out)
         if as_json:
@@ -121,12 +133,13 @@ def add_simulate(sub: typer.Typer) -> None:
             raise typer.Exit(1)
 
 
-def _run(robot, ref, ctl, errs, rate, dyn):
+def _run(robot, ref, ctl, errs, rate, dyn, sensing):
     """simulate() with progress on stderr (a bar on a terminal, else a line every 10 s)."""
     from ..cdpr import simulate
 
     with working(f"cdpr simulate ({ctl.name} control)") as update:
         return simulate(robot, ref, ctl, model_errors=errs, dynamics=dyn, progress=update,
+                        sensing=sensing,
                         **given(control_rate=rate))
 
 

@@ -2,7 +2,9 @@
 (:class:`taut.cdpr.DynamicsModel`; every key optional, defaults are the FASTKIT values).
 
 Keys (SI, motor side): ``cable_stiffness`` (EA, N), ``cable_damping`` (N s),
-``drum_diameter`` (m), ``gear_ratio``, ``efficiency``, ``motor_torque_limit`` (N m),
+``drum_diameter`` (m), ``gear_ratio``, ``efficiency`` and ``backdrive_efficiency``
+(dimensionless, in (0, 1]; the second applies when the load drives the motor, default the
+first), ``motor_torque_limit`` (N m),
 ``motor_speed_limit`` (rad/s), ``rotor_inertia`` (kg m^2), ``friction_static``,
 ``friction_coulomb`` (N m), ``friction_viscous`` (N m s/rad), ``stribeck_speed`` (rad/s),
 ``drive_speed_gain`` (N m s/rad), ``drive_integral_gain`` (N m/rad).
@@ -31,6 +33,7 @@ class _Dynamics(BaseModel):
     drum_diameter: Optional[float] = None
     gear_ratio: Optional[float] = None
     efficiency: Optional[float] = None
+    backdrive_efficiency: Optional[float] = None
     motor_torque_limit: Optional[float] = None
     motor_speed_limit: Optional[float] = None
     rotor_inertia: Optional[float] = None

@@ -122,3 +122,25 @@ def test_cli_simulate_from_a_reference_csv(capsys, tmp_path, fastkit):
     code, _, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--reference",
                         str(tmp_path / "missing.csv"))
     assert code == 2 and err.startswith("taut: error:")
+
+
+def test_cli_tension_feedback_and_ideal_pose_options(capsys):
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--waypoints", WP, "--controller", "velocity", "--dwell", "0.1",
+                           "--tension-gain", "200", "--exit-error", "5", "--json")
+    data = json.loads(text)
+    assert data["controller"]["tension_gain"] == 200.0
+    lib = simulate_lib("velocity", tension_gain=200.0)
+    assert max(data["tracking_error"]) == pytest.approx(lib.tracking_error.max(), rel=1e-9)
+    code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
+                           "--waypoints", WP, "--controller", "torque", "--tension-gain", "1")
+    assert code == 2 and "--tension-gain" in err and len(err.strip().splitlines()) == 1
+
+
+def simulate_lib(name, **kw):
+    from taut.cdpr import CONTROLLERS, ModelErrors, pick_and_place, simulate, with_stabilisers
+    from taut.io.cdpr_model import load_cdpr_model
+    robot = with_stabilisers(load_cdpr_model("fastkit"))
+    pts = [[float(v) for v in p.split(",")] for p in WP.split(";")]
+    ref = pick_and_place(robot, pts, dwell=0.1)
+    return simulate(robot, ref, CONTROLLERS[name](**kw), model_errors=ModelErrors(exit_offset=0.005))

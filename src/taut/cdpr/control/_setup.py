@@ -16,6 +16,7 @@ from ..kinematics._bases import as_base_poses, moved_exits
 from .._tol import INTERP_TENSION_TOL
 from .controllers import ControlContext
 from .dynamics import DynamicsModel
+from .plant import moving_body
 from ..kinematics.cables import gravity_wrench, rotation_matrices
 from ..model.robot import CableRobot
 from .references import Reference
@@ -200,12 +201,9 @@ def build_context(robot: CableRobot, dyn: DynamicsModel, times: np.ndarray, ref:
     reference leaves the wrench-feasible workspace."""
     P, V, A = ref.sample(times)
     R = rotation_matrices(P[:, 3:])
-    mp, ml = robot.platform.mass, robot.payload.mass
-    M = mp + ml
-    c_loc = (mp * robot.platform.com + ml * robot.payload.com) / M
-    dp, dl = robot.platform.com - c_loc, robot.payload.com - c_loc
-    I_loc = (robot.platform.inertia + mp * (dp @ dp * np.eye(3) - np.outer(dp, dp))
-             + ml * (dl @ dl * np.eye(3) - np.outer(dl, dl)))
+    M = robot.platform.mass + robot.payload.mass
+    c_b, I_b = moving_body(robot, np.ones(1))
+    c_loc, I_loc = c_b[0], I_b[0]
     com = R @ c_loc
     inertia = R @ I_loc @ np.swapaxes(R, 1, 2)
     w_ext = _inertial_wrench(M, com, inertia, V, A)
@@ -235,4 +233,6 @@ def build_context(robot: CableRobot, dyn: DynamicsModel, times: np.ndarray, ref:
     CT[:, 1, 0], CT[:, 2, 0], CT[:, 2, 1] = -com[:, 2], com[:, 1], -com[:, 0]
     CT[:, 0, 1], CT[:, 0, 2], CT[:, 1, 2] = com[:, 2], -com[:, 1], com[:, 0]
     return ControlContext(dyn, dt, P, V, A, W, W_pinv, t, L0, L0_dot, L0_ddot, com, CT,
-                          inertia, R, M, robot.t_min, robot.t_max)
+                          inertia, R, M, robot.t_min, robot.t_max,
+                          np.ascontiguousarray(geo.exits), np.ascontiguousarray(geo.exit_vel),
+                          np.array(robot.attach_local, dtype=float))

@@ -12,14 +12,16 @@ reference cable rates are ``l_dot = A t_P - B_b q_dot_b``, i.e. the winches pay 
 what the moving active base takes away, so either law holds the platform on its own reference
 while the base moves.
 
-Measurements are ideal (platform pose and twist as from an external tracker, encoder lengths
-with the seeded encoder offsets): the paper's ongoing work adds cameras for the pose.
+Measurements are set by :class:`taut.cdpr.Sensing`: by default quantised encoders (with the
+seeded encoder offsets), the drives' torques, and a pose and twist *estimated* from the
+encoders on the nominal model (FASTKIT has no exteroceptive sensor; the paper's ongoing work
+adds cameras); ``Sensing(ideal_pose=True)`` gives the true pose and twist.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, is_dataclass
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -65,6 +67,10 @@ class ControlContext:
         Nominal moving mass, kg.
     t_min, t_max : (m,)
         Tension limits, N.
+    exits, exit_vel : (T, m, 3)
+        Nominal world exit points (m) and their velocities (m/s).
+    attach : (m, 3)
+        Attachment points in the platform frame, m.
     """
 
     dynamics: DynamicsModel
@@ -85,13 +91,18 @@ class ControlContext:
     mass: float
     t_min: np.ndarray
     t_max: np.ndarray
+    exits: np.ndarray
+    exit_vel: np.ndarray
+    attach: np.ndarray
 
 
 @dataclass(frozen=True)
 class Measurement:
     """What a controller sees at one instant, for B plants: ``p`` (B, 3) position of P, m;
-    ``R`` (B, 3, 3); ``v`` (B, 3) m/s and ``w`` (B, 3) rad/s (world); ``L0`` (B, m) encoder
-    cable lengths, m; ``speed`` (B, m) motor speeds, rad/s."""
+    ``R`` (B, 3, 3); ``v`` (B, 3) m/s and ``w`` (B, 3) rad/s (world), true or estimated (see
+    :class:`taut.cdpr.Sensing`); ``L0`` (B, m) encoder cable lengths, m; ``speed`` (B, m)
+    motor speeds, rad/s; ``tension`` (B, m) measured or estimated tensions, N (NaN without a
+    tension measurement)."""
 
     p: np.ndarray
     R: np.ndarray
@@ -99,6 +110,7 @@ class Measurement:
     w: np.ndarray
     L0: np.ndarray
     speed: np.ndarray
+    tension: np.ndarray
 
 
 class Controller(ABC):
@@ -112,14 +124,22 @@ class Controller(ABC):
         """Motor torques (N m) or speed set-points (rad/s) at control step ``k``."""
 
     def describe(self) -> dict[str, Any]:
-        """Name and gains, JSON-friendly."""
-        return {"name": self.name, **{f.name: getattr(self, f.name) for f in fields(self)}}  # type: ignore[arg-type]
+        """Name and gains, JSON-friendly (public attributes of a custom controller that is
+        not a dataclass)."""
+        if is_dataclass(self):
+            gains = {f.name: getattr(self, f.name) for f in fields(self)}
+        else:
+            gains = {k: v for k, v in vars(self).items() if not k.startswith("_")}
+        out: dict[str, Any] = {"name": self.name, "mode": self.mode}
+        for k, v in gains.items():
+            out[k] = v.tolist() if isinstance(v, np.ndarray) else v
+        return out
 
 
 def _validated(obj: Any) -> None:
     for f in fields(obj):
         v = getattr(obj, f.name)
-        check = as_nonnegative if f.name.startswith("joint_damping") else as_positive
+        check = as_nonnegative if f.name in ("joint_damping", "tension_gain") else as_positive
         object.__setattr__(obj, f.name, check(v, f"controller.{f.name}"))
 
 
@@ -128,15 +148,22 @@ class VelocityController(Controller):
     """Velocity control (FASTKIT §2.2): motor speed set-points from the first-order model
     (eqs. 1, 8) for the reference twist plus a joint-space correction on the cable lengths,
 
-        theta_dot_cmd = (N / r) (L0_dot_ref + length_gain (L0_ref - L0_encoder)).
+        theta_dot_cmd = (N / r) (L0_dot_ref + length_gain (L0_ref - L0_encoder)
+                                 + tension_gain (T_meas - t_ref) L0_ref / EA).
 
-    The servo drives close the speed loop (see :class:`DynamicsModel`). Tensions are not
-    controlled: they are whatever the geometry errors make them.
+    The servo drives close the speed loop (see :class:`DynamicsModel`). With
+    ``tension_gain = 0`` tensions are not controlled: they are whatever the geometry errors
+    make them. With ``tension_gain > 0`` a cable pulled above its reference tension pays out
+    (an admittance on the tension the controller sees: by default the drives' torque-based
+    estimate, see :class:`taut.cdpr.Sensing`; a run without a tension measurement is refused).
 
     Parameters
     ----------
     length_gain : float
         1/s (default 20: a 50 ms joint-space time constant).
+    tension_gain : float
+        1/s (default 0: pure velocity control); the tension error's stretch
+        ``(T - t_ref) L0 / EA`` is paid out at this rate.
 
     Examples
     --------
@@ -145,6 +172,7 @@ class VelocityController(Controller):
     """
 
     length_gain: float = 20.0
+    tension_gain: float = 0.0
     name: ClassVar[str] = "velocity"
     mode: ClassVar[CommandMode] = "speed"
 
@@ -153,6 +181,9 @@ class VelocityController(Controller):
 
     def command(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
         rate = ctx.L0_dot[k] + self.length_gain * (ctx.L0[k] - meas.L0)
+        if self.tension_gain > 0.0:
+            rate = rate + self.tension_gain * (meas.tension - ctx.tensions[k]) * ctx.L0[k] \
+                / ctx.dynamics.cable_stiffness
         return rate / ctx.dynamics.length_per_rad
 
 
@@ -167,10 +198,14 @@ class TorqueController(Controller):
     ``dw = [M (a + alpha x c); I alpha + c x M (a + alpha x c)]``; the tensions are
     ``t = clip(t_ref + W_ref^+ dw, t_min, t_max)`` where ``t_ref`` is the closed-form tension
     distribution for gravity plus the reference inertial wrench (precomputed over the
-    reference, batched); the motor torques invert the winch model:
+    reference, batched); the motor torques invert the nominal winch model, gearbox loss in
+    the direction of power flow included (:meth:`DynamicsModel.holding_torque`):
 
-        tau = ((r/N) t - tau_f_est(theta_dot) - J theta_ddot_ref
-               + joint_damping (theta_dot - theta_dot_ref)) / eta.
+        tau + tau_g(tau, t, theta_dot) = (r/N) t - tau_f_est(theta_dot) - J theta_ddot_ref
+                                         + joint_damping (theta_dot - theta_dot_ref).
+
+    Pose and twist are what :class:`taut.cdpr.Sensing` gives (by default estimated from the
+    encoders on the nominal model).
 
     Parameters
     ----------
@@ -216,8 +251,9 @@ class TorqueController(Controller):
         d = ctx.dynamics
         kl = d.length_per_rad
         speed_ref = ctx.L0_dot[k] / kl
-        return (kl * t - d.friction(meas.speed) - d.rotor_inertia * ctx.L0_ddot[k] / kl
-                + self.joint_damping * (meas.speed - speed_ref)) / d.efficiency
+        load = (kl * t - d.friction(meas.speed) - d.rotor_inertia * ctx.L0_ddot[k] / kl
+                + self.joint_damping * (meas.speed - speed_ref))
+        return d.holding_torque(load, t, meas.speed)
 
 
 #: Controller names accepted by the CLI.

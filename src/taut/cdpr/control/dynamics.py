@@ -7,17 +7,25 @@ Units: SI, float64. Motor-side quantities (torque N m, speed rad/s, inertia kg m
 motor shaft, before the gearhead.
 
 Winch model (one per cable). With ``theta`` the motor angle, ``N`` the gear ratio, ``r`` the
-drum radius and ``eta`` the transmission efficiency, the unstretched (paid-out) cable length is
-``L0 = L0(0) + (r / N) theta`` and
+drum radius, ``kl = r / N``, the unstretched (paid-out) cable length is
+``L0 = L0(0) + kl theta`` and
 
-    J theta_ddot = (r / N) T - eta tau - tau_f(theta_dot),
+    J theta_ddot = kl T - tau - tau_g(tau, T, theta_dot) - tau_f(theta_dot),
 
 where ``T`` is the cable tension, ``tau`` the motor torque (positive winds the cable in) and
 ``tau_f = (tau_c + (tau_s - tau_c) exp(-(w / w_s)^2)) tanh(w / w_eps) + b w`` the motor friction
-(static ``tau_s``, Coulomb ``tau_c``, viscous ``b``, Stribeck speed ``w_s``). Efficiency is
-modelled as a constant loss factor on the motor torque (the paper gives one 70 % figure, not
-its dependence on the direction of power flow). Holding 45 N then needs
-``45 * 0.04 / (5 * 0.7) = 0.514 N m``, inside Table 1's 0.6 N m working point.
+(static ``tau_s``, Coulomb ``tau_c``, viscous ``b``, Stribeck speed ``w_s``). The gearbox loss
+``tau_g`` follows the direction of power flow (a load-dependent Coulomb friction of the mesh):
+with ``s = tanh(w / w_eps)``,
+
+    tau_g = s ((1 - eta) max(-s tau, 0) + (1 - eta_b) max(s kl T, 0)),
+
+so when the motor drives the load (winding in, ``s = -1``) ``J theta_ddot = kl T - eta tau``
+and when the load drives the motor (paying out under tension, ``s = +1``)
+``J theta_ddot = eta_b kl T - tau``: lowering 45 N needs ``eta_b kl T = 0.25 N m``, lifting
+it ``kl T / eta = 0.51 N m`` (Table 1's 0.6 N m working point). The dissipated power
+``tau_g w`` is never negative. At rest the regularised loss vanishes like the regularised
+Coulomb friction (a real mesh holds any torque in ``[eta_b kl T, kl T / eta]``).
 
 Cable model: tension ``T = max(0, (EA (L - L0) + d (L_dot - L0_dot)) / L0)``: stiffness ``k = EA / L0``,
 unilateral (no force when the cable is shorter than its unstretched length).
@@ -60,7 +68,10 @@ class DynamicsModel:
     gear_ratio : float
         Motor turns per drum turn (Table 1: 5:1).
     efficiency : float
-        Transmission efficiency in (0, 1] (Table 1: 70 %).
+        Transmission efficiency in (0, 1] when the motor drives the load (Table 1: 70 %).
+    backdrive_efficiency : float, optional
+        Efficiency in (0, 1] when the load drives the motor (paying out under tension);
+        default (None) the forward ``efficiency`` (the paper gives one figure).
     motor_torque_limit : float
         N m (Table 1 gives the 0.6 N m working point; taken as the limit).
     motor_speed_limit : float
@@ -86,6 +97,7 @@ class DynamicsModel:
     drum_diameter: float = 0.08
     gear_ratio: float = 5.0
     efficiency: float = 0.7
+    backdrive_efficiency: float | None = None
     motor_torque_limit: float = 0.6
     motor_speed_limit: float = 250.0
     rotor_inertia: float = 4.5e-5
@@ -97,7 +109,10 @@ class DynamicsModel:
     drive_integral_gain: float = 4.0
 
     def __post_init__(self) -> None:
+        if self.backdrive_efficiency is None:
+            object.__setattr__(self, "backdrive_efficiency", self.efficiency)
         positive = ("cable_stiffness", "drum_diameter", "gear_ratio", "efficiency",
+                    "backdrive_efficiency",
                     "motor_torque_limit", "motor_speed_limit", "rotor_inertia",
                     "stribeck_speed")
         for f in fields(self):
@@ -108,9 +123,10 @@ class DynamicsModel:
                 raise InvalidModelError(f"dynamics.{f.name}",
                                         f"must be non-negative, got {v:g}")
             object.__setattr__(self, f.name, v)
-        if self.efficiency > 1.0:
-            raise InvalidModelError("dynamics.efficiency",
-                                    f"must be in (0, 1], got {self.efficiency:g}")
+        for name in ("efficiency", "backdrive_efficiency"):
+            if getattr(self, name) > 1.0:
+                raise InvalidModelError(f"dynamics.{name}",
+                                        f"must be in (0, 1], got {getattr(self, name):g}")
         if self.friction_static < self.friction_coulomb:
             raise InvalidModelError("dynamics.friction_static", "static friction "
                                     f"{self.friction_static:g} N m is below Coulomb friction "
@@ -155,12 +171,61 @@ class DynamicsModel:
         return np.asarray(scale) * (level * np.tanh(w / FRICTION_SPEED_WIDTH)
                                     + self.friction_viscous * w)
 
+    def gear_loss(self, tau: Any, tension: Any, speed: Any, efficiency: Any = None,
+                  backdrive_efficiency: Any = None) -> np.ndarray:
+        """Gearbox loss torque ``tau_g`` (N m at the motor, same sign as ``speed``) for motor
+        torques ``tau`` (N m), cable tensions ``tension`` (N) and motor speeds ``speed``
+        (rad/s), with the direction of power flow (see the module docstring); the
+        efficiencies default to this model's (arrays broadcast, for perturbed plants).
+
+        Examples
+        --------
+        >>> d = DynamicsModel(backdrive_efficiency=0.5)
+        >>> round(float(d.gear_loss(0.3, 45.0, 100.0)), 3)        # lowering: (1 - 0.5) kl T
+        0.18
+        >>> round(float(d.gear_loss(0.6, 45.0, -100.0)), 3)       # lifting: -(1 - 0.7) tau
+        -0.18
+        """
+        from .._tol import FRICTION_SPEED_WIDTH
+        eta = self.efficiency if efficiency is None else efficiency
+        eta_b = (self.efficiency if self.backdrive_efficiency is None
+                 else self.backdrive_efficiency) if backdrive_efficiency is None \
+            else backdrive_efficiency
+        s = np.tanh(np.asarray(speed, dtype=float) / FRICTION_SPEED_WIDTH)
+        load = self.length_per_rad * np.asarray(tension, dtype=float)
+        return s * ((1.0 - eta) * np.maximum(-s * np.asarray(tau, dtype=float), 0.0)
+                    + (1.0 - eta_b) * np.maximum(s * load, 0.0))
+
+    def holding_torque(self, load: Any, tension: Any, speed: Any) -> np.ndarray:
+        """Motor torque ``tau`` (N m) solving ``tau + tau_g(tau, T, w) = load`` for the
+        net torque ``load`` (N m at the motor, e.g. ``kl T - tau_f - J theta_ddot``), cable
+        tensions ``T`` (N) and motor speeds ``w`` (rad/s): the inverse of the gearbox loss
+        (``load / eta`` winding in, ``load - (1 - eta_b) kl T`` paying out).
+
+        Examples
+        --------
+        >>> d = DynamicsModel(backdrive_efficiency=0.5)
+        >>> kT = d.length_per_rad * 45.0
+        >>> bool(np.isclose(d.holding_torque(kT, 45.0, 100.0), 0.5 * kT))
+        True
+        >>> bool(np.isclose(d.holding_torque(kT, 45.0, -100.0), kT / 0.7))
+        True
+        """
+        from .._tol import FRICTION_SPEED_WIDTH
+        s = np.tanh(np.asarray(speed, dtype=float) / FRICTION_SPEED_WIDTH)
+        kT = self.length_per_rad * np.asarray(tension, dtype=float)
+        eta_b = self.efficiency if self.backdrive_efficiency is None else \
+            self.backdrive_efficiency
+        z = np.asarray(load, dtype=float) - (1.0 - eta_b) * s * np.maximum(s * kT, 0.0)
+        return np.where(z * s < 0.0, z / (1.0 - (1.0 - self.efficiency) * s * s), z)
+
     def without_losses(self) -> "DynamicsModel":
         """The same winches with no friction, no cable damping and 100 % efficiency
         (for energy-conservation checks)."""
         from dataclasses import replace
         return replace(self, cable_damping=0.0, friction_static=0.0, friction_coulomb=0.0,
-                       friction_viscous=0.0, efficiency=1.0)
+                       friction_viscous=0.0, efficiency=1.0,
+                       backdrive_efficiency=1.0)
 
     def describe(self) -> dict[str, Any]:
         """JSON-friendly parameters, with which ones come from the FASTKIT paper."""

@@ -69,27 +69,36 @@ class Plant:
         B = len(perturbations)
         self.B = B
         ms = np.array([p.mass_scale for p in perturbations])
-        mp, ml = robot.platform.mass, robot.payload.mass
-        com = (mp * robot.platform.com + ml * robot.payload.com) / (mp + ml)
-        dp, dl = robot.platform.com - com, robot.payload.com - com
-        inertia = (robot.platform.inertia + mp * (dp @ dp * np.eye(3) - np.outer(dp, dp))
-                   + ml * (dl @ dl * np.eye(3) - np.outer(dl, dl)))
+        ps = np.array([p.payload_scale for p in perturbations])
+        com, inertia = moving_body(robot, ps)                    # (B, 3), (B, 3, 3)
         self.com_local = com                                     # P -> CoM, platform frame
-        self.mass = ms * (mp + ml)                               # (B,)
+        self.mass = ms * (robot.platform.mass + ps * robot.payload.mass)       # (B,)
         self.inertia = ms[:, None, None] * inertia               # (B, 3, 3) about the CoM
         self.inertia_inv = np.linalg.inv(self.inertia)
-        self.attach_c = (robot.attach_local - com).T.copy()      # (3, m) from the CoM
+        self.attach_c = robot.attach_local.T[None] - com[:, :, None]   # (B, 3, m) from CoM
         self.exit_offsets = np.stack([p.exit_offsets for p in perturbations]).transpose(0, 2, 1)
         self.length_offsets = np.stack([p.length_offsets for p in perturbations])
-        self.friction_scale = np.array([p.friction_scale for p in perturbations])[:, None]
+        # Per-winch plant parameters (B, m): efficiencies (capped at 1), friction scale,
+        # rotor inertia.
+        es = np.stack([p.efficiency_scales for p in perturbations])
+        self.eta = np.minimum(dynamics.efficiency * es, 1.0)
+        eta_b = dynamics.efficiency if dynamics.backdrive_efficiency is None \
+            else dynamics.backdrive_efficiency
+        self.eta_b = np.minimum(eta_b * es, 1.0)
+        self.friction_scale = np.array([p.friction_scale for p in perturbations])[:, None] \
+            * np.stack([p.friction_scales for p in perturbations])
+        self.rotor_inertia = dynamics.rotor_inertia * np.stack(
+            [p.inertia_scales for p in perturbations])
         self.g = robot.gravity
         ext = np.zeros(6) if external_wrench is None else np.asarray(external_wrench, float)
         self.f_ext, self.m_ext = ext[:3], ext[3:]
         # Constant blocks that turn the per-step cross products into matrix products.
-        skews = _skew(self.attach_c.T)                          # (m, 3, 3): [b_i]x
-        self._skew_row_T = np.concatenate(list(skews), axis=1).T.copy()     # (3m, 3)
-        self._skew_stack_T = np.concatenate(list(skews), axis=0).T.copy()   # (3, 3m)
-        self._skew_com_T = _skew(self.com_local[None])[0].T.copy()
+        skews = np.stack([_skew(a.T) for a in self.attach_c])          # (B, m, 3, 3)
+        Bn, m = skews.shape[:2]
+        self._skew_row_T = np.swapaxes(np.concatenate(list(np.swapaxes(skews, 0, 1)), axis=2),
+                                       1, 2).copy()                      # (B, 3m, 3)
+        self._skew_stack_T = np.swapaxes(skews.reshape(Bn, 3 * m, 3), 1, 2).copy()  # (B, 3, 3m)
+        self._skew_com_T = np.swapaxes(_skew(self.com_local), 1, 2).copy()        # (B, 3, 3)
         self._inv_mass = (1.0 / self.mass)[:, None]
         self._inertia_T = np.swapaxes(self.inertia, 1, 2).copy()
         self._inertia_inv_T = np.swapaxes(self.inertia_inv, 1, 2).copy()
@@ -108,7 +117,7 @@ class Plant:
         d = self.dyn
         if d.cable_damping > 0.0:
             # velocity of the attachments: v_c + R (w_b x b_i) = v_c - R [b_i]x w_b
-            bxw = (s.wb @ self._skew_stack_T).reshape(B, -1, 3)
+            bxw = (s.wb[:, None, :] @ self._skew_stack_T)[:, 0].reshape(B, -1, 3)
             va = s.vc[:, :, None] - s.R @ np.swapaxes(bxw, 1, 2)
             # strain rate: L_dot - L0_dot (paying out at the rotor speed is not stretching)
             sdot = (u * (exit_vel - va)).sum(axis=1) - d.length_per_rad * s.speed
@@ -142,7 +151,8 @@ class Plant:
         F = Tu.sum(axis=2) + self.f_ext
         # Body-frame moment about the CoM: sum_i b_i x (R^T f_i) = [[b_1]x ... [b_m]x] g.
         g = np.swapaxes(s.R, 1, 2) @ Tu
-        tb = np.swapaxes(g, 1, 2).reshape(B, -1) @ self._skew_row_T + self.m_ext @ s.R
+        tb = (np.swapaxes(g, 1, 2).reshape(B, 1, -1) @ self._skew_row_T)[:, 0] \
+            + self.m_ext @ s.R
         Iw = (s.wb[:, None, :] @ self._inertia_T)[:, 0, :]
         gyro = _cross_rows(s.wb, Iw)
         s.vc += h * (F * self._inv_mass + self.g)
@@ -151,8 +161,8 @@ class Plant:
         s.R[:] = s.R @ so3_exp(h * s.wb)
         d = self.dyn
         k = d.length_per_rad
-        acc = (k * T - d.efficiency * tau - d.friction(s.speed, self.friction_scale)) \
-            * (1.0 / d.rotor_inertia)
+        acc = (k * T - tau - d.gear_loss(tau, T, s.speed, self.eta, self.eta_b)
+               - d.friction(s.speed, self.friction_scale)) / self.rotor_inertia
         s.speed += h * acc
         s.L0 += (h * k) * s.speed
         return T
@@ -160,26 +170,47 @@ class Plant:
     # -- measurements and energy -----------------------------------------------------------
     def pose_of(self, s: PlantState) -> tuple[np.ndarray, np.ndarray]:
         """Platform reference point P (B, 3) and its velocity (B, 3)."""
-        rc = s.R @ self.com_local
+        rc = (s.R @ self.com_local[:, :, None])[:, :, 0]
         # v_P = v_c - R (w_b x c) = v_c + R ([c]x w_b)
-        cxw = s.wb @ self._skew_com_T
+        cxw = (s.wb[:, None, :] @ self._skew_com_T)[:, 0]
         return s.xc - rc, s.vc + (s.R @ cxw[:, :, None])[:, :, 0]
 
     def energy(self, s: PlantState, exits: np.ndarray, tau: np.ndarray,
                L0_start: np.ndarray) -> np.ndarray:
         """Total mechanical energy (B,), J: platform and rotor kinetic energy, gravity (zero
         at the ground), cable strain energy ``EA (L - L0)^2 / (2 L0)`` and the potential of
-        constant motor torques ``eta tau N / r (L0 - L0_start)`` (valid for constant tau)."""
+        constant motor torques ``tau N / r (L0 - L0_start)`` (valid for constant tau; a
+        conservative check needs the lossless model, see ``DynamicsModel.without_losses``)."""
         d = self.dyn
         T, _, _ = self.cables(s, exits, np.zeros_like(exits))
         stretch = T * s.L0 / d.cable_stiffness
         ke = 0.5 * self.mass * np.einsum("bi,bi->b", s.vc, s.vc) + 0.5 * np.einsum(
-            "bi,bij,bj->b", s.wb, self.inertia, s.wb) + 0.5 * d.rotor_inertia * np.einsum(
-            "bm,bm->b", s.speed, s.speed)
+            "bi,bij,bj->b", s.wb, self.inertia, s.wb) + 0.5 * np.einsum(
+            "bm,bm,bm->b", self.rotor_inertia, s.speed, s.speed)
         pe = -self.mass * (s.xc @ self.g) + 0.5 * np.einsum(
             "bm,bm->b", d.cable_stiffness * stretch ** 2, 1.0 / s.L0)
-        pm = np.einsum("bm,bm->b", d.efficiency * tau / d.length_per_rad, s.L0 - L0_start)
+        pm = np.einsum("bm,bm->b", tau / d.length_per_rad, s.L0 - L0_start)
         return ke + pe + pm
+
+
+def moving_body(robot: CableRobot, payload_scale: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Centre of mass (B, 3) in the platform frame (from P, m) and inertia about it (B, 3, 3),
+    kg m^2, of the platform and its payload (mass and own inertia x ``payload_scale`` (B,)),
+    by the parallel-axis theorem."""
+    mp, com_p, Ip = robot.platform.mass, robot.platform.com, robot.platform.inertia
+    ml = robot.payload.mass * np.asarray(payload_scale, dtype=float)
+    com_l = robot.payload.com
+    com = (mp * com_p[None] + ml[:, None] * com_l[None]) / (mp + ml)[:, None]
+    dp, dl = com_p[None] - com, com_l[None] - com
+
+    def steiner(d: np.ndarray) -> np.ndarray:
+        return np.einsum("bi,bi->b", d, d)[:, None, None] * np.eye(3) \
+            - d[:, :, None] * d[:, None, :]
+
+    inertia = Ip[None] + mp * steiner(dp) + ml[:, None, None] * steiner(dl) \
+        + np.asarray(payload_scale, dtype=float)[:, None, None] * robot.payload.inertia[None]
+    return com, inertia
 
 
 def _skew(r: np.ndarray) -> np.ndarray:
@@ -201,7 +232,8 @@ def stiffest_mode(plant: Plant, state: PlantState, exits: np.ndarray) -> float:
     """Largest natural frequency (rad/s) of the linearised platform-cable-rotor system at the
     state of plant 0: ``sqrt(max eig(M^-1 K))`` with generalised coordinates (platform twist
     about the CoM, 6; unstretched lengths, m) and the axial cable stiffnesses
-    ``k_i = EA / L0_i`` (taut cables only). The integrator needs ``omega_max h < 2``."""
+    ``k_i = EA / L0_i`` (taut cables only) and, per cable, the lightest rotor of all plants.
+    The integrator needs ``omega_max h < 2``."""
     d = plant.dyn
     T, u, r = plant.cables(state, exits, np.zeros_like(exits))
     u0, r0 = u[0].T, r[0].T
@@ -214,7 +246,8 @@ def stiffest_mode(plant: Plant, state: PlantState, exits: np.ndarray) -> float:
     Minv_mat[:3, :3] = np.eye(3) / plant.mass[0]
     Rw = state.R[0]
     Minv_mat[3:6, 3:6] = Rw @ plant.inertia_inv[0] @ Rw.T
-    Minv_mat[6:, 6:] = np.eye(m) * d.length_per_rad ** 2 / d.rotor_inertia
+    # the lightest rotor of any plant per cable (winch errors): conservative for the batch
+    Minv_mat[6:, 6:] = np.diag(d.length_per_rad ** 2 / plant.rotor_inertia.min(axis=0))
     ev = np.linalg.eigvals(Minv_mat @ K)
     return float(np.sqrt(max(float(np.max(ev.real)), 0.0)))
 
@@ -224,11 +257,12 @@ def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.nda
     """Every plant at rest in elastic static equilibrium with unstretched lengths ``L0``
     (B, m) under gravity (the external wrench, a disturbance, starts acting at the first
     step), found by Newton's method on the force and moment balance from the pose ``guess``
-    (6,) of P; drives initialised to hold the tensions."""
+    (6,) of P; drives initialised to hold the tensions (at rest the regularised gearbox loss
+    vanishes: ``tau = kl T``)."""
     B = plant.B
     R0 = np.repeat(rotation_matrices(guess[None, 3:]), B, axis=0)
-    xc0 = guess[:3] + R0[0] @ plant.com_local
-    s = PlantState(np.tile(xc0, (B, 1)), np.zeros((B, 3)), R0, np.zeros((B, 3)), L0.copy(),
+    xc0 = guess[:3] + (R0 @ plant.com_local[:, :, None])[:, :, 0]
+    s = PlantState(xc0, np.zeros((B, 3)), R0, np.zeros((B, 3)), L0.copy(),
                    np.zeros_like(L0), np.zeros_like(L0))
     zero_v = np.zeros_like(exits)
 
@@ -253,7 +287,7 @@ def initial_state(plant: Plant, exits: np.ndarray, L0: np.ndarray, guess: np.nda
         s = _moved(s, step)
     T, _, _ = plant.cables(s, exits, zero_v)
     d = plant.dyn
-    s.integ[:] = d.length_per_rad * T / d.efficiency
+    s.integ[:] = d.length_per_rad * T
     return s
 
 

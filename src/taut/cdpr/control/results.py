@@ -139,10 +139,10 @@ def _cable_geometry(setup: Any, xc: np.ndarray, R: np.ndarray, sl: slice
     """Actual exits (T, m, 3), unit vectors and P positions of plant 0."""
     pl = setup.plant
     exits = setup.geo.exits[sl] + pl.exit_offsets[0].T[None]
-    att = xc[:, :, None] + R @ pl.attach_c
+    att = xc[:, :, None] + R @ pl.attach_c[0]
     vec = exits - np.swapaxes(att, 1, 2)
     u = vec / np.linalg.norm(vec, axis=2, keepdims=True)
-    p = xc - R @ pl.com_local
+    p = xc - R @ pl.com_local[0]
     return exits, u, p
 
 
@@ -240,7 +240,7 @@ class summarise:
         if k < self.setup.k0:
             return
         xc, R = snap[0], snap[1]
-        p = xc - R @ pl.com_local
+        p = xc - (R @ pl.com_local[:, :, None])[:, :, 0]
         e = np.linalg.norm(p - ctx.ref_poses[k, :3], axis=1)
         self.err_max = np.fmax(self.err_max, e)
         self.err_sq += e * e

@@ -28,6 +28,7 @@ from ..model.robot import CableRobot
 from .model_errors import ModelErrors, stack_perturbations
 from .plant import Plant, PlantState, initial_state, stiffest_mode
 from .references import Reference
+from .sensing import Sensing, current_tension, estimate_pose, estimate_twist, quantise
 from ._setup import BaseMotion, RefGeometry, build_context, reference_geometry
 from .results import ControlResult, MonteCarloResult, assemble_result, summarise
 
@@ -55,11 +56,25 @@ class _Setup:
     h: float
     substeps: int
     k0: int                 # first recorded step (after the settling pre-roll)
+    sensing: Sensing
+    quantum: float          # encoder resolution, m of cable per count
+    delay: int              # latency, control periods
+    noise: np.ndarray       # (n, B, m) tension noise, N, or (1, 1, m) zeros
+    T_last: np.ndarray      # (B, m) tensions at the last substep, N
+    tau_last: np.ndarray    # (B, m) motor torques at the last substep, N m
+    est_p: np.ndarray       # (B, 3) pose estimate of P, m
+    est_R: np.ndarray       # (B, 3, 3)
+    est_v: np.ndarray       # (B, 3) filtered twist estimate minus the reference, m/s
+    est_w: np.ndarray       # (B, 3) rad/s
+    filter_gain: float      # per-step gain of the twist filter
+    speed_last: np.ndarray  # (B, m) motor speeds at the previous control step, rad/s
+    T_est: np.ndarray       # (B, m) filtered current-based tension estimate, N
 
 
 def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
              model_errors: Any, base_motion: Any, control_rate: float, duration: Any,
-             dynamics: Any, substeps: int, external_wrench: Any, settle: Any) -> _Setup:
+             dynamics: Any, substeps: int, external_wrench: Any, settle: Any,
+             sensing: Any = None) -> _Setup:
     """Validate the inputs, precompute the nominal context, build and initialise the plant."""
     if not isinstance(robot, CableRobot):
         raise InvalidInputError("robot", "must be a taut.cdpr.CableRobot")
@@ -71,6 +86,12 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
                                               "VelocityController() or TorqueController()")
     if robot.dof != 6:
         raise InvalidInputError("robot", "the dynamics need a 6-DoF platform")
+    sens = Sensing() if sensing is None else sensing
+    if not isinstance(sens, Sensing):
+        raise InvalidInputError("sensing", "must be a taut.cdpr.Sensing")
+    if getattr(controller, "tension_gain", 0.0) > 0.0 and sens.tension == "none":
+        raise InvalidInputError("sensing.tension", "VelocityController(tension_gain > 0) "
+                                "needs a tension measurement: 'current' or 'load_cell'")
     dyn = DynamicsModel() if dynamics is None else dynamics
     if not isinstance(dyn, DynamicsModel):
         raise InvalidInputError("dynamics", "must be a taut.cdpr.DynamicsModel")
@@ -104,7 +125,7 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
     state = initial_state(plant, ex0, _parked_lengths(plant, ex0, ctx), ctx.ref_poses[0])
     h = dt / int(substeps)
     w_max = stiffest_mode(plant, state, ex0)
-    w_drive = dyn.efficiency * dyn.drive_speed_gain / dyn.rotor_inertia   # speed-loop pole
+    w_drive = float(np.max(plant.eta * dyn.drive_speed_gain / plant.rotor_inertia))  # drive pole
     w_max = max(w_max, w_drive) if controller.mode == "speed" else w_max
     if w_max * h > STABILITY_OMEGA_H:
         need = w_max / STABILITY_OMEGA_H / int(substeps)
@@ -112,7 +133,17 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
                                 f"is too slow for the semi-implicit Euler integrator: the "
                                 f"stiffest mode ({w_max:.0f} rad/s) needs a rate of at least "
                                 f"{need:.0f} Hz (or more substeps)")
-    return _Setup(robot, dyn, times, ctx, geo, plant, state, h, int(substeps), k0)
+    B, m = plant.B, robot.m
+    noise = (np.random.default_rng(int(sens.seed)).normal(0.0, sens.tension_noise,
+                                                          (len(times), B, m))
+             if sens.tension_noise > 0.0 else np.zeros((1, 1, m)))
+    T0, _, _ = plant.cables(state, ex0, np.zeros_like(ex0))
+    R0 = np.repeat(ctx.R_ref[:1], B, axis=0)
+    return _Setup(robot, dyn, times, ctx, geo, plant, state, h, int(substeps), k0, sens,
+                  sens.quantum(dyn.length_per_rad), sens.delay_steps(rate), noise, T0,
+                  state.integ.copy(), np.repeat(ctx.ref_poses[:1, :3], B, axis=0), R0,
+                  np.zeros((B, 3)), np.zeros((B, 3)), sens.filter_gain(rate),
+                  state.speed.copy(), T0.copy())
 
 
 def _parked_lengths(plant: Plant, exits: np.ndarray, ctx: ControlContext) -> np.ndarray:
@@ -128,11 +159,46 @@ def _parked_lengths(plant: Plant, exits: np.ndarray, ctx: ControlContext) -> np.
     return EA * L / (EA + ctx.tensions[0])
 
 
-def _measure(setup: _Setup) -> Measurement:
-    pl, s = setup.plant, setup.state
-    p, v = pl.pose_of(s)
-    w = (s.R @ s.wb[:, :, None])[:, :, 0]
-    return Measurement(p, s.R, v, w, s.L0 + pl.length_offsets, s.speed)
+def _measure(setup: _Setup, k: int) -> Measurement:
+    """The controller's measurements at step ``k`` (see :class:`Sensing`)."""
+    pl, s, sens, ctx, d = setup.plant, setup.state, setup.sensing, setup.ctx, setup.dyn
+    L0m = quantise(s.L0 + pl.length_offsets, setup.quantum)
+    m_ = _measure_at(setup, k, pl, s, sens, ctx, d, L0m)
+    setup.speed_last = s.speed.copy()
+    return m_
+
+
+def _measure_at(setup: _Setup, k: int, pl: Plant, s: PlantState, sens: Sensing,
+                ctx: ControlContext, d: DynamicsModel, L0m: np.ndarray) -> Measurement:
+    from .._tol import SENSING_FK_FIRST_ITERATIONS, SENSING_FK_ITERATIONS
+    if sens.tension == "load_cell":
+        tension = setup.T_last + setup.noise[k % len(setup.noise)]
+    elif sens.tension == "current":
+        acc = (s.speed - setup.speed_last) / ctx.dt if k > 0 else np.zeros_like(s.speed)
+        raw = current_tension(d, setup.tau_last, s.speed, acc)
+        a = 1.0 if k == 0 else setup.filter_gain
+        setup.T_est = setup.T_est + a * (raw - setup.T_est)
+        tension = setup.T_est + setup.noise[k % len(setup.noise)]
+    else:
+        tension = np.full_like(L0m, np.nan)
+    if sens.ideal_pose:
+        p, v = pl.pose_of(s)
+        w = (s.R @ s.wb[:, :, None])[:, :, 0]
+        return Measurement(p, s.R, v, w, L0m, s.speed, tension)
+    t_known = setup.T_last + setup.noise[k % len(setup.noise)] \
+        if sens.tension == "load_cell" else ctx.tensions[k][None]
+    lengths = L0m * (1.0 + t_known / d.cable_stiffness)
+    it = SENSING_FK_FIRST_ITERATIONS if k == 0 else SENSING_FK_ITERATIONS
+    setup.est_p, setup.est_R = estimate_pose(setup.est_p, setup.est_R, ctx.exits[k],
+                                             ctx.attach, lengths, it)
+    v, w = estimate_twist(setup.est_p, setup.est_R, ctx.exits[k], ctx.exit_vel[k], ctx.attach,
+                          d.length_per_rad * s.speed)
+    a = 1.0 if k == 0 else setup.filter_gain     # the filter acts on the deviation from
+    vr, wr = ctx.ref_vel[k, :3], ctx.ref_vel[k, 3:]  # the reference twist (no lag on it)
+    setup.est_v = setup.est_v + a * (v - vr - setup.est_v)
+    setup.est_w = setup.est_w + a * (w - wr - setup.est_w)
+    return Measurement(setup.est_p, setup.est_R, vr + setup.est_v, wr + setup.est_w, L0m,
+                       s.speed, tension)
 
 
 def _loop(setup: _Setup, controller: Controller,
@@ -146,8 +212,12 @@ def _loop(setup: _Setup, controller: Controller,
     exits_T = np.swapaxes(geo.exits, 1, 2)
     vel_T = np.swapaxes(geo.exit_vel, 1, 2)
     with np.errstate(all="ignore"):
+        buf: list[np.ndarray] = []
         for k in range(n):
-            cmd = controller.command(ctx, k, _measure(setup))
+            buf.append(np.asarray(controller.command(ctx, k, _measure(setup, k)), dtype=float))
+            if k == 0:
+                buf = buf * (setup.delay + 1)
+            cmd = buf.pop(0)                   # computed setup.delay control periods ago
             ex, ev = exits_T[k], vel_T[k]
             snap = (s.xc.copy(), s.R.copy(), s.speed.copy())
             for j in range(setup.substeps):
@@ -155,6 +225,7 @@ def _loop(setup: _Setup, controller: Controller,
                 T = pl.step(s, setup.h, ex, ev, tau)
                 if j == 0:
                     record(k, T, tau, snap)
+            setup.T_last, setup.tau_last = T, tau
             if k % _CHECK_EVERY == _CHECK_EVERY - 1 or k == n - 1:
                 bad = ~np.all(np.isfinite(s.xc) & (s.xc > lo) & (s.xc < hi), axis=1) \
                     | ~np.all(np.isfinite(s.L0), axis=1)
@@ -189,21 +260,31 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
     """Run the compiled loop; returns records (n/rec_every, Brec, 12 + 3m), per-plant
     summaries (B, 6) and the first diverged step per plant (-1 if none)."""
     from ._kernel import run
-    from .._tol import FRICTION_SPEED_WIDTH
+    from .._tol import (FRICTION_SPEED_WIDTH, SENSING_FK_FIRST_ITERATIONS,
+                        SENSING_FK_ITERATIONS)
     pl, s, ctx, geo, d = setup.plant, setup.state, setup.ctx, setup.geo, setup.dyn
     n, m, B = len(setup.times), setup.robot.m, pl.B
     if isinstance(controller, VelocityController):
-        mode, gains = 0, np.array([controller.length_gain, 0, 0, 0, 0], float)
+        mode, gains = 0, np.array([controller.length_gain, controller.tension_gain, 0, 0, 0],
+                                  float)
     else:
         c = controller
         mode, gains = 1, np.array([c.position_stiffness, c.position_damping,  # type: ignore[attr-defined]
                                    c.rotation_stiffness, c.rotation_damping,  # type: ignore[attr-defined]
                                    c.joint_damping], float)  # type: ignore[attr-defined]
+    eta_b = d.efficiency if d.backdrive_efficiency is None else d.backdrive_efficiency
     dyn = np.array([d.cable_stiffness, d.cable_damping, d.length_per_rad, d.efficiency,
                     d.motor_torque_limit, d.motor_speed_limit, d.rotor_inertia,
                     d.friction_static, d.friction_coulomb, d.friction_viscous,
                     d.stribeck_speed, FRICTION_SPEED_WIDTH, d.drive_speed_gain,
-                    d.drive_integral_gain])
+                    d.drive_integral_gain, eta_b])
+    sens = setup.sensing
+    sv = np.array([float(sens.ideal_pose), setup.quantum,
+                   {"none": 0.0, "current": 1.0, "load_cell": 2.0}[sens.tension],
+                   setup.filter_gain, float(setup.delay), float(SENSING_FK_ITERATIONS),
+                   float(SENSING_FK_FIRST_ITERATIONS)])
+    winch = np.stack([pl.eta, pl.eta_b, pl.friction_scale * np.ones_like(pl.eta),
+                      pl.rotor_inertia])
     rec = np.full(((n + rec_every - 1) // rec_every, n_rec_plants, 12 + 3 * m), np.nan)
     summ = np.zeros((B, 6))
     summ[:, 2], summ[:, 3] = np.inf, -np.inf
@@ -216,11 +297,14 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
             C(ctx.ref_vel), C(ctx.R_ref), C(ctx.tensions), C(ctx.W_pinv), C(ctx.com_skew_T),
             C(ctx.inertia), float(ctx.mass), C(ctx.t_min), C(ctx.t_max),
             C(np.swapaxes(geo.exits, 1, 2)), C(np.swapaxes(geo.exit_vel, 1, 2)),
-            C(pl.exit_offsets), C(pl.length_offsets), C(pl.friction_scale[:, 0]),
+            C(pl.exit_offsets), C(pl.length_offsets), C(winch),
             C(pl.mass), C(pl.inertia), C(pl.inertia_inv), C(pl.attach_c), C(pl.com_local),
             C(pl.g), C(np.r_[pl.f_ext, pl.m_ext]), s.xc, s.vc, s.R, s.wb, s.L0, s.speed,
             s.integ, float(setup.h), int(setup.substeps), lo, hi, _CHECK_EVERY, rec,
-            int(rec_every), summ, int(setup.k0), diverged)
+            int(rec_every), summ, int(setup.k0), diverged, sv, C(setup.noise),
+            C(ctx.attach.T), setup.est_p, setup.est_R, setup.est_v, setup.est_w,
+            setup.T_last, setup.tau_last, np.zeros((setup.delay + 1, B, m)),
+            setup.speed_last, setup.T_est, float(ctx.dt))
     return rec, summ, diverged
 
 
@@ -229,7 +313,7 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
              control_rate: float = 1000.0, duration: float | None = None,
              dynamics: DynamicsModel | None = None, substeps: int = 1,
              external_wrench: ArrayLike | None = None, settle: float = 1.0,
-             backend: Backend = "auto",
+             backend: Backend = "auto", sensing: Sensing | None = None,
              progress: Callable[[int, int], None] | None = None) -> ControlResult:
     """Simulate a controller driving the cable robot along a reference.
 
@@ -264,6 +348,10 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
     backend : {"auto", "numba", "numpy"}
         The compiled loop (built-in controllers, needs numba) or the numpy one (any
         controller); "auto" picks numba when it can. Both compute the same model.
+    sensing : Sensing, optional
+        What the controller measures (default ``Sensing()``: encoders and drive torques,
+        pose estimated from the encoders on the nominal model; ``Sensing(ideal_pose=True)``
+        for the true pose).
     progress : callable(done, total), optional
         Called during the run (numpy backend) or at its end (numba backend).
 
@@ -294,7 +382,7 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
         raise InvalidInputError("model_errors", "must be a taut.cdpr.ModelErrors")
     used = _backend(backend, controller)
     setup = _prepare(robot, reference, controller, model_errors, base_motion, control_rate,
-                     duration, dynamics, substeps, external_wrench, settle)
+                     duration, dynamics, substeps, external_wrench, settle, sensing)
     n, m = len(setup.times), robot.m
     if used == "numba":
         rec_n, _, div_n = _loop_numba(setup, controller, 1, 1)
@@ -318,7 +406,7 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
                 model_errors: Sequence[ModelErrors], *, base_motion: BaseMotion | None = None,
                 control_rate: float = 1000.0, duration: float | None = None,
                 dynamics: DynamicsModel | None = None, substeps: int = 1,
-                settle: float = 1.0, backend: Backend = "auto",
+                settle: float = 1.0, backend: Backend = "auto", sensing: Sensing | None = None,
                 progress: Callable[[int, int], None] | None = None) -> MonteCarloResult:
     """Run one simulation per entry of ``model_errors``, batched through one plant (the
     per-step work is vectorised over runs), keeping summary numbers per run.
@@ -334,7 +422,7 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
         raise InvalidInputError("model_errors", "needs at least one ModelErrors")
     used = _backend(backend, controller)
     setup = _prepare(robot, reference, controller, errs, base_motion, control_rate,
-                     duration, dynamics, substeps, None, settle)
+                     duration, dynamics, substeps, None, settle, sensing)
     acc = summarise(setup)
     if used == "numba":
         rec, summ, div = _loop_numba(setup, controller, _MC_RECORD_EVERY, len(errs))

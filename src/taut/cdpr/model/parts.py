@@ -185,25 +185,20 @@ class Platform:
             raise InvalidModelError("platform.mass", f"must be non-negative, got {m:g}")
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", as_array(self.com, "platform.com", shape=(3,)))
-        inertia = as_array(self.inertia, "platform.inertia")
-        if inertia.shape == (3,):
-            inertia = np.diag(inertia)
-        if inertia.shape != (3, 3):
-            raise InvalidModelError("platform.inertia", "must be 3 numbers or a 3x3 matrix")
-        if not np.allclose(inertia, inertia.T, atol=INERTIA_REL * (1 + np.abs(inertia).max())):
-            raise InvalidModelError("platform.inertia", "must be symmetric")
-        if np.linalg.eigvalsh(inertia).min() < -INERTIA_REL * (1 + np.abs(inertia).max()):
-            raise InvalidModelError("platform.inertia", "must be positive semi-definite")
+        inertia = _inertia_matrix(self.inertia, "platform.inertia")
         object.__setattr__(self, "inertia", inertia)
 
 
 @dataclass(frozen=True, eq=False)
 class Payload:
-    """A payload rigidly held by the platform: mass (kg, >= 0) and centre of mass in the
-    platform frame (m)."""
+    """A payload rigidly held by the platform: mass (kg, >= 0), centre of mass in the
+    platform frame (m) and inertia about that centre of mass in the platform frame (kg m^2,
+    3 numbers or 3x3; default zero: a point mass). Statics use mass and centre of mass; the
+    control simulation's rigid body adds the inertia."""
 
     mass: float = 0.0
     com: Any = (0.0, 0.0, 0.0)
+    inertia: Any = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
     def __post_init__(self) -> None:
         m = as_finite_scalar(self.mass, "payload.mass")
@@ -211,6 +206,22 @@ class Payload:
             raise InvalidModelError("payload.mass", f"must be non-negative, got {m:g}")
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", as_array(self.com, "payload.com", shape=(3,)))
+        object.__setattr__(self, "inertia", _inertia_matrix(self.inertia, "payload.inertia"))
+
+
+def _inertia_matrix(value: Any, field: str) -> np.ndarray:
+    """A symmetric positive semi-definite 3x3 inertia (kg m^2) from 3 numbers (principal
+    moments) or a 3x3 matrix."""
+    inertia = as_array(value, field)
+    if inertia.shape == (3,):
+        inertia = np.diag(inertia)
+    if inertia.shape != (3, 3):
+        raise InvalidModelError(field, "must be 3 numbers or a 3x3 matrix")
+    if not np.allclose(inertia, inertia.T, atol=INERTIA_REL * (1 + np.abs(inertia).max())):
+        raise InvalidModelError(field, "must be symmetric")
+    if np.linalg.eigvalsh(inertia).min() < -INERTIA_REL * (1 + np.abs(inertia).max()):
+        raise InvalidModelError(field, "must be positive semi-definite")
+    return inertia
 
 
 @dataclass(frozen=True)
