@@ -180,6 +180,8 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.io", "read_mapping"): {"path": str(ROOT / "examples/sheet/example1.yaml")},
         ("taut.io", "read_text"): {"path": "pyproject.toml"},
         ("taut.io", "write_json"): {"path": "/dev/null"},
+        ("taut.io", "parse_mapping"): {"text": "a: 1\n", "source": "inline.yaml"},
+        ("taut.io", "write_text_atomic"): {"path": "{tmp}/out.txt", "text": "x"},
         ("taut.io", "load_sheet_scenario"): {"path": str(ROOT / "examples/sheet/example1.yaml")},
         ("taut.io", "load_plan_scenario"): {"path": str(ROOT / "examples/plan/paper_corridor.yaml")},
         ("taut.io", "sheet_scenario_from_mapping"): {"data": {"sheet": [[0, 0], [1, 0],

@@ -19,9 +19,15 @@ from taut.cli import main  # noqa: E402
 ROOT = Path(__file__).parents[2]
 
 
+def local_client(app, **kw):
+    """A test client that is the app's own page: loopback Host and the app's token."""
+    return testclient.TestClient(app, base_url="http://127.0.0.1:8765",
+                                 headers={"X-Taut-Token": app.state.token}, **kw)
+
+
 @pytest.fixture(scope="module")
 def client():
-    with testclient.TestClient(create_app(catalog=Catalog(ROOT / "examples"))) as c:
+    with local_client(create_app(catalog=Catalog(ROOT / "examples"))) as c:
         yield c
 
 
@@ -53,7 +59,7 @@ def test_catalog_lists_the_examples(client):
     ("/api/cdpr/state", json.dumps({"model": {"name": "x"}, "pose": [0] * 6}).encode(), None),
 ])
 def test_bad_requests_get_one_line(client, path, body, line):
-    r = client.post(path, content=body)
+    r = client.post(path, content=body, headers={"Content-Type": "application/json"})
     assert r.status_code == 422
     err = r.json()["error"]
     assert "\n" not in err and "Traceback" not in err and ": " in err
@@ -68,8 +74,8 @@ def test_a_bug_is_one_line_and_the_server_goes_on(monkeypatch):
         raise ZeroDivisionError("secret detail")
 
     monkeypatch.setattr(sheet_api.SheetAPI, "fk", boom)
-    with testclient.TestClient(create_app(catalog=Catalog(ROOT / "examples")),
-                               raise_server_exceptions=False) as c:
+    with local_client(create_app(catalog=Catalog(ROOT / "examples")),
+                      raise_server_exceptions=False) as c:
         r = c.post("/api/sheet/fk", json={})
         assert r.status_code == 500
         err = r.json()["error"]
@@ -86,7 +92,7 @@ def test_infeasible_answers_are_json_without_nan(client):
 
 def test_initial_scenario_opens_its_view():
     data = {"hold_height": 1.0, "sheet": [[0, 0], [1, 0], [0, 1]]}
-    with testclient.TestClient(create_app(data)) as c:
+    with local_client(create_app(data)) as c:
         assert c.get("/api/initial").json()["initial"] == {"kind": "sheet", "mapping": data}
 
 

@@ -34,7 +34,8 @@ def find_browser() -> tuple[str, str] | None:
 
 @contextmanager
 def served(app: Any) -> Iterator[str]:
-    """Serve ``app`` on a free localhost port in a thread; yields the base URL."""
+    """Serve ``app`` on a free localhost port in a thread; yields the page's URL with the
+    app's token (``http://127.0.0.1:PORT/?token=...``)."""
     import uvicorn
 
     from .server import bind
@@ -48,7 +49,7 @@ def served(app: Any) -> Iterator[str]:
     while not server.started and time.monotonic() < deadline:
         time.sleep(0.02)
     try:
-        yield f"http://127.0.0.1:{port}/"
+        yield f"http://127.0.0.1:{port}/?token={app.state.token}"
     finally:
         server.should_exit = True
         thread.join(10)

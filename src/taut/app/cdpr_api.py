@@ -25,7 +25,7 @@ from ..errors import InfeasiblePoseError, InvalidInputError
 from ..io import cdpr_model_from_mapping
 from ..io.serialize import json_ready
 from .catalog import Catalog
-from .payload import ModelCache, field, mapping_from_upload
+from .payload import ModelCache, field, mapping_from_upload, numbers
 
 __all__ = ["CdprAPI"]
 
@@ -58,6 +58,14 @@ def geometry(robot: CableRobot) -> dict[str, Any]:
             "has_tipping": bool(robot.has_tipping), "methods": list(TENSION_METHODS)}
 
 
+def _pose(body: dict[str, Any]) -> np.ndarray:
+    pose = numbers(field(body, "pose", list), "pose", 1)
+    if pose.shape != (6,) or not np.all(np.isfinite(pose)):
+        raise InvalidInputError("pose", "must be 6 finite numbers x y z roll pitch yaw "
+                                        "(m, rad)")
+    return pose
+
+
 class CdprAPI:
     """The cable-robot explorer's endpoints (models cached by their mapping)."""
 
@@ -84,17 +92,19 @@ class CdprAPI:
 
     def yaml(self, body: dict[str, Any]) -> dict[str, Any]:
         """The model file, headed by the ``taut cdpr tensions`` command for the pose (the
-        same library defaults as :meth:`state`)."""
-        robot = self._robot(body)
-        pose = np.asarray(field(body, "pose", list), dtype=float)
-        cmd = (f"taut cdpr tensions FILE --pose {pose[0]:g} {pose[1]:g} {pose[2]:g} "
-               f"--rpy {pose[3]:g} {pose[4]:g} {pose[5]:g}")
+        same library defaults as :meth:`state`). The model (its name included) is written
+        by the YAML serializer only; the comment holds nothing but validated numbers and
+        choices, so no text from the request can add a line or a key."""
+        self._robot(body)
+        pose = _pose(body)
+        num = [np.format_float_positional(v, trim="-") for v in pose]   # shortest exact
+        cmd = f"taut cdpr tensions FILE --pose {' '.join(num[:3])} --rpy {' '.join(num[3:])}"
         method = field(body, "method", str, default=None)
         if method is not None:
-            cmd += f" --method {method}"
+            cmd += " --method " + as_choice(method, tuple(TENSION_METHODS), "method")
         if field(body, "stabilisers", bool, default=False):
             cmd += " --stabilisers"
-        text = (f"# cable-robot model '{robot.name}' saved by `taut app`; the pose shown:\n"
+        text = ("# cable-robot model saved by `taut app`; the pose shown:\n"
                 f"#   {cmd}\n" + yaml.safe_dump(field(body, "model", dict), sort_keys=False,
                                                default_flow_style=None))
         return {"yaml": text, "filename": "cdpr_model.yaml"}
@@ -104,9 +114,7 @@ class CdprAPI:
         margins, feasibility; a pose outside the frame box is flagged, not an error.
         ``method`` (optional) is passed on; omitted, the library's default is used."""
         robot = self._robot(body)
-        pose = np.asarray(field(body, "pose", list), dtype=float)
-        if pose.shape != (6,) or not np.all(np.isfinite(pose)):
-            raise InvalidInputError("pose", "must be 6 finite numbers x y z roll pitch yaw")
+        pose = _pose(body)
         method = field(body, "method", str, default=None)
         st = cable_state(robot, pose[None], validated=True)
         attach = (pose[:3] + st.r[0]).tolist()
@@ -149,7 +157,10 @@ class CdprAPI:
                 or n[0] * n[1] > MAX_SLICE_POINTS):
             raise InvalidInputError("n", f"must be two integers >= 2 with at most "
                                          f"{MAX_SLICE_POINTS} points in all")
-        rpy = field(body, "rpy", list, default=[0.0, 0.0, 0.0])
+        rpy = numbers(field(body, "rpy", list, default=[0.0, 0.0, 0.0]), "rpy", 1,
+                      length=3)
+        if not np.all(np.isfinite(rpy)):
+            raise InvalidInputError("rpy", "must be 3 finite angles, rad")
         box = np.array(robot.bounds, dtype=float)
         flat = 1 if plane == "xz" else 2
         offset = float(field(body, "offset", (int, float), default=0.0))

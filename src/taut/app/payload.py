@@ -8,20 +8,90 @@ Every failure is a :class:`taut.errors.TautError`; the server turns it into
 from __future__ import annotations
 
 import json
-import tempfile
 from collections import OrderedDict
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ..errors import InvalidInputError, ScenarioError, TautError
-from ..io import read_mapping
+import numpy as np
 
-__all__ = ["field", "mapping_from_upload", "ModelCache", "kind_of_mapping"]
+from ..errors import InvalidInputError, ScenarioError, TautError
+from ..io import parse_mapping
+
+__all__ = ["field", "numbers", "check_json", "check_filename", "mapping_from_upload",
+           "ModelCache", "kind_of_mapping", "MAX_DEPTH"]
 
 T = TypeVar("T")
 
 _MISSING = object()
+
+#: Deepest nesting of lists and objects accepted in a request body (a drag path is 4).
+MAX_DEPTH = 32
+#: Longest upload file name, characters.
+MAX_NAME = 255
+
+
+def _bad_constant(name: str) -> Any:
+    raise InvalidInputError("request", f"{name} is not a JSON number")
+
+
+def check_json(raw: bytes) -> dict[str, Any]:
+    """Decode a request body: UTF-8 JSON, a top-level object, nested at most
+    :data:`MAX_DEPTH` deep, no NaN/Infinity, every string valid Unicode.
+
+    Raises
+    ------
+    InvalidInputError
+        ``request`` (not JSON, not an object, too deep) or the top-level key whose value
+        holds a lone surrogate (``"\\ud800"`` decodes to text that is not Unicode).
+
+    Examples
+    --------
+    >>> check_json(b'{"a": [1, 2]}')
+    {'a': [1, 2]}
+    >>> try:
+    ...     check_json(b'{"name": "\\\\ud800"}')
+    ... except InvalidInputError as exc:
+    ...     print(exc)
+    name: is not valid Unicode (a lone surrogate)
+    """
+    try:
+        text = raw.decode("utf-8") if raw else "{}"
+    except UnicodeDecodeError:
+        raise InvalidInputError("request", "is not UTF-8 text") from None
+    try:
+        body = json.loads(text, parse_constant=_bad_constant)
+    except RecursionError:
+        raise InvalidInputError("request", f"nested deeper than {MAX_DEPTH} levels") from None
+    except ValueError as exc:
+        if isinstance(exc, InvalidInputError):
+            raise
+        raise InvalidInputError("request", "is not valid JSON") from None
+    if not isinstance(body, dict):
+        raise InvalidInputError("request", "must be a JSON object")
+    stack: list[tuple[Any, str, int]] = [(body, "request", 0)]
+    while stack:
+        value, top, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise InvalidInputError("request", f"nested deeper than {MAX_DEPTH} levels")
+        if isinstance(value, dict):
+            for k, v in value.items():
+                where = k if depth == 0 else top
+                _unicode(k, where)
+                stack.append((v, where, depth + 1))
+        elif isinstance(value, list):
+            stack.extend((v, top, depth + 1) for v in value)
+        elif isinstance(value, str):
+            _unicode(value, top)
+    return body
+
+
+def _unicode(text: str, where: str) -> None:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        name = where.encode("utf-8", "replace").decode("utf-8")
+        raise InvalidInputError(name, "is not valid Unicode (a lone surrogate)") from None
 
 
 def field(body: dict[str, Any], name: str, kind: type | tuple[type, ...], *,
@@ -49,12 +119,74 @@ def field(body: dict[str, Any], name: str, kind: type | tuple[type, ...], *,
     return value
 
 
-def mapping_from_upload(text: str, filename: str) -> dict[str, Any]:
-    """Parse uploaded file text exactly as the CLI parses a file of that name.
+def numbers(value: Any, name: str, ndim: int, *, length: int | None = None) -> np.ndarray:
+    """A JSON value as a float64 array of ``ndim`` dimensions (``length`` entries along
+    the first when given).
 
-    The text is written to a private temporary folder under the upload's base name and
-    read with :func:`taut.io.read_mapping`, so a syntax error reads
-    ``<name>: invalid YAML at line 3`` as in the CLI (without the temporary folder).
+    Raises
+    ------
+    InvalidInputError
+        ``name``: not a (regular, nested) list of numbers of that shape; strings,
+        booleans, objects and ragged lists included.
+
+    Examples
+    --------
+    >>> numbers([[0, 1], [2, 3.5]], "sheet", 2).shape
+    (2, 2)
+    >>> try:
+    ...     numbers(["a", "b"], "pose", 1)
+    ... except InvalidInputError as exc:
+    ...     print(exc)
+    pose: must be a list of numbers
+    """
+    what = ("a list of numbers" if ndim == 1 else
+            f"a list of {'lists of ' * (ndim - 1)}numbers")
+    stack: list[tuple[Any, int]] = [(value, 0)]
+    while stack:
+        v, depth = stack.pop()
+        if depth < ndim:
+            if not isinstance(v, list):
+                raise InvalidInputError(name, f"must be {what}")
+            stack.extend((x, depth + 1) for x in v)
+        elif isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InvalidInputError(name, f"must be {what}")
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidInputError(name, f"must be {what} (rows of equal length)") from None
+    if arr.ndim != ndim:
+        raise InvalidInputError(name, f"must be {what} (rows of equal length)")
+    if length is not None and arr.shape[0] != length:
+        raise InvalidInputError(name, f"must hold {length} numbers, got {arr.shape[0]}")
+    return arr
+
+
+def check_filename(name: Any) -> str:
+    """An upload's file name: a plain name (no folder, ``.``/``..``, NUL or control
+    character), at most :data:`MAX_NAME` characters.
+
+    Raises
+    ------
+    InvalidInputError
+        ``filename``: anything else.
+    """
+    if not isinstance(name, str) or not name:
+        raise InvalidInputError("filename", "must be a non-empty file name")
+    if len(name) > MAX_NAME:
+        raise InvalidInputError("filename", f"longer than {MAX_NAME} characters")
+    if any(c in name for c in "/\\") or name in (".", ".."):
+        raise InvalidInputError("filename", "must be a file name, not a path")
+    if any(ord(c) < 32 or ord(c) == 127 for c in name):
+        raise InvalidInputError("filename", "must not hold control characters (NUL, "
+                                            "newline, ...)")
+    _unicode(name, "filename")
+    return name
+
+
+def mapping_from_upload(text: str, filename: str) -> dict[str, Any]:
+    """Parse uploaded file text exactly as the CLI parses a file of that name
+    (:func:`taut.io.parse_mapping`: size limit, alias bombs refused, JSON for ``.json``,
+    YAML otherwise), so a syntax error reads ``<name>: invalid YAML at line 3``.
 
     Examples
     --------
@@ -66,14 +198,9 @@ def mapping_from_upload(text: str, filename: str) -> dict[str, Any]:
     ...     print(exc)
     b.json: invalid JSON at line 1: Expecting ',' delimiter
     """
-    name = Path(filename or "upload.yaml").name or "upload.yaml"
-    with tempfile.TemporaryDirectory(prefix="taut-app-") as tmp:
-        path = Path(tmp) / name
-        path.write_text(text, encoding="utf-8")
-        try:
-            return read_mapping(path)
-        except TautError as exc:
-            raise ScenarioError(exc.field.replace(str(path), name), exc.problem) from None
+    name = check_filename(filename or "upload.yaml")
+    _unicode(text, "text")
+    return parse_mapping(text, name, suffix=Path(name).suffix)
 
 
 def kind_of_mapping(data: dict[str, Any]) -> str:

@@ -26,9 +26,12 @@ from ..plan import PlanResult, Scenario, plan, plan_profile
 from .catalog import Catalog
 from .payload import field, mapping_from_upload
 
-__all__ = ["PlanAPI", "plan_series", "world_to_dict"]
+__all__ = ["PlanAPI", "BusyError", "plan_series", "world_to_dict", "MAX_JOBS"]
 
-#: Finished jobs kept for the page to collect.
+#: Planning jobs queued or running at once; one more is refused as busy (HTTP 503).
+MAX_JOBS = 4
+#: Finished jobs not yet collected by the page that are kept (oldest dropped first);
+#: queued and running jobs are never dropped.
 _KEEP_JOBS = 16
 #: Wall-clock cap of one planning job, s: the app stays interactive (the planner's own
 #: budget is counted in samples; a failing plan could otherwise search for minutes).
@@ -68,6 +71,10 @@ def _summary(r: PlanResult) -> dict[str, Any]:
     return out
 
 
+class BusyError(TautError):
+    """The planner's queue is full (the server answers HTTP 503); retry later."""
+
+
 @dataclass
 class _Job:
     scenario: Scenario
@@ -80,12 +87,15 @@ class _Job:
 
 
 class PlanAPI:
-    """The planner viewer's endpoints; planning jobs run one at a time in a worker thread."""
+    """The planner viewer's endpoints; planning jobs run one at a time in a worker thread,
+    at most ``max_jobs`` queued or running. A job's id stays valid until the job has
+    finished and its result been fetched once by :meth:`job`."""
 
     STEPS = 2                                  # baseline, then the crossing planner
 
-    def __init__(self, catalog: Catalog) -> None:
+    def __init__(self, catalog: Catalog, max_jobs: int = MAX_JOBS) -> None:
         self.catalog = catalog
+        self.max_jobs = max_jobs
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="taut-plan")
         self._jobs: dict[str, _Job] = {}
         self._ids = itertools.count(1)
@@ -124,9 +134,14 @@ class PlanAPI:
         """Start planning ``scenario``; returns ``{"job": id}`` to poll with :meth:`job`."""
         job = _Job(self._scenario(field(body, "scenario", dict)))
         with self._lock:
+            pending = sum(j.finished is None for j in self._jobs.values())
+            if pending >= self.max_jobs:
+                raise BusyError("plan", f"busy: {pending} planning jobs are queued or "
+                                        "running; retry when one has finished")
             jid = str(next(self._ids))
             self._jobs[jid] = job
-            for old in list(self._jobs)[:-_KEEP_JOBS]:
+            done = [k for k, j in self._jobs.items() if j.finished is not None]
+            for old in done[:max(0, len(done) - _KEEP_JOBS)]:
                 del self._jobs[old]
         self._pool.submit(self._work, job)
         return {"job": jid}
@@ -134,6 +149,7 @@ class PlanAPI:
     def _work(self, job: _Job) -> None:
         sc = job.scenario
         try:
+            job.started = time.monotonic()
             job.stage, job.step = "SE(2) bypass baseline", 1
             base = plan(sc, baseline="se2", time_budget=PLAN_TIME_CAP_S)
             job.stage, job.step = "planner with obstacle crossing", 2
@@ -151,9 +167,13 @@ class PlanAPI:
     def job(self, jid: str) -> dict[str, Any]:
         """Progress of a job: ``state`` (running/done/error), ``stage``, ``step`` of
         ``steps``, ``elapsed`` s; the plans once done."""
-        job = self._jobs.get(jid)
+        with self._lock:
+            job = self._jobs.get(jid)
+            if job is not None and job.finished is not None:
+                del self._jobs[jid]               # fetched: the id is spent
         if job is None:
-            raise ScenarioError("job", f"no planning job {jid!r}")
+            raise ScenarioError("job", f"no planning job {jid[:40]!r} (unknown, or its "
+                                       "result was already fetched)")
         end = job.finished if job.finished is not None else time.monotonic()
         out: dict[str, Any] = {"stage": job.stage, "step": job.step, "steps": self.STEPS,
                                "elapsed": end - job.started}

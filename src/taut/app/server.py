@@ -5,42 +5,75 @@ scenarios), ``GET /api/initial`` (the scenario given on the command line), ``POS
 /api/<view>/<action>`` for the views' endpoints (:mod:`.sheet_api`, :mod:`.plan_api`,
 :mod:`.cdpr_api`), ``GET /api/plan/job/<id>``.
 
-Every reply is JSON. Bad input gives HTTP 422 and ``{"error": "<field>: <problem>"}`` (the
-line the CLI prints); anything unexpected gives HTTP 500 with a one-line ``error`` and is
-logged with its traceback on the server's stderr only, never sent to the page.
+Only its user can drive it (the model of JupyterLab's and the Dask dashboard's servers):
+
+* every ``/api/`` request carries the per-launch secret token (``X-Taut-Token`` header or
+  ``?token=`` query; the page reads it from the URL ``taut app`` prints), else HTTP 403;
+* the ``Host`` header must name this machine (``127.0.0.1``, ``localhost``, ``::1`` or the
+  address served on), which defeats DNS rebinding, and a request with an ``Origin``
+  header must come from the page itself (same scheme, host and port), else HTTP 403;
+* a POST must say ``Content-Type: application/json`` (a cross-site form or a
+  ``text/plain`` fetch cannot), else HTTP 415; no CORS headers are ever sent;
+* a body is counted while it streams in: past :data:`MAX_BODY` bytes HTTP 413 (before the
+  rest is read), slower than :data:`BODY_TIMEOUT_S` HTTP 408;
+* the views' handlers run in a worker pool (one thread per core), never on the event
+  loop, so the page, its scripts, the catalog and job polls answer while a heavy request
+  runs; a request past its time budget (``budget_s``) gets HTTP 503 (its thread finishes
+  in the background; numerical code cannot be stopped midway).
+
+Every reply is JSON, errors included: ``{"error": "<field>: <problem>"}`` (the line the
+CLI prints) with HTTP 422 for bad input, 403/404/405/408/413/415/503 as above, and HTTP 500
+with a one-line ``error`` for a bug, logged with its traceback on the server's stderr
+only, never sent to the page.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hmac
 import json
 import logging
+import os
+import secrets
 import socket
 from collections.abc import AsyncIterator, Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any
+from urllib.parse import parse_qs
 
+import anyio
+import anyio.to_thread
 from starlette.applications import Starlette
+from starlette.exceptions import HTTPException
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import BaseRoute, Mount, Route
 from starlette.staticfiles import StaticFiles
+from starlette.types import ASGIApp, Receive, Scope, Send
 
 from ..errors import InvalidInputError, TautError
 from ..io.serialize import json_ready
 from .catalog import Catalog
 from .cdpr_api import CdprAPI
-from .payload import kind_of_mapping
-from .plan_api import PlanAPI
+from .payload import check_json, kind_of_mapping
+from .plan_api import BusyError, PlanAPI
 from .sheet_api import SheetAPI
 
-__all__ = ["create_app", "bind", "serve", "static_dir"]
+__all__ = ["create_app", "bind", "serve", "static_dir", "new_token", "LOOPBACK_HOSTS"]
 
 log = logging.getLogger("taut.app")
 
 #: Largest request body accepted (an uploaded scenario or a long drag path), bytes.
 MAX_BODY = 8 * 1024 * 1024
+#: Longest wait for a request body to arrive in full, s.
+BODY_TIMEOUT_S = 10.0
+#: Default time budget of one request's work, s.
+BUDGET_S = 60.0
+#: Header that carries the token.
+TOKEN_HEADER = "x-taut-token"
+#: Host names that always mean this machine.
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 
 
 def static_dir() -> Path:
@@ -48,40 +81,157 @@ def static_dir() -> Path:
     return Path(str(resources.files("taut.app") / "static"))
 
 
+def new_token() -> str:
+    """A fresh per-launch secret (43 URL-safe characters, 256 bits)."""
+    return secrets.token_urlsafe(32)
+
+
+def _render(content: Any) -> bytes:
+    return json.dumps(json_ready(content), allow_nan=False,
+                      separators=(",", ":")).encode("utf-8")
+
+
 class _JSON(JSONResponse):
     """JSON without NaN (the page's JSON.parse rejects it): NaN/inf become null."""
 
     def render(self, content: Any) -> bytes:
-        return json.dumps(json_ready(content), allow_nan=False,
-                          separators=(",", ":")).encode("utf-8")
+        return _render(content)
 
 
-def _endpoint(handler: Callable[[dict[str, Any]], dict[str, Any]]):
-    """Wrap a ``body -> dict`` handler as a POST route with the error contract above."""
+def _error(status: int, line: str) -> Response:
+    return _JSON({"error": line}, status_code=status)
 
-    async def route(request: Request) -> Response:
+
+class _Refused(Exception):
+    """A request refused before its handler runs (status and one line)."""
+
+    def __init__(self, status: int, line: str) -> None:
+        super().__init__(line)
+        self.status, self.line = status, line
+
+
+def _host_name(host: str) -> str:
+    """``"[::1]:8765"`` -> ``"::1"``, ``"LocalHost:80"`` -> ``"localhost"``."""
+    host = host.strip().lower()
+    if host.startswith("["):
+        return host[1:host.find("]")] if "]" in host else host
+    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+class _Guard:
+    """ASGI middleware: the Host and Origin allow-lists for every request and the token
+    for every ``/api/`` request (see the module docstring)."""
+
+    def __init__(self, app: ASGIApp, token: str, hosts: tuple[str, ...]) -> None:
+        self.app, self.token, self.hosts = app, token.encode(), hosts
+
+    def _check(self, scope: Scope) -> None:
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1")
+                   for k, v in scope.get("headers", [])}
+        host = headers.get("host", "")
+        if _host_name(host) not in self.hosts:
+            raise _Refused(403, f"Host: {host[:80]!r} is not this app's address "
+                                f"(allowed: {', '.join(self.hosts)})")
+        origin = headers.get("origin")
+        if origin is not None and origin != f"http://{host}":
+            raise _Refused(403, f"Origin: {origin[:80]!r} is not this app's page; "
+                                "other sites cannot use it")
+        if scope["path"].startswith("/api/"):
+            given = headers.get(TOKEN_HEADER)
+            if given is None:
+                query = parse_qs(scope.get("query_string", b"").decode("latin-1"))
+                given = (query.get("token") or [None])[0]
+            if given is None or not hmac.compare_digest(given.encode("latin-1", "replace"),
+                                                        self.token):
+                raise _Refused(403, "token: missing or wrong; open the URL (with its "
+                                    "?token=...) that `taut app` printed")
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "lifespan":
+            await self.app(scope, receive, send)
+            return
+        if scope["type"] != "http":               # no websockets
+            return
         try:
-            raw = await request.body()
-            if len(raw) > MAX_BODY:
-                raise InvalidInputError("request", f"larger than {MAX_BODY // 2**20} MiB")
+            self._check(scope)
+        except _Refused as exc:
+            await _error(exc.status, exc.line)(scope, receive, send)
+            return
+        await self.app(scope, receive, send)
+
+
+async def _read_body(request: Request, limit: int, timeout: float) -> bytes:
+    """The request body, refused past ``limit`` bytes as it streams in."""
+    declared = request.headers.get("content-length")
+    if declared is not None:
+        try:
+            if int(declared) > limit:
+                raise _Refused(413, f"request: larger than {limit // 2**20} MiB")
+        except ValueError:
+            raise _Refused(400, "request: bad Content-Length") from None
+    chunks, size = [], 0
+    try:
+        with anyio.fail_after(timeout):
+            async for chunk in request.stream():
+                size += len(chunk)
+                if size > limit:
+                    raise _Refused(413, f"request: larger than {limit // 2**20} MiB")
+                chunks.append(chunk)
+    except TimeoutError:
+        raise _Refused(408, f"request: body not received within {timeout:g} s") from None
+    return b"".join(chunks)
+
+
+def _run(handler: Callable[[dict[str, Any]], dict[str, Any]], raw: bytes | None,
+         path: str) -> tuple[int, bytes]:
+    """Parse, handle and render one request (in a worker thread)."""
+    try:
+        body = {} if raw is None else check_json(raw)
+        return 200, _render(handler(body))
+    except BusyError as exc:
+        return 503, _render({"error": str(exc)})
+    except TautError as exc:
+        return 422, _render({"error": str(exc)})
+    except Exception as exc:               # a bug: log it here, one line to the page
+        log.exception("internal error in %s", path)
+        return 500, _render({"error": f"internal error ({exc.__class__.__name__}); the "
+                                      "server log has the details"})
+
+
+class _Worker:
+    """Runs handlers in a thread pool of ``workers`` threads, each within ``budget_s``."""
+
+    def __init__(self, workers: int, budget_s: float) -> None:
+        self.limiter = anyio.CapacityLimiter(workers)
+        self.budget_s = budget_s
+
+    def endpoint(self, handler: Callable[[dict[str, Any]], dict[str, Any]], *,
+                 post: bool = True) -> Callable[[Request], Any]:
+        async def route(request: Request) -> Response:
             try:
-                body = json.loads(raw or b"{}")
-            except (ValueError, UnicodeDecodeError):
-                raise InvalidInputError("request", "is not valid JSON") from None
-            if not isinstance(body, dict):
-                raise InvalidInputError("request", "must be a JSON object")
-            return _JSON(handler(body))
-        except TautError as exc:
-            return _JSON({"error": str(exc)}, status_code=422)
-        except Exception as exc:               # a bug: log it here, one line to the page
-            log.exception("internal error in %s", request.url.path)
-            return _JSON({"error": f"internal error ({exc.__class__.__name__}); the "
-                                   "server log has the details"}, status_code=500)
-    return route
+                raw = None
+                if post:
+                    kind = request.headers.get("content-type", "").split(";")[0]
+                    if kind.strip().lower() != "application/json":
+                        raise _Refused(415, "Content-Type: must be application/json")
+                    raw = await _read_body(request, MAX_BODY, BODY_TIMEOUT_S)
+                with anyio.fail_after(self.budget_s):
+                    status, data = await anyio.to_thread.run_sync(
+                        _run, handler, raw, request.url.path, abandon_on_cancel=True,
+                        limiter=self.limiter)
+                return Response(data, status_code=status, media_type="application/json")
+            except _Refused as exc:
+                return _error(exc.status, exc.line)
+            except TimeoutError:
+                return _error(503, f"request: took longer than its {self.budget_s:g} s "
+                                   "budget; try a smaller input")
+        return route
 
 
 def create_app(initial: dict[str, Any] | None = None, *,
-               catalog: Catalog | None = None) -> Starlette:
+               catalog: Catalog | None = None, token: str | None = None,
+               hosts: tuple[str, ...] = (), workers: int | None = None,
+               budget_s: float = BUDGET_S, max_jobs: int | None = None) -> Starlette:
     """The Starlette application.
 
     Parameters
@@ -91,11 +241,26 @@ def create_app(initial: dict[str, Any] | None = None, *,
         chosen by its keys (:func:`taut.app.payload.kind_of_mapping`).
     catalog : Catalog, optional
         Where bundled examples come from (default: the source checkout's ``examples/``).
+    token : str, optional
+        The secret every ``/api/`` request must carry; default :func:`new_token`. The app
+        keeps it in ``app.state.token``.
+    hosts : tuple of str
+        Host names accepted besides :data:`LOOPBACK_HOSTS` (the ``--host`` served on).
+    workers : int, optional
+        Threads running requests at once (default: the machine's cores, at least 2).
+    budget_s : float
+        Time budget of one request, s.
+    max_jobs : int, optional
+        Planning jobs queued or running at once (default
+        :data:`taut.app.plan_api.MAX_JOBS`); more get HTTP 503 "busy".
     """
     catalog = catalog or Catalog()
-    sheet, planner, cdpr = SheetAPI(catalog), PlanAPI(catalog), CdprAPI(catalog)
+    token = token or new_token()
+    sheet, cdpr = SheetAPI(catalog), CdprAPI(catalog)
+    planner = PlanAPI(catalog) if max_jobs is None else PlanAPI(catalog, max_jobs=max_jobs)
     start = None if initial is None else {"kind": kind_of_mapping(initial), "mapping": initial}
     page = static_dir() / "index.html"
+    worker = _Worker(workers or max(2, os.cpu_count() or 2), float(budget_s))
 
     async def index(request: Request) -> Response:
         return FileResponse(page, headers={"Cache-Control": "no-store"})
@@ -107,7 +272,8 @@ def create_app(initial: dict[str, Any] | None = None, *,
         return _JSON({"initial": start})
 
     async def get_job(request: Request) -> Response:
-        return await _endpoint(lambda _: planner.job(request.path_params["jid"]))(request)
+        jid = request.path_params["jid"]
+        return await worker.endpoint(lambda _: planner.job(jid), post=False)(request)
 
     routes: list[BaseRoute] = [Route("/", index), Route("/api/catalog", get_catalog),
               Route("/api/initial", get_initial),
@@ -116,16 +282,31 @@ def create_app(initial: dict[str, Any] | None = None, *,
                                ("plan", planner, ("load", "run", "yaml")),
                                ("cdpr", cdpr, ("load", "state", "workspace", "yaml"))):
         for action in actions:
-            routes.append(Route(f"/api/{view}/{action}", _endpoint(getattr(api, action)),
-                                methods=["POST"]))
+            routes.append(Route(f"/api/{view}/{action}",
+                                worker.endpoint(getattr(api, action)), methods=["POST"]))
     routes.append(Mount("/static", StaticFiles(directory=str(static_dir())), name="static"))
+
+    async def http_error(request: Request, exc: Exception) -> Response:
+        code = getattr(exc, "status_code", 500)
+        if code == 404:
+            line = f"path: no page or endpoint {request.url.path[:200]!r}"
+        elif code == 405:
+            line = f"method: {request.method} is not allowed on {request.url.path[:200]!r}"
+        else:
+            line = f"request: {getattr(exc, 'detail', 'refused')}"
+        return _error(code, line)
 
     @contextlib.asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
         yield
         planner.close()
 
-    return Starlette(routes=routes, lifespan=lifespan)
+    app = Starlette(routes=routes, lifespan=lifespan,
+                    exception_handlers={HTTPException: http_error})
+    app.state.token = token
+    allowed = tuple(dict.fromkeys(LOOPBACK_HOSTS + tuple(h.lower() for h in hosts)))
+    app.add_middleware(_Guard, token=token, hosts=allowed)
+    return app
 
 
 def bind(host: str, port: int) -> socket.socket:
@@ -157,9 +338,13 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
-def serve(sock: socket.socket, app: Starlette, *, log_level: str = "warning") -> None:
-    """Serve ``app`` on an already bound socket until interrupted (uvicorn)."""
+def serve(sock: socket.socket, app: Starlette, *, log_level: str = "critical") -> None:
+    """Serve ``app`` on an already bound socket until interrupted (uvicorn; at most 2 s
+    of graceful shutdown after Ctrl-C). uvicorn's own log is off by default: the app
+    logs its errors itself (logger ``taut.app``), and a request cut short by Ctrl-C is
+    not one."""
     import uvicorn
 
-    config = uvicorn.Config(app, log_level=log_level, access_log=False, lifespan="on")
+    config = uvicorn.Config(app, log_level=log_level, access_log=False, lifespan="on",
+                            timeout_graceful_shutdown=2, server_header=False)
     uvicorn.Server(config).run(sockets=[sock])

@@ -23,7 +23,7 @@ from ..io.serialize import equilibrium_to_dict
 from ..sheet import Sheet, SheetTeam, forward_kinematics, inverse_kinematics
 from ..sheet import simulate
 from .catalog import Catalog, regular_team
-from .payload import ModelCache, field, mapping_from_upload
+from .payload import ModelCache, field, mapping_from_upload, numbers
 
 __all__ = ["SheetAPI"]
 
@@ -60,7 +60,7 @@ def scenario_mapping(sc: SheetScenario) -> dict[str, Any]:
 
 
 def _sheet(vertices: Any) -> Sheet:
-    return Sheet(np.asarray(vertices, dtype=float) if isinstance(vertices, list) else vertices)
+    return Sheet(numbers(vertices, "sheet", 2))
 
 
 class SheetAPI:
@@ -87,7 +87,9 @@ class SheetAPI:
         return {"scenario": scenario_mapping(sheet_scenario_from_mapping(data))}
 
     def _team(self, body: dict[str, Any]) -> SheetTeam:
-        sheet = self.sheets.get(field(body, "sheet", list))
+        vertices = field(body, "sheet", list)
+        numbers(vertices, "sheet", 2)             # checked before it becomes a cache key
+        sheet = self.sheets.get(vertices)
         hold = field(body, "hold_height", (int, float))
         mass = field(body, "mass", (int, float), default=None)
         return SheetTeam(sheet, float(hold), None if mass is None else float(mass))
@@ -96,7 +98,7 @@ class SheetAPI:
         """Every equilibrium of ``formation``; an infeasible formation is an answer
         (``feasible: false`` with the pair), not an error."""
         team = self._team(body)
-        formation = field(body, "formation", list)
+        formation = numbers(field(body, "formation", list), "formation", 2)
         t0 = time.perf_counter()
         try:
             res = forward_kinematics(team, formation)
@@ -113,8 +115,10 @@ class SheetAPI:
     def ik(self, body: dict[str, Any]) -> dict[str, Any]:
         """Formation holding the object stably at ``target`` ([x, y, z]) with every cable
         taut, staying close to ``reference`` (the current formation) when given."""
-        res = inverse_kinematics(self._team(body), field(body, "target", list),
-                                 reference=field(body, "reference", list, default=None))
+        ref = field(body, "reference", list, default=None)
+        res = inverse_kinematics(self._team(body),
+                                 numbers(field(body, "target", list), "target", 1),
+                                 reference=None if ref is None else numbers(ref, "reference", 2))
         return {"ik": ik_to_dict(res)}
 
     def simulate(self, body: dict[str, Any]) -> dict[str, Any]:
@@ -123,7 +127,9 @@ class SheetAPI:
         formations = field(body, "formations", list)
         if len(formations) > 20000:
             raise InvalidInputError("formations", "at most 20000 steps")
-        res = simulate(team, formations, start=field(body, "start", list, default=None))
+        start = field(body, "start", list, default=None)
+        res = simulate(team, numbers(formations, "formations", 3),
+                       start=None if start is None else numbers(start, "start", 1))
         return {"simulation": simulation_to_dict(res, np.arange(len(res), dtype=float))}
 
     def yaml(self, body: dict[str, Any]) -> dict[str, Any]:

@@ -18,8 +18,12 @@ Commands import their solvers when they run, so ``taut --help`` loads no scipy.
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
+import threading
 import warnings
+from typing import Any
 
 import typer
 from typer.exceptions import TyperException
@@ -69,6 +73,67 @@ webapp.register(app)
 
 EXIT_NO = 1
 EXIT_USAGE = 2
+#: Exit code after Ctrl-C (128 + SIGINT, the shell's convention).
+EXIT_INTERRUPTED = 130
+
+#: Set by the Ctrl-C handler: checked when the command returns, so an interrupt that
+#: library code swallowed (numba turns it into a SystemError inside a kernel call) still
+#: ends the command as interrupted.
+_interrupt = threading.Event()
+
+
+def _on_sigint(signum: int, frame: Any) -> None:
+    """First Ctrl-C: note it and raise KeyboardInterrupt at the next Python step (between
+    kernel calls); a second one: leave at once.
+
+    Python ignores (prints and drops) an exception raised inside a finalizer, which numba
+    and llvmlite run while compiling; there the interrupt is raised again 50 ms later
+    (SIGALRM), outside it."""
+    if signum == signal.SIGINT and _interrupt.is_set():
+        os.write(2, b"taut: interrupted\n")
+        os._exit(EXIT_INTERRUPTED)
+    _interrupt.set()
+    depth = 0
+    while frame is not None and depth < 64:
+        if frame.f_code.co_name == "__del__" and hasattr(signal, "setitimer"):
+            signal.setitimer(signal.ITIMER_REAL, 0.05)
+            return
+        frame, depth = frame.f_back, depth + 1
+    raise KeyboardInterrupt
+
+
+def _interrupted(exc: BaseException | None) -> bool:
+    """Whether a KeyboardInterrupt is in the exception's cause/context chain."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+#: Top-level modules of the optional extras -> the extra that installs them.
+EXTRAS = {"mujoco": "physics", "dask": "sweep", "distributed": "sweep", "pyarrow": "sweep",
+          "starlette": "app", "uvicorn": "app", "ompl": "plan-ompl",
+          "selenium": "app-test"}
+
+
+def _missing_extra(exc: ModuleNotFoundError) -> str | None:
+    """The one line for an optional dependency that is not installed, else None."""
+    top = (exc.name or "").split(".")[0]
+    extra = EXTRAS.get(top)
+    if extra is None:
+        return None
+    return f"{top}: not installed; install taut[{extra}] (pip install 'taut[{extra}]')"
+
+
+def _stopped() -> int:
+    try:
+        print("taut: interrupted", file=sys.stderr)
+    except (OSError, ValueError):
+        pass
+    return EXIT_INTERRUPTED
 
 
 def _fail(message: str) -> int:
@@ -104,12 +169,32 @@ def main(argv: list[str] | None = None) -> int:
     Numeric warnings of numpy (overflow, invalid values) never reach the terminal: inputs
     are range-checked before any solver runs (:mod:`taut._validate`), and what remains
     inside a solver is its own business (it reports NaN/None, never a silent wrong answer).
+
+    Ctrl-C ends any command with exit code 130 and the one line ``taut: interrupted``
+    (whatever was running: a numba kernel's interrupt surfaces between kernel calls);
+    files a command writes are written whole or not at all.
     """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        import numpy as np
-        with np.errstate(all="ignore"):
-            return _run(argv)
+    _interrupt.clear()
+    from ._paths import set_command_line
+    set_command_line(sys.argv[1:] if argv is None else list(argv))
+    installed = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _on_sigint) if installed else None
+    alarm = (signal.signal(signal.SIGALRM, _on_sigint)
+             if installed and hasattr(signal, "SIGALRM") else None)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            import numpy as np
+            with np.errstate(all="ignore"):
+                code = _run(argv)
+        return _stopped() if _interrupt.is_set() else code
+    except KeyboardInterrupt:
+        return _stopped()
+    finally:
+        if installed:
+            signal.signal(signal.SIGINT, previous)
+            if alarm is not None:
+                signal.signal(signal.SIGALRM, alarm)
 
 
 def _run(argv: list[str] | None) -> int:
@@ -117,8 +202,10 @@ def _run(argv: list[str] | None) -> int:
         result = app(args=argv, prog_name="taut", standalone_mode=False)
     except TautError as exc:
         return _fail(str(exc))
-    except typer.Abort:
-        return _fail("aborted")
+    except KeyboardInterrupt:
+        return _stopped()
+    except typer.Abort as exc:
+        return _stopped() if _interrupted(exc) else _fail("aborted")
     except typer.Exit as exc:
         return int(getattr(exc, "exit_code", 0) or 0)
     except TyperException as exc:
@@ -136,6 +223,15 @@ def _run(argv: list[str] | None) -> int:
         return _fail(f"{where}: {exc.strerror or exc}")
     except MemoryError:
         return _fail("input: too large to fit in memory")
+    except ModuleNotFoundError as exc:           # an optional extra that is not installed
+        line = _missing_extra(exc)
+        if line is None:
+            raise
+        return _fail(line)
+    except SystemError as exc:                   # numba: a kernel interrupted by Ctrl-C
+        if _interrupted(exc) or _interrupt.is_set():
+            return _stopped()
+        raise
     return int(result) if isinstance(result, int) else 0
 
 

@@ -7,8 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._validate import MAX_CDPR_LENGTH_M, MAX_MASS_KG, MAX_SPEED, check_range
-from ..errors import InvalidModelError
+from .._validate import MAX_CDPR_LENGTH_M, MAX_SPEED, check_range
 
 if TYPE_CHECKING:
     from ..cdpr.model.robot import CableRobot
@@ -25,19 +24,13 @@ MODEL_HELP = "Preset name (fastkit, ipanema) or model file (YAML/JSON)."
 def load_robot(model: str, stabilisers: bool) -> CableRobot:
     """A preset or model file, with the stabilisers of its mobile bases deployed if asked.
 
-    Masses above ``MAX_MASS_KG`` and frames farther than ``MAX_CDPR_LENGTH_M`` are rejected
-    (see :mod:`taut._validate`; the model itself rejects tension limits above
-    ``MAX_TENSION_N``)."""
+    Masses above ``MAX_MASS_KG`` and points farther than ``MAX_CDPR_LENGTH_M`` are rejected
+    by the loader itself (:func:`taut.io.cdpr_model.physical_ranges`), so the app and
+    the library accept the same files as the CLI."""
     from ..cdpr import with_stabilisers
     from ..io.cdpr_model import load_cdpr_model
 
-    robot = load_cdpr_model(model)              # tension limits: checked by the model
-    total = robot.platform.mass + robot.payload.mass
-    if total > MAX_MASS_KG:
-        raise InvalidModelError("payload.mass", f"platform + payload {total:g} kg exceeds "
-                                f"the accepted range {MAX_MASS_KG:g} kg")
-    if robot.bounds is not None:
-        check_range(robot.bounds, "bounds", MAX_CDPR_LENGTH_M, "m")
+    robot = load_cdpr_model(model)
     return with_stabilisers(robot) if stabilisers else robot
 
 

@@ -2,17 +2,24 @@
 
 Every ``--plot``, ``--animate``, ``--out`` (and any other file the CLI writes) goes through
 :func:`output_path`, so a mistake in a path costs the user one line and exit code 2 instead
-of a finished computation followed by a traceback.
+of a finished computation followed by a traceback, and an output that is (or resolves to,
+through ``..``, a symbolic or a hard link) one of the command's input files is refused
+before any work: ``taut plan sc.json --out sc.json`` would otherwise replace the scenario
+with the plan. The command's files are the existing files named on its command line
+(:func:`set_command_line`, called by :func:`taut.cli.main`); files are compared by device
+and inode, so two spellings of one file are one file.
 """
 
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 from ..errors import InvalidInputError
 
-__all__ = ["output_path", "FIGURE_SUFFIXES", "ANIMATION_SUFFIXES", "JSON_SUFFIXES"]
+__all__ = ["output_path", "set_command_line", "FIGURE_SUFFIXES", "ANIMATION_SUFFIXES",
+           "JSON_SUFFIXES"]
 
 #: Formats matplotlib writes with its default (Agg) backends.
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
@@ -20,6 +27,34 @@ FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
 ANIMATION_SUFFIXES = (".gif",)
 #: Machine-readable output files.
 JSON_SUFFIXES = (".json",)
+
+#: The words of the running command's line (set by :func:`set_command_line`).
+_ARGV: list[str] = []
+
+
+def set_command_line(argv: list[str]) -> None:
+    """Remember the command line whose files :func:`output_path` protects."""
+    _ARGV[:] = [str(a) for a in argv]
+
+
+def _identity(text: str) -> tuple[int, int] | None:
+    """(device, inode) of an existing regular file, else None."""
+    try:
+        st = os.stat(text)
+    except (OSError, ValueError):
+        return None
+    return (st.st_dev, st.st_ino) if stat.S_ISREG(st.st_mode) else None
+
+
+def _named_files() -> list[tuple[int, int]]:
+    """Identities of the existing files named on the command line (``--opt=FILE`` too)."""
+    out = []
+    for word in _ARGV:
+        for text in {word, word.split("=", 1)[-1]} if word.startswith("-") else {word}:
+            ident = _identity(text)
+            if ident is not None:
+                out.append(ident)
+    return out
 
 
 def output_path(value: str | os.PathLike[str] | None, field: str,
@@ -44,7 +79,8 @@ def output_path(value: str | os.PathLike[str] | None, field: str,
     ------
     InvalidInputError
         An empty name, a name without or with an unsupported extension, an existing
-        directory, a parent that is not a directory, or a directory that is not writable.
+        directory, a parent that is not a directory, a directory that is not writable,
+        or a file that is also one of the command's inputs.
 
     Examples
     --------
@@ -79,6 +115,11 @@ def output_path(value: str | os.PathLike[str] | None, field: str,
         raise InvalidInputError(field, f"{str(ancestor)!r} is not a directory")
     if path.exists() and not os.access(path, os.W_OK):
         raise InvalidInputError(field, f"{text!r} exists and is not writable")
+    ident = _identity(text)
+    if ident is not None and _named_files().count(ident) > 1:
+        raise InvalidInputError(field, f"{text!r} is also an input of this command; "
+                                       "writing it would destroy that input (choose "
+                                       "another file)")
     _probe(path, field)
     return path
 

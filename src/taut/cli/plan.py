@@ -94,7 +94,8 @@ def plan_command(
             rob = monte_carlo(result, replays)
         doc["robustness"] = robustness_to_dict(rob)
     if out is not None:
-        out.write_text(to_json(doc, indent=None) + "\n", encoding="utf-8")
+        from ..io.files import write_text_atomic
+        write_text_atomic(out, to_json(doc, indent=None) + "\n")
     if result.success and (plot is not None or animate is not None):
         from ..viz.plan import animate_plan, plot_plan
         if plot is not None:

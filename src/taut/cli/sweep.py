@@ -101,6 +101,8 @@ def run_command(
     with _Reporter() as report:
         result = run_sweep(sweep, out, workers=workers, scheduler=scheduler, resume=resume,
                            limit=limit, progress=report)
+    if result.status == "interrupted" and result.message.startswith("interrupted"):
+        raise KeyboardInterrupt             # Ctrl-C: the one line `taut: interrupted`
     if not result.success:
         print(f"taut: sweep: {result.message}", file=sys.stderr)
         return 1

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import sys
+import threading
 import webbrowser
 from pathlib import Path
 from typing import Optional
@@ -19,7 +22,7 @@ def _validated(path: Path) -> dict:
     from ..io import (cdpr_model_from_mapping, plan_scenario_from_mapping, read_mapping,
                       sheet_scenario_from_mapping)
 
-    data = read_mapping(path)
+    data = read_mapping(path)          # size limit and alias bombs refused here
     load = {"sheet": sheet_scenario_from_mapping, "plan": plan_scenario_from_mapping,
             "cdpr": cdpr_model_from_mapping}[kind_of_mapping(data)]
     load(data)
@@ -35,7 +38,8 @@ def app_command(
     open_browser: bool = typer.Option(False, "--open", help="Open the page in a browser."),
 ) -> int:
     """Serve an interactive web app: drag robots and watch the object, run and replay
-    plans, move a cable robot's platform. Stop with Ctrl+C."""
+    plans, move a cable robot's platform. The URL printed carries a per-launch secret
+    token; requests without it are refused. Stop with Ctrl+C."""
     if not 0 <= port <= 65535:
         raise InvalidInputError("--port", f"must be between 0 and 65535, got {port}")
     try:
@@ -44,11 +48,11 @@ def app_command(
         raise InvalidInputError("taut app", "needs the app extra: pip install 'taut[app]' "
                                 f"({exc.name} is missing)") from None
     initial = _validated(scenario) if scenario is not None else None
-    app = create_app(initial)
+    app = create_app(initial, hosts=(host,))
     sock = bind(host, port)
     bound = sock.getsockname()[1]
     shown = f"[{host}]" if ":" in host else host
-    url = f"http://{shown}:{bound}/"
+    url = f"http://{shown}:{bound}/?token={app.state.token}"
     typer.echo(f"taut app: serving on {url}  (Ctrl+C to stop)")
     if open_browser:
         webbrowser.open(url)
@@ -58,6 +62,13 @@ def app_command(
         pass
     finally:
         sock.close()
+    if any(t.is_alive() and not t.daemon for t in threading.enumerate()
+           if t is not threading.main_thread()):
+        # A request or planning job still computing (numerical code cannot be stopped
+        # midway): leave now rather than wait for it after the user pressed Ctrl+C.
+        sys.stdout.flush()
+        print("taut: interrupted", file=sys.stderr, flush=True)
+        os._exit(130)
     return 0
 
 

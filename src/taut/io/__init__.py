@@ -1,9 +1,12 @@
 """Scenario and model files: load, validate, save. Solvers never import this package.
 
 Files
-    :func:`read_mapping` parses a YAML or JSON file whose top level is a mapping,
-    :func:`read_text` reads one, :func:`validate_mapping` checks a parsed mapping against a
-    pydantic model (errors naming the dotted key), :func:`write_json` writes JSON.
+    :func:`read_mapping` parses a YAML or JSON file whose top level is a mapping
+    (:func:`parse_mapping` the same from text; files over :data:`MAX_FILE_BYTES` and
+    alias bombs over :data:`MAX_YAML_VALUES` values refused), :func:`read_text` reads
+    one, :func:`validate_mapping` checks a parsed mapping against a pydantic model
+    (errors naming the dotted key), :func:`write_json` writes JSON and
+    :func:`write_text_atomic` any text (temporary file, then rename).
 Sheet scenarios
     :func:`load_sheet_scenario` and :func:`sheet_scenario_from_mapping` build a
     :class:`SheetScenario` (the team, its formation, the length unit).
@@ -32,7 +35,8 @@ from .._lazy import lazy_names
 
 if TYPE_CHECKING:                   # the real names, for type checkers
     from .cdpr_model import cdpr_model_from_mapping, load_cdpr_model
-    from .files import read_mapping, read_text, validate_mapping, write_json
+    from .files import (MAX_FILE_BYTES, MAX_YAML_VALUES, parse_mapping, read_mapping,
+                        read_text, validate_mapping, write_json, write_text_atomic)
     from .plan_scenario import (load_plan_scenario, plan_scenario_from_mapping,
                                 plan_scenario_to_mapping)
     from .sheet_scenario import SheetScenario, load_sheet_scenario, sheet_scenario_from_mapping
@@ -40,7 +44,8 @@ if TYPE_CHECKING:                   # the real names, for type checkers
 _HOME = {
     "cdpr_model_from_mapping": "cdpr_model", "load_cdpr_model": "cdpr_model",
     "read_mapping": "files", "read_text": "files", "validate_mapping": "files",
-    "write_json": "files",
+    "write_json": "files", "parse_mapping": "files", "write_text_atomic": "files",
+    "MAX_FILE_BYTES": "files", "MAX_YAML_VALUES": "files",
     "load_plan_scenario": "plan_scenario", "plan_scenario_from_mapping": "plan_scenario",
     "plan_scenario_to_mapping": "plan_scenario",
     "SheetScenario": "sheet_scenario", "load_sheet_scenario": "sheet_scenario",
@@ -49,7 +54,8 @@ _HOME = {
 
 __all__ = [
     # files
-    "read_mapping", "read_text", "validate_mapping", "write_json",
+    "read_mapping", "read_text", "parse_mapping", "validate_mapping", "write_json",
+    "write_text_atomic", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
     # sheet scenarios
     "load_sheet_scenario", "sheet_scenario_from_mapping", "SheetScenario",
     # plan scenarios

@@ -8,7 +8,8 @@ Top-level keys (unknown keys are errors; SI units):
 ``com`` [x, y, z], ``footprint`` [[x, y], ...], optional ``stabilisers``
 {``footprint``: [[x, y], ...], ``deployed``: bool}),
 ``platform`` (``mass``, ``com``, ``inertia`` (3 numbers or 3x3), ``attachment_points``
-{name: [x, y, z]}), ``payload`` (``mass``, ``com``), ``cables`` (list; each ``name``,
+{name: [x, y, z]}), ``payload`` (``mass`` kg, ``com`` m, optional ``inertia`` kg m^2 about
+its centre of mass, 3 numbers or 3x3, default a point mass), ``cables`` (list; each ``name``,
 ``exit`` "base.point", ``attachment``, ``t_min``, ``t_max``), optional ``bounds`` and
 ``desired_workspace`` ({``min``: [x, y, z], ``max``: [x, y, z]}), optional
 ``platform_inside_exits`` (bool, default false: the platform must stay inside the exits'
@@ -21,7 +22,7 @@ from __future__ import annotations
 
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -29,7 +30,7 @@ from .._units import GRAVITY
 from ..cdpr.model.robot import Base, Cable, CableRobot, Payload, Platform
 from ..errors import InvalidModelError, ScenarioError, TautError
 from .files import read_mapping, validate_mapping
-from .._validate import as_path
+from .._validate import MAX_CDPR_LENGTH_M, MAX_MASS_KG, as_path, check_range
 
 __all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
 
@@ -70,6 +71,7 @@ class _Platform(_Strict):
 class _Payload(_Strict):
     mass: float = 0.0
     com: Vec3 = (0.0, 0.0, 0.0)
+    inertia: Vec3 | tuple[Vec3, Vec3, Vec3] = (0.0, 0.0, 0.0)
 
 
 class _Cable(_Strict):
@@ -95,8 +97,9 @@ class _ModelFile(_Strict):
     bounds: _Box | None = None
     desired_workspace: _Box | None = None
     platform_inside_exits: bool = False
-    # Elastic cables and winches, read by taut.io.cdpr_dynamics (validated there).
-    dynamics: dict[str, Any] | None = None
+    # Elastic cables and winches, read by taut.io.cdpr_dynamics (key names and ranges
+    # validated there); here already a flat mapping of numbers, never free-form data.
+    dynamics: dict[str, Optional[float]] | None = None
 
 
 def _file_field(exc: TautError, raw: _ModelFile) -> str:
@@ -145,7 +148,7 @@ def cdpr_model_from_mapping(data: dict[str, Any]) -> CableRobot:
             platform=Platform(attachment_points=p.attachment_points, mass=p.mass, com=p.com,
                               inertia=p.inertia),
             cables=tuple(cables),
-            payload=Payload(raw.payload.mass, raw.payload.com),
+            payload=Payload(raw.payload.mass, raw.payload.com, raw.payload.inertia),
             gravity=raw.gravity,
             bounds=None if raw.bounds is None else (raw.bounds.min, raw.bounds.max),
             desired_workspace=(None if raw.desired_workspace is None else
@@ -155,6 +158,36 @@ def cdpr_model_from_mapping(data: dict[str, Any]) -> CableRobot:
         raise InvalidModelError(_file_field(exc, raw), exc.problem) from None
     except TautError as exc:
         raise InvalidModelError(_file_field(exc, raw), exc.problem) from None
+    return physical_ranges(robot)
+
+
+def physical_ranges(robot: CableRobot) -> CableRobot:
+    """``robot`` if its sizes are in the ranges every front end accepts
+    (:mod:`taut._validate`): platform + payload mass at most ``MAX_MASS_KG`` kg, exit and
+    attachment points and the frame box within ``MAX_CDPR_LENGTH_M`` m of the origin
+    (tension limits are the model's own check, ``MAX_TENSION_N``). Every model loader
+    applies it, so the CLI, the app and the library accept the same files.
+
+    Raises
+    ------
+    InvalidModelError
+        The field out of range (``payload.mass``, ``bases``, ``platform``, ``bounds``).
+    """
+    total = float(robot.platform.mass + robot.payload.mass)
+    if not total <= MAX_MASS_KG:
+        raise InvalidModelError("payload.mass", f"platform + payload {total:g} kg exceeds "
+                                f"the accepted range {MAX_MASS_KG:g} kg")
+    r: Any = robot                         # exits_world: set when the model is validated
+    for where, values in (("bases", r.exits_world),
+                          ("platform.attachment_points",
+                           list(robot.platform.attachment_points.values())),
+                          ("bounds", robot.bounds), ("desired_workspace",
+                                                     robot.desired_workspace)):
+        if values is not None:
+            try:
+                check_range(values, where, MAX_CDPR_LENGTH_M, "m")
+            except TautError as exc:
+                raise InvalidModelError(exc.field, exc.problem) from None
     return robot
 
 

@@ -1,14 +1,26 @@
 """Reading YAML/JSON files into plain mappings, and pydantic validation with errors that
-name the offending field. Every loader in :mod:`taut.io` goes through these two functions.
+name the offending field. Every loader in :mod:`taut.io` (and the sweep file, and the
+app's uploads) goes through these functions.
 
 Two silent conversions are refused: a key given twice in one mapping (YAML and JSON
 parsers keep the last value) and a boolean where a number is expected (pydantic's lax
 mode reads ``hold_height: true`` as 1).
+
+Files that could exhaust the machine are refused in one line before any work: a file
+larger than :data:`MAX_FILE_BYTES`, and a YAML document whose aliases (``*name``) would
+add more than :data:`MAX_YAML_VALUES` values to it (an "alias bomb": a few kB that
+expand to billions of values). The expansion is counted on the parsed node graph (each
+anchored node once), so a bomb is refused in milliseconds.
+
+:func:`write_text_atomic` is how every command writes a file: a temporary file in the
+same folder, renamed over the target, so an interrupted command never leaves half a file.
 """
 
 from __future__ import annotations
 
 import json
+import os
+import tempfile
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -18,9 +30,20 @@ from pydantic import BaseModel, ValidationError
 from ..errors import InvalidInputError, ScenarioError
 from .._validate import as_path, require_instance
 
-__all__ = ["read_text", "read_mapping", "validate_mapping", "write_json"]
+__all__ = ["read_text", "read_mapping", "parse_mapping", "validate_mapping", "write_json",
+           "write_text_atomic", "MAX_FILE_BYTES", "MAX_YAML_VALUES"]
 
 M = TypeVar("M", bound=BaseModel)
+
+#: Largest input file read, bytes (scenarios, models, sweeps, trajectories: a few kB to a
+#: few MB in practice).
+MAX_FILE_BYTES = 32 * 2**20
+#: Most values (scalars, lists, mappings) aliases may add to a YAML document (an alias
+#: repeats its anchored value; a file without aliases is limited by its size alone).
+MAX_YAML_VALUES = 100_000
+
+_UMASK = os.umask(0o022)          # read once at import (os.umask is not thread safe)
+os.umask(_UMASK)
 
 
 def read_text(path: str | Path) -> str:
@@ -31,13 +54,21 @@ def read_text(path: str | Path) -> str:
     if not p.is_file():
         raise ScenarioError(str(path), "file not found")
     try:
+        size = p.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError(str(path), f"file is {size / 2**20:.0f} MiB; at most "
+                                           f"{MAX_FILE_BYTES // 2**20} MiB are read")
         return p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(str(path), f"cannot read file ({exc.__class__.__name__})") from None
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing a key that appears twice in one mapping."""
+_SafeBase: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class _UniqueKeyLoader(_SafeBase):
+    """PyYAML's safe loader (libyaml's parser when present), refusing a key that appears
+    twice in one mapping."""
 
 
 def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode,
@@ -65,23 +96,93 @@ def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def read_mapping(path: str | Path) -> dict[str, Any]:
-    """Parse a ``.yaml``/``.yml``/``.json`` file whose top level is a mapping.
+_HUGE = 2**62
+
+
+def _alias_values(root: yaml.Node) -> int:
+    """How many values aliases add: the size of the node graph with every alias expanded
+    minus its distinct nodes (each node's size computed once, iteratively: linear in the
+    number of distinct nodes)."""
+    sizes: dict[int, int] = {}
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    on_stack: set[int] = set()
+    while stack:
+        node, done = stack.pop()
+        if id(node) in sizes:
+            continue
+        if isinstance(node, yaml.ScalarNode):
+            sizes[id(node)] = 1
+            continue
+        children = ([c for pair in node.value for c in pair]
+                    if isinstance(node, yaml.MappingNode) else list(node.value))
+        if done:
+            sizes[id(node)] = min(1 + sum(sizes.get(id(c), 1) for c in children), _HUGE)
+            on_stack.discard(id(node))
+            continue
+        if id(node) in on_stack:          # a recursive alias: its own ancestor
+            sizes[id(node)] = _HUGE
+            continue
+        on_stack.add(id(node))
+        stack.append((node, True))
+        stack.extend((c, False) for c in children if id(c) not in sizes)
+    return sizes[id(root)] - len(sizes)
+
+
+def _load_yaml(text: str, source: str) -> Any:
+    loader = _UniqueKeyLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        if _alias_values(node) > MAX_YAML_VALUES:
+            raise ScenarioError(source, f"YAML aliases add more than {MAX_YAML_VALUES:,} "
+                                        "values (an alias bomb?)")
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
+def parse_mapping(text: str, source: str, *, suffix: str = ".yaml") -> dict[str, Any]:
+    """Parse file text whose top level is a mapping, as :func:`read_mapping` does.
+
+    Parameters
+    ----------
+    text : str
+        The file's text (at most :data:`MAX_FILE_BYTES` bytes of UTF-8).
+    source : str
+        The name errors give as their field (a path or an upload's name).
+    suffix : str
+        ``".json"`` parses JSON; anything else YAML (JSON is YAML too).
 
     Raises
     ------
     ScenarioError
-        Missing or unreadable file, a syntax error, a key given twice, or a top level that
-        is not a mapping.
+        Too large, a syntax error, an alias bomb, a key given twice, text that is not
+        valid Unicode, or a top level that is not a mapping.
+
+    Examples
+    --------
+    >>> parse_mapping("a: 1", "x.yaml")
+    {'a': 1}
+    >>> parse_mapping("a: &x [1, 2]\\nb: *x", "x.yaml")
+    {'a': [1, 2], 'b': [1, 2]}
     """
-    path = as_path(path)
-    p = Path(path)
-    text = read_text(p)
+    require_instance(text, str, "text")
+    require_instance(source, str, "source")
+    require_instance(suffix, str, "suffix")
     try:
-        if p.suffix.lower() == ".json":
+        size = len(text.encode("utf-8"))
+    except UnicodeEncodeError:
+        raise ScenarioError(source, "text is not valid Unicode (a lone surrogate)") from None
+    if size > MAX_FILE_BYTES:
+        raise ScenarioError(source, f"file is {size / 2**20:.0f} MiB; at most "
+                                    f"{MAX_FILE_BYTES // 2**20} MiB are read")
+    path = source
+    try:
+        if suffix.lower() == ".json":
             data = json.loads(text, object_pairs_hook=_unique_pairs)
         else:
-            data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader)
+            data = _load_yaml(text, source)
     except json.JSONDecodeError as exc:
         raise ScenarioError(str(path), f"invalid JSON at line {exc.lineno}: {exc.msg}") from None
     except RecursionError:
@@ -93,6 +194,20 @@ def read_mapping(path: str | Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise ScenarioError(str(path), "top level must be a mapping of keys to values")
     return data
+
+
+def read_mapping(path: str | Path) -> dict[str, Any]:
+    """Parse a ``.yaml``/``.yml``/``.json`` file whose top level is a mapping.
+
+    Raises
+    ------
+    ScenarioError
+        Missing, unreadable or too large file, a syntax error, an alias bomb, a key given
+        twice, or a top level that is not a mapping (see :func:`parse_mapping`).
+    """
+    path = as_path(path)
+    p = Path(path)
+    return parse_mapping(read_text(p), str(path), suffix=p.suffix)
 
 
 def _location(loc: tuple[Any, ...]) -> str:
@@ -169,4 +284,38 @@ def write_json(obj: Any, path: str | Path) -> None:
         text = to_json(obj)
     except (TypeError, ValueError, RecursionError) as exc:
         raise InvalidInputError("obj", f"is not plain JSON data ({exc})") from None
-    Path(path).write_text(text + "\n", encoding="utf-8")
+    write_text_atomic(path, text + "\n")
+
+
+def write_text_atomic(path: str | Path, text: str | bytes) -> None:
+    """Write a file all at once: a temporary file next to ``path``, flushed, then renamed
+    over it (:func:`os.replace` is atomic on POSIX and Windows), so a reader sees the old
+    file or the new one, never half of one, and an interrupt leaves no partial file.
+
+    Raises
+    ------
+    InvalidInputError
+        ``path``: the folder cannot be written; ``text`` neither ``str`` nor ``bytes``.
+    """
+    path = Path(as_path(path))
+    require_instance(text, (str, bytes), "text")
+    data = text.encode("utf-8") if isinstance(text, str) else text
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
+                                   dir=path.parent if str(path.parent) else ".")
+    except OSError as exc:
+        raise InvalidInputError(str(path), f"cannot write ({exc.strerror or exc})") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        if path.exists():
+            try:
+                os.chmod(tmp, path.stat().st_mode & 0o7777)
+            except OSError:
+                pass
+        else:
+            os.chmod(tmp, 0o666 & ~_UMASK)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -10,6 +10,7 @@ shows it).
 from __future__ import annotations
 
 import csv
+import io
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +18,7 @@ import numpy as np
 
 from .._validate import MAX_BATCH, MAX_SHEET_LENGTH
 from ..errors import InvalidTrajectoryError
-from .files import read_text
+from .files import read_text, write_text_atomic
 
 __all__ = ["Trajectory", "load_trajectory", "parse_trajectory", "save_trajectory"]
 
@@ -141,8 +142,9 @@ def save_trajectory(path: str | Path, time: np.ndarray, formations: np.ndarray) 
     R = np.asarray(formations, dtype=float)
     n = R.shape[1]
     header = ["t"] + [f"{c}{i + 1}" for i in range(n) for c in ("x", "y")]
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        for k in range(len(t)):
-            w.writerow([repr(float(t[k]))] + [repr(float(v)) for v in R[k].ravel()])
+    fh = io.StringIO(newline="")
+    w = csv.writer(fh)
+    w.writerow(header)
+    for k in range(len(t)):
+        w.writerow([repr(float(t[k]))] + [repr(float(v)) for v in R[k].ravel()])
+    write_text_atomic(path, fh.getvalue())          # whole or not at all

@@ -17,7 +17,12 @@ outputs: [n_stable, lowest_height]  # optional subset of the task's outputs
 options: {grid: [21, 1, 9]}         # task options that are not swept
 ```
 
-Every mistake is a :class:`~taut.errors.SweepError` naming the key (``parameters.scale``).
+``options`` are checked per task (:data:`TASK_OPTIONS`): ``cdpr_workspace`` and
+``cdpr_deployment`` take ``box`` ([[xmin, ymin, zmin], [xmax, ymax, zmax]], m) and ``grid``
+(three integers nx ny nz >= 1, points per axis of the box); the other tasks take none.
+
+Every mistake is a :class:`~taut.errors.SweepError` naming the key (``parameters.scale``,
+``options.grid[0]``).
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ from typing import Any, Literal, cast
 
 import numpy as np
 
-from .._validate import as_path
+from .._validate import MAX_CDPR_LENGTH_M, as_path
 from ..errors import SweepError
 from ..io.files import read_mapping, read_text
 from .registry import TASKS
@@ -42,6 +47,15 @@ _KEYS = {"task", "base", "mode", "seed", "samples", "chunk_size", "parameters", 
 MAX_POINTS = 10**9
 #: Most values one grid axis may hold.
 MAX_AXIS = 10**7
+#: Most points of a task's workspace grid (``options.grid``), per sweep point.
+MAX_GRID_POINTS = 10**6
+
+#: Options each task accepts (name -> meaning with unit); tasks not listed take none.
+TASK_OPTIONS: dict[str, dict[str, str]] = {
+    task: {"box": "workspace box [[xmin, ymin, zmin], [xmax, ymax, zmax]], m (default: "
+                  "the model's desired workspace)",
+           "grid": "grid points per axis of the box [nx, ny, nz] (default [21, 1, 9])"}
+    for task in ("cdpr_workspace", "cdpr_deployment")}
 
 
 def _number(value: Any, field: str) -> float:
@@ -92,6 +106,45 @@ def _grid_values(value: Any, field: str) -> np.ndarray:
             raise SweepError(field, "is an empty list")
         return np.array([_number(v, f"{field}[{i}]") for i, v in enumerate(value)])
     return np.array([_number(value, field)])
+
+
+def _options(value: Any, task: str) -> dict[str, Any]:
+    """The ``options`` mapping checked against :data:`TASK_OPTIONS` (plain lists kept)."""
+    if not isinstance(value, Mapping):
+        raise SweepError("options", "must be a mapping")
+    known = TASK_OPTIONS.get(task, {})
+    for key in value:
+        if key not in known:
+            expected = (f"expected one of {', '.join(known)}" if known else
+                        f"task {task} takes no options")
+            raise SweepError(f"options.{key}", f"unknown option; {expected}")
+    out: dict[str, Any] = {}
+    if value.get("grid") is not None:
+        grid = value["grid"]
+        if not isinstance(grid, list) or len(grid) != 3:
+            raise SweepError("options.grid", "must be three integers [nx, ny, nz]")
+        counts = [_count(g, f"options.grid[{k}]", 1, MAX_GRID_POINTS)
+                  for k, g in enumerate(grid)]
+        if int(np.prod(counts)) > MAX_GRID_POINTS:
+            raise SweepError("options.grid", f"makes more than {MAX_GRID_POINTS} points")
+        out["grid"] = counts
+    if value.get("box") is not None:
+        box = value["box"]
+        if not (isinstance(box, list) and len(box) == 2
+                and all(isinstance(r, list) and len(r) == 3 for r in box)):
+            raise SweepError("options.box", "must be [[xmin, ymin, zmin], [xmax, ymax, "
+                                            "zmax]], m")
+        rows = [[_number(v, f"options.box[{i}][{k}]") for k, v in enumerate(r)]
+                for i, r in enumerate(box)]
+        for i, r in enumerate(rows):
+            for k, v in enumerate(r):
+                if abs(v) > MAX_CDPR_LENGTH_M:
+                    raise SweepError(f"options.box[{i}][{k}]", f"|value| {v:g} exceeds the "
+                                     f"accepted range {MAX_CDPR_LENGTH_M:g} m")
+        if any(lo > hi for lo, hi in zip(*rows)):
+            raise SweepError("options.box", "min must be <= max on every axis")
+        out["box"] = rows
+    return out
 
 
 def _parameter(name: str, value: Any, mode: str) -> Parameter:
@@ -222,9 +275,7 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".",
             raise SweepError(f"outputs[{k}]", f"unknown output {name!r} of {task}; expected "
                              f"one of {', '.join(spec_task.outputs)}")
     chunk = _count(data.get("chunk_size", 0), "chunk_size", 0, 10**7)
-    options = data.get("options", {})
-    if not isinstance(options, Mapping):
-        raise SweepError("options", "must be a mapping")
+    options = _options(data.get("options", {}), task)
     base, base_data = _base(data, task, folder)
     spec = SweepSpec(task=task, parameters=tuple(params), base=base, base_data=base_data,
                      mode=mode, samples=samples, seed=seed, chunk_size=chunk,

@@ -18,7 +18,7 @@ def read_results(folder: str | Path) -> tuple[dict[str, np.ndarray], dict[str, s
     Raises
     ------
     SweepError
-        No ``results.parquet`` in ``folder``, or pyarrow missing.
+        No ``results.parquet`` in ``folder``, a damaged one, or pyarrow missing.
     """
     path = as_path(folder, "folder") / "results.parquet"
     if not path.is_file():
@@ -28,7 +28,11 @@ def read_results(folder: str | Path) -> tuple[dict[str, np.ndarray], dict[str, s
         import pyarrow.parquet as pq
     except ImportError:  # pragma: no cover - depends on the install
         raise SweepError("sweep", "needs pyarrow: pip install 'taut[sweep]'") from None
-    table = pq.read_table(path)
+    try:
+        table = pq.read_table(path)
+    except (OSError, ValueError) as exc:        # pyarrow's ArrowInvalid is a ValueError
+        raise SweepError("folder", f"{path} is damaged ({exc.__class__.__name__}); run the "
+                         "sweep again with --resume to rebuild it") from None
     meta = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()
             if not k.startswith(b"ARROW")}
     columns = {name: np.asarray(table.column(name).to_numpy(zero_copy_only=False))

@@ -197,7 +197,13 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     total = spec.size if limit is None else min(int(limit), spec.size)
     if total < 1:
         raise SweepError("limit" if limit is not None else "parameters", "selects no points")
-    store = Store(out, spec.digest, resume=resume)
+    with Store(out, spec.digest, resume=resume) as store:
+        return _run(spec, store, limit, total, workers, scheduler, progress, t0)
+
+
+def _run(spec: SweepSpec, store: Store, limit: int | None, total: int,
+         workers: int | None, scheduler: str | None, progress: Any,
+         t0: float) -> SweepResult:
     bounds = [b for b in chunk_bounds(spec.size, chunk_size_of(spec)) if b[0] < total]
     todo = [k for k in range(len(bounds)) if not store.has(k)]
     reused = len(bounds) - len(todo)

@@ -2,14 +2,25 @@
 sweep, and the assembled ``results.parquet``.
 
 Every file is written to a temporary name and renamed into place, so a file that exists is
-complete: an interrupted run loses at most the chunks in flight, and a resumed run skips
-every chunk file present. This is the only module of :mod:`taut.sweep` that touches files.
+complete: an interrupted run loses at most the chunks in flight. Each chunk has a SHA-256
+checksum beside it (``chunk-NNNNNNN.parquet.sha256``); a resumed run skips only chunks
+whose file matches its checksum and recomputes any other (truncated, damaged, or written
+by a version without checksums).
+
+One writer per folder: a run holds ``DIR/.lock`` (naming its process, host and start
+time) from start to end, and a second run on the same folder is refused with a line
+naming the holder; a lock left by a process that no longer runs on this host is taken
+over. Every chunk write re-reads the manifest and stops if the folder has been given to
+another sweep. This is the only module of :mod:`taut.sweep` that touches files.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
+import socket
+import time
 from pathlib import Path
 from typing import Any
 
@@ -47,8 +58,29 @@ def to_table(columns: dict[str, np.ndarray]) -> Any:
 
 def _atomic_write(path: Path, write: Any) -> None:
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    write(tmp)
-    os.replace(tmp, path)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True
+    return True
 
 
 class Store:
@@ -73,9 +105,66 @@ class Store:
     def __init__(self, root: str | Path, digest: str, *, resume: bool) -> None:
         self.root = Path(root)
         self.digest = digest
+        self._locked = False
         if self.root.exists() and not self.root.is_dir():
             raise SweepError("out", f"{self.root} is a file, not a folder")
         manifest = self.root / "manifest.json"
+        self._manifest = manifest
+        self._lock()
+        try:
+            self._check_folder(manifest, digest, resume)
+        except BaseException:
+            self.close()
+            raise
+
+    # --- the lock -----------------------------------------------------------------
+    def _lock(self) -> None:
+        """Take ``DIR/.lock`` (see the module docstring)."""
+        try:
+            self.root.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise SweepError("out", f"cannot create {self.root} ({exc.strerror})") from None
+        lock = self.root / ".lock"
+        me = {"pid": os.getpid(), "host": socket.gethostname(),
+              "started": time.strftime("%Y-%m-%d %H:%M:%S %Z")}
+        for _ in range(3):
+            try:
+                fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                try:
+                    holder = json.loads(lock.read_text(encoding="utf-8"))
+                except (OSError, ValueError):
+                    holder = {}
+                pid, host = holder.get("pid"), holder.get("host")
+                if (host == me["host"] and isinstance(pid, int) and not _alive(pid)) \
+                        or not holder:
+                    lock.unlink(missing_ok=True)          # left by a process now gone
+                    continue
+                raise SweepError("out", f"{self.root} is being written by another sweep "
+                                 f"(process {pid} on {host}, since {holder.get('started')});"
+                                 " wait for it to finish or choose another folder") from None
+            except OSError as exc:
+                raise SweepError("out", f"cannot write to {self.root} ({exc.strerror})"
+                                 ) from None
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                json.dump(me, fh)
+            self._locked = True
+            return
+        raise SweepError("out", f"cannot take the lock {lock}")
+
+    def close(self) -> None:
+        """Release the folder's lock (idempotent)."""
+        if self._locked:
+            (self.root / ".lock").unlink(missing_ok=True)
+            self._locked = False
+
+    def __enter__(self) -> Store:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _check_folder(self, manifest: Path, digest: str, resume: bool) -> None:
         if manifest.is_file():
             try:
                 found = json.loads(manifest.read_text(encoding="utf-8")).get("sweep_digest")
@@ -87,7 +176,6 @@ class Store:
             if not resume:
                 raise SweepError("out", f"{self.root} already holds results of this sweep; "
                                  "pass --resume to continue it or choose another folder")
-        self._manifest = manifest
         parent = self.root if self.root.exists() else self.root.parent
         while not parent.exists() and parent != parent.parent:
             parent = parent.parent
@@ -110,15 +198,36 @@ class Store:
         return self.root / "chunks" / f"chunk-{index:07d}.parquet"
 
     def has(self, index: int) -> bool:
-        """Whether chunk ``index`` is finished."""
-        return self.chunk_path(index).is_file()
+        """Whether chunk ``index`` is finished: its file matches its checksum."""
+        path = self.chunk_path(index)
+        check = path.with_name(path.name + ".sha256")
+        try:
+            return path.is_file() and check.read_text(encoding="ascii").strip() == \
+                _sha256(path)
+        except (OSError, ValueError):
+            return False
+
+    def _check_manifest(self) -> None:
+        try:
+            found = json.loads(self._manifest.read_text(encoding="utf-8")).get("sweep_digest")
+        except (OSError, ValueError, AttributeError):
+            found = None
+        if found != self.digest:
+            raise SweepError("out", f"{self.root} now holds another sweep's manifest; "
+                             "stopped so the two do not mix")
 
     def write_chunk(self, index: int, columns: dict[str, np.ndarray]) -> None:
-        """Store a finished chunk (atomically)."""
+        """Store a finished chunk and its checksum (atomically), after checking that the
+        folder's manifest is still this sweep's."""
         pq = _pa().parquet
         table = to_table(columns)
         self._ensure()
-        _atomic_write(self.chunk_path(index), lambda p: pq.write_table(table, p))
+        self._check_manifest()
+        path = self.chunk_path(index)
+        _atomic_write(path, lambda p: pq.write_table(table, p))
+        digest = _sha256(path)
+        _atomic_write(path.with_name(path.name + ".sha256"),
+                      lambda p: p.write_text(digest + "\n", encoding="ascii"))
 
     def assemble(self, indices: list[int], rows: int, metadata: dict[str, str]) -> Path:
         """Concatenate chunks ``indices`` in order, keep the first ``rows`` rows and write
@@ -126,6 +235,7 @@ class Store:
         pa = _pa()
         pq = pa.parquet
         self._ensure()
+        self._check_manifest()
         tables = [pq.read_table(self.chunk_path(i)) for i in indices]
         table = pa.concat_tables(tables).slice(0, rows)
         meta = dict(table.schema.metadata or {})

@@ -5,6 +5,10 @@
 const taut = {views: {}, current: null};
 window.taut = taut;
 
+// The per-launch secret `taut app` put in the page's URL (?token=...); every API request
+// carries it, and the server refuses requests without it.
+const TOKEN = new URLSearchParams(location.search).get("token") || "";
+
 // POST a JSON body; resolves to {ok, data}. Errors from the server are one line
 // ("<field>: <problem>") and are shown in the message bar; the caller keeps its state.
 async function api(path, body, {quiet = false} = {}) {
@@ -12,7 +16,7 @@ async function api(path, body, {quiet = false} = {}) {
   try {
     resp = await fetch(path, {
       method: body === undefined ? "GET" : "POST",
-      headers: {"Content-Type": "application/json"},
+      headers: {"Content-Type": "application/json", "X-Taut-Token": TOKEN},
       body: body === undefined ? undefined : JSON.stringify(body),
     });
     data = await resp.json();

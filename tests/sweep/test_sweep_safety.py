@@ -1,0 +1,160 @@
+"""Sweeps that cannot mix or silently lose (issue 24): one writer per folder (a lock naming
+its holder), checksummed chunks with a damaged one recomputed on resume, a damaged
+results file a one-line error, ``options:`` validated per task, and two different sweeps
+started together on one folder: one runs, the other is refused."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from taut.cli import main
+from taut.errors import SweepError
+from taut.sweep import read_results, run_sweep, sweep_from_mapping
+from taut.sweep.store import Store
+
+ROOT = Path(__file__).parents[2]
+TAUT = Path(sys.executable).with_name("taut")
+
+
+def test_a_second_writer_is_refused_naming_the_holder(fk_spec, tmp_path):
+    spec = fk_spec(scale=[0.8, 0.9])
+    with Store(tmp_path / "run", spec.digest, resume=False):
+        with pytest.raises(SweepError) as err:
+            run_sweep(spec, tmp_path / "run", workers=0)
+        assert err.value.field == "out"
+        assert f"process {os.getpid()}" in err.value.problem
+    assert run_sweep(spec, tmp_path / "run", workers=0).success      # lock released
+    assert not (tmp_path / "run" / ".lock").exists()
+
+
+def test_a_stale_lock_of_a_dead_process_is_taken_over(fk_spec, tmp_path):
+    import socket
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / ".lock").write_text(json.dumps(
+        {"pid": dead.pid, "host": socket.gethostname(), "started": "earlier"}))
+    assert run_sweep(fk_spec(scale=[0.8]), tmp_path / "run", workers=0).success
+
+
+def test_two_different_sweeps_started_together_never_mix(tmp_path):
+    """Two `taut sweep run` processes, different sweeps, one folder: exactly one
+    writes, the other exits 2 naming the folder, and the results are the winner's."""
+    specs = []
+    for k, scale in enumerate(([0.7, 0.8, 0.9], [0.75, 0.85, 0.95])):
+        path = tmp_path / f"s{k}.yaml"
+        path.write_text(textwrap.dedent(f"""\
+            task: fk_stability_map
+            base: {ROOT / 'examples/sheet/example2_r2_r4_353mm.yaml'}
+            chunk_size: 1
+            parameters: {{scale: {scale}, stretch_angle: {{range: [0, 170], step: 10}}}}
+            """))
+        specs.append(path)
+    out = tmp_path / "out"
+    procs = [subprocess.Popen([str(TAUT), "sweep", "run", str(s), "--workers", "0",
+                               "--out", str(out)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for s in specs]
+    results = [(p.wait(120), p.stderr.read()) for p in procs]
+    codes = sorted(code for code, _ in results)
+    assert codes == [0, 2], results
+    loser = next(err for code, err in results if code == 2)
+    assert "taut: error: out:" in loser and loser.count("\n") == 1
+    cols, meta = read_results(out)
+    winner = specs[[code for code, _ in results].index(0)]
+    assert meta["sweep_source"] == winner.read_text()
+    assert len(cols["point"]) == 54 and len(set(cols["scale"])) == 3
+
+
+def test_a_damaged_chunk_is_recomputed_on_resume(tmp_path, same_rows):
+    spec = sweep_from_mapping({"task": "fk_stability_map",
+                               "base": "examples/sheet/example2_r2_r4_353mm.yaml",
+                               "chunk_size": 3,
+                               "parameters": {"scale": {"range": [0.6, 1.0], "num": 8}}},
+                              ROOT)
+    assert run_sweep(spec, tmp_path / "run", workers=0).success
+    good, _ = read_results(tmp_path / "run")
+    chunk = tmp_path / "run" / "chunks" / "chunk-0000001.parquet"
+    chunk.write_bytes(chunk.read_bytes()[:100])             # truncated
+    res = run_sweep(spec, tmp_path / "run", workers=0, resume=True)
+    assert res.success and res.chunks_run == 1 and res.chunks_reused == 2
+    same_rows(read_results(tmp_path / "run")[0], good)
+    # a flipped byte with the length kept is caught by the checksum too
+    data = bytearray(chunk.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    chunk.write_bytes(bytes(data))
+    res = run_sweep(spec, tmp_path / "run", workers=0, resume=True)
+    assert res.success and res.chunks_run == 1
+    same_rows(read_results(tmp_path / "run")[0], good)
+
+
+def test_a_damaged_results_file_is_one_line_in_sweep_plot(fk_spec, tmp_path, capsys):
+    spec = fk_spec(scale=[0.8, 0.9])
+    run_sweep(spec, tmp_path / "run", workers=0)
+    (tmp_path / "run" / "results.parquet").write_bytes(b"PAR1 not really")
+    assert main(["sweep", "plot", str(tmp_path / "run"), "--x", "scale",
+                 "--value", "n_stable"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("taut: error: folder: ") and "damaged" in err
+    assert err.count("\n") == 1
+
+
+@pytest.mark.parametrize("task, options, field", [
+    ("cdpr_workspace", {"grid": "abc"}, "options.grid"),
+    ("cdpr_workspace", {"grid": [2.7, 1, 1.9]}, "options.grid[0]"),     # was truncated
+    ("cdpr_workspace", {"grid": [21, 0, 9]}, "options.grid[1]"),
+    ("cdpr_workspace", {"grid": [True, 1, 1]}, "options.grid[0]"),
+    ("cdpr_workspace", {"grid": [10**4, 10**4, 10]}, "options.grid"),
+    ("cdpr_workspace", {"colour": 1}, "options.colour"),                # was accepted
+    ("cdpr_workspace", {"box": [[0, 0, 0], [1, 1]]}, "options.box"),
+    ("cdpr_workspace", {"box": [[0, 0, 0], [1, 1, "x"]]}, "options.box[1][2]"),
+    ("cdpr_workspace", {"box": [[0, 0, 0], [1e300, 1, 1]]}, "options.box[1][0]"),
+    ("cdpr_workspace", {"box": [[1, 0, 0], [0, 1, 1]]}, "options.box"),
+    ("fk_stability_map", {"grid": [1, 1, 1]}, "options.grid"),
+])
+def test_options_are_validated_per_task(tmp_path, task, options, field):
+    base = ("fastkit" if task.startswith("cdpr") else
+            str(ROOT / "examples/sheet/example2_r2_r4_353mm.yaml"))
+    params = {"payload": [1.0]} if task.startswith("cdpr") else {"scale": [1.0]}
+    with pytest.raises(SweepError) as err:
+        sweep_from_mapping({"task": task, "base": base, "parameters": params,
+                            "options": options}, tmp_path)
+    assert err.value.field == field
+
+
+def test_valid_options_are_kept(tmp_path):
+    spec = sweep_from_mapping({"task": "cdpr_workspace", "base": "fastkit",
+                               "parameters": {"payload": [1.0]},
+                               "options": {"grid": [3, 1, 2],
+                                           "box": [[-1, 0, 0.5], [1, 0, 1.5]]}}, tmp_path)
+    assert spec.options == {"grid": [3, 1, 2], "box": [[-1.0, 0.0, 0.5], [1.0, 0.0, 1.5]]}
+    assert run_sweep(spec, tmp_path / "o", workers=0).rows == 1
+    cols, _ = read_results(tmp_path / "o")
+    assert np.all(np.isfinite(cols["coverage"]))
+
+
+def test_sweep_plot_draws_every_documented_column(tmp_path, capsys):
+    """Every output of the task, text columns (lowest_taut) as categories, as a curve and
+    as a heat map."""
+    from taut.sweep import TASKS
+    spec = sweep_from_mapping({"task": "fk_stability_map",
+                               "base": "examples/sheet/example2_r2_r4_353mm.yaml",
+                               "parameters": {"scale": [0.7, 0.85, 1.0],
+                                              "stretch_angle": [0, 60, 120]},
+                               "options": {}}, ROOT)
+    run_sweep(spec, tmp_path / "run", workers=0)
+    cols, _ = read_results(tmp_path / "run")
+    assert cols["lowest_taut"].dtype == object
+    for value in TASKS["fk_stability_map"].outputs:
+        heat = value in ("lowest_taut", "n_stable")          # a category and a count
+        for extra in ([], ["--y", "stretch_angle"]) if heat else ([],):
+            out = tmp_path / f"{value}{len(extra)}.png"
+            code = main(["sweep", "plot", str(tmp_path / "run"), "--x", "scale",
+                         "--value", value, "--out", str(out), *extra])
+            assert code == 0, capsys.readouterr().err
+            assert out.stat().st_size > 1000
