@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from taut.cli import main
-from taut.errors import ScenarioError
+from taut.errors import InvalidInputError, ScenarioError
 from taut.io import MAX_YAML_VALUES, load_cdpr_model, parse_mapping, read_mapping, \
     write_text_atomic
 
@@ -78,13 +78,23 @@ def test_an_unrelated_existing_output_is_still_replaced(scenario_json, capsys):
     assert not list(scenario_json.parent.glob(".old.json.*"))      # no temporary left
 
 
-def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path):
+def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path, monkeypatch):
+    import os
+
     target = tmp_path / "a.json"
     target.write_text("old")
 
-    with pytest.raises(TypeError):
-        write_text_atomic(target, 12345)           # not text: fails before the rename
+    def full_disk(*args):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", full_disk)         # fails after the temp file
+    with pytest.raises(OSError):
+        write_text_atomic(target, "new")
+    monkeypatch.undo()
     assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["a.json"]   # no temp file left
+    with pytest.raises(InvalidInputError):
+        write_text_atomic(target, 12345)                  # not text: refused, nothing written
     assert [p.name for p in tmp_path.iterdir()] == ["a.json"]
     write_text_atomic(target, "new")
     assert target.read_text() == "new"

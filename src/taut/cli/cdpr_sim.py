@@ -40,9 +40,11 @@ def _waypoints(text: str) -> np.ndarray:
 
 
 def add_simulate(sub: typer.Typer) -> None:
-    """Add ``simulate`` to the ``cdpr`` sub-application."""
+    """Add ``simulate`` to the ``cdpr`` sub-application (long because the command's
+    options are declared in its signature, one typer option each)."""
 
-    @sub.command("simulate")
+    @sub.command("simulate", help="Simulate velocity or torque control of the cable robot "
+                                  "(FASTKIT §2.2).")
     def simulate_cmd(
         model: str = typer.Argument(..., help="Preset name (fastkit, ipanema) or model file."),
         waypoints: Optional[str] = typer.Option(
@@ -84,7 +86,8 @@ def add_simulate(sub: typer.Typer) -> None:
         plot: Optional[Path] = typer.Option(None, "--plot", help="Figure (PNG/PDF)."),
         animate: Optional[Path] = typer.Option(None, "--animate", help="3D animation (GIF)."),
     ) -> None:
-        """Simulate velocity or torque control of the cable robot (FASTKIT §2.2)."""
+        """``taut cdpr simulate`` (help text above); long because its options, one typer
+        declaration each, are in the signature."""
         if (waypoints is None) == (reference is None):
             raise InvalidInputError("--waypoints", "give exactly one of --waypoints and "
                                                    "--reference")

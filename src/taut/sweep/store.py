@@ -106,6 +106,7 @@ class Store:
         self.root = Path(root)
         self.digest = digest
         self._locked = False
+        self._created = not self.root.exists()
         if self.root.exists() and not self.root.is_dir():
             raise SweepError("out", f"{self.root} is a file, not a folder")
         manifest = self.root / "manifest.json"
@@ -153,10 +154,16 @@ class Store:
         raise SweepError("out", f"cannot take the lock {lock}")
 
     def close(self) -> None:
-        """Release the folder's lock (idempotent)."""
+        """Release the folder's lock (idempotent); a folder this store created and left
+        empty (the run failed before its first chunk) is removed: nothing was written."""
         if self._locked:
             (self.root / ".lock").unlink(missing_ok=True)
             self._locked = False
+            if self._created:
+                try:
+                    self.root.rmdir()                 # only if empty
+                except OSError:
+                    pass
 
     def __enter__(self) -> Store:
         return self
