@@ -23,6 +23,7 @@ __all__ = ["Status", "STATUSES", "check_status"]
 Status = Literal[
     "ok",                # the analysis produced what was asked for
     "infeasible",        # no solution satisfies the constraints (e.g. tension limits)
+    "not_strict",        # the answer exists but is not strict (e.g. a flat lowest rest state)
     "unreachable",       # a target provably cannot be reached (a certificate is attached)
     "refuted",           # a certificate proves that no solution exists
     "no_route",          # the planner's search space holds no route

@@ -133,6 +133,7 @@ def ik_to_dict(r: IKResult) -> dict[str, Any]:
         "curvature": finite_or_none(r.curvature),
         "spacing": float(r.spacing),
         "construction": r.construction,
+        "unmet": list(r.unmet),
     }
 
 

@@ -85,6 +85,21 @@ TINY = 1e-300
 
 # --- Input checks and snapping (relative to the sheet size) ---
 
+#: Equilibria whose object points and contact points both lie within this distance
+#: (relative to the sheet size) of each other are one physical state and are reported once
+#: (fk._merge; docs/sheet_fk_solver.md "One state, one answer"): above the splitting float64
+#: and finite-digit data cause next to a similar copy of the sheet (measured up to 3.5e-6:
+#: a regular hexagon at 0.9x written to 6 decimals), and 500x below a robot's 5 mm error on
+#: a 1 m sheet (the planner's robustness check), so no two states a team can tell apart merge.
+MERGE_RTOL = 1e-5
+#: Formations within this distance (relative to the sheet size) of a similar copy of the
+#: sheet whose enumeration reports no stable state get the direct minimisation of the
+#: object's height (fk._lowest): 10x the largest noise of the issue-25 property test (1e-4),
+#: far outside SNAP_TOL, where the taut-set enumeration can lose the lowest state.
+DIRECT_RTOL = 1e-3
+#: Iterations of each of those descents (next to a similar copy the descent from the
+#: centroids arrives within a few dozen; one still running drifts towards the floor).
+DIRECT_MAXIT = 400
 #: Relative tolerance (times the sheet size) for geometric equalities on input data:
 #: robot pairs may exceed their sheet distance by this much (rounding of given data).
 GEOMETRY_RTOL = 1e-9
@@ -207,6 +222,23 @@ MEDIAN_MIN_STEP = 1e-14
 #: Closure directions are accepted when the weighted sum of the unit vectors is below this
 #: times the total weight (dimensionless): far above the median's convergence (1e-14).
 CLOSURE_RTOL = 1e-10
+
+#: Default IK ``sheet_margin`` (relative to the sheet size): every robot pair of an answer
+#: stays this far inside its sheet distance -- the planner's default (10 mm) on its 1 m
+#: sheets, so 5 mm of error on each robot of a pair cannot tear the sheet.
+IK_MARGIN_RTOL = 0.01
+#: Relative slack (dimensionless) of the IK margin test: polishing moves robots by ~1e-9,
+#: so an answer optimised to the margin is accepted within this fraction of it.
+MARGIN_SLACK = 1e-6
+#: Seeded draws of the IK robustness admission: each robot displaced by ``position_error``
+#: in a random direction; the object must stay held in every draw ...
+ROBUST_DRAWS = 8
+#: ... i.e. a stable state within this many times ``position_error`` of the target
+#: (dimensionless): the object follows the robots by about their error; a state farther
+#: away is a jump to another branch (or none: lost).
+ROBUST_REACH = 20.0
+#: Seed of those draws (answers are deterministic).
+ROBUST_SEED = 25
 
 # --------------------------------------------------------------------------- simulation
 

@@ -93,10 +93,11 @@ def solve(sheet: Sheet, R: np.ndarray, hold_height: float, method: str
     """Every rest state of formations ``R`` (B, N, 2) (validated) of ``sheet`` held at
     ``hold_height``: the normalised frame, the classified solutions in output order, and
     the step counts of Algorithm 1 (``method="exhaustive"`` only, else None). Formations
-    next to a similar copy of the sheet are solved as the copy (``_snap_near_similar``)."""
+    next to a similar copy of the sheet are solved as the copy (``_snap_near_similar``), by
+    every method: the exhaustive one too (issue 25: all methods report the same states),
+    its step counts staying those of the formation as given."""
     frame, c, counts = _solve_as_given(sheet, R, hold_height, method)
-    if method != "exhaustive":
-        c = _snap_near_similar(sheet, R, hold_height, method, c)
+    c = _snap_near_similar(sheet, R, hold_height, method, c)
     return frame, c, counts
 
 

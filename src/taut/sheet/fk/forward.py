@@ -58,19 +58,27 @@ def forward_kinematics(team: SheetTeam, formation: ArrayLike, *, method: Method 
         Robot positions :math:`\\mathcal{R}_N` in the world frame, robot ``i`` holding
         sheet vertex ``i``. Same length unit as the sheet.
     method : {"fast", "exhaustive", "subsets"}
-        Algorithm (see module docstring). All return the same equilibria, except within
+        Algorithm (see module docstring). All return the same stable states. Within
         ``SNAP_TOL`` (1e-7 of the sheet size) of a similar copy of the sheet (the FK
-        paper's Lemma 2 configuration), where float64 cannot resolve the taut set: there
-        "fast" and "subsets" solve the copy (docs/sheet_fk_solver.md), and the paper's Algorithm 1 ("exhaustive") may find nothing.
+        paper's Lemma 2 configuration), where float64 cannot resolve the taut set,
+        every method solves the copy (docs/sheet_fk_solver.md). Every method
+        reports one physical state once: states whose object and contact points
+        coincide within ``MERGE_RTOL`` (1e-5 of the sheet size) are merged into one on
+        the union of their taut cables; and where, next to a copy (within
+        ``DIRECT_RTOL``, 1e-3 of the sheet size), no stable state was enumerated, a
+        direct minimisation of the height supplies the lowest one (``.direct``).
 
     Returns
     -------
     FKResult
         ``.equilibria`` (every state passing the paper's Algorithm 1, each with ``taut``,
         ``object``, ``contact``, ``weights``, ``tensions``, ``kind``, ``stable``),
-        ``.stable``, ``.lowest``, ``.funnel`` for the exhaustive method, and the outcome:
-        ``.success`` (at least one stable state), ``.status``, ``.message`` (without any
-        state, why: e.g. the states that would hang below the floor).
+        ``.stable``, ``.lowest`` (the lowest rest state), ``.direct`` (the direct
+        minimisation supplied it), ``.funnel`` for the exhaustive method, and the
+        outcome: ``.success`` (at least one stable state), ``.status`` (``"ok"``;
+        ``"not_strict"``: the lowest rest state is not a strict minimum, reported as a
+        ``"saddle"``; ``"infeasible"``), ``.message`` (without any state, why: e.g. the
+        states that would hang below the floor).
 
     Raises
     ------

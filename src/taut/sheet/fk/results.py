@@ -1,8 +1,10 @@
 """Result objects of sheet forward kinematics: frozen, with named fields.
 
 Both results follow taut's outcome convention (:mod:`taut._outcome`): ``success`` when a
-formation holds the object in at least one stable state, ``status`` ``"ok"`` or
-``"infeasible"``, and a ``message`` saying what was found or why not.
+formation holds the object in at least one stable state, ``status`` ``"ok"``,
+``"not_strict"`` (single results: the lowest rest state is not a strict minimum) or
+``"infeasible"``, and a ``message`` saying what was found or why not. One physical state
+is reported once (:mod:`taut.sheet.fk._merge`).
 """
 
 from __future__ import annotations
@@ -17,7 +19,10 @@ from ..._units import GRAVITY
 from ..._validate import as_array
 from ...errors import InvalidInputError
 from .._lifted import KIND_NAMES, KIND_NOT_EQUILIBRIUM, KIND_STABLE
+from .._tol import MERGE_RTOL
 from ..model import Sheet, check_formation
+from ._lowest import lowest_by_descent, near_copy
+from ._merge import coincident_groups, merged_weights
 from ._solve import explain_no_equilibrium
 
 __all__ = ["Equilibrium", "Funnel", "FKResult", "BatchFKResult", "EquilibriumKind"]
@@ -115,6 +120,70 @@ def _equilibrium(taut: tuple[int, ...], obj: np.ndarray, contact: np.ndarray,
     return e
 
 
+_KIND_RANK = {"stable": 0, "saddle": 1, "not_equilibrium": 2}
+
+
+def _merge_equilibria(eqs: tuple[Equilibrium, ...], sheet: Sheet, formation: np.ndarray,
+                      hold_height: float, mass: float | None) -> tuple[Equilibrium, ...]:
+    """``eqs`` with coinciding states reported once (:mod:`taut.sheet.fk._merge`), in
+    output order (taut-set size, then taut set)."""
+    if len(eqs) < 2:
+        return eqs
+    # Screen: coinciding states have coinciding heights (cheap, and nearly always decisive).
+    tol = MERGE_RTOL * sheet.size
+    z = sorted(float(e.object[2]) for e in eqs)
+    if all(b - a > tol for a, b in zip(z, z[1:])):
+        return eqs
+    obj = np.array([e.object for e in eqs])
+    contact = np.array([e.contact for e in eqs])
+    labels = coincident_groups(obj, contact, sheet.size)
+    if labels is None:
+        return eqs
+    out = []
+    for g in np.unique(labels):
+        members = [eqs[k] for k in np.flatnonzero(labels == g)]
+        if len(members) == 1:
+            out.append(members[0])
+            continue
+        rep = min(members, key=lambda e: (_KIND_RANK[e.kind], e.height))
+        idx = np.array(sorted(set().union(*(e.taut for e in members))), dtype=np.intp)
+        w = merged_weights(sheet.vertices, formation, hold_height, sheet.size, idx,
+                           rep.object[:2], rep.contact)
+        lengths = np.linalg.norm(sheet.vertices[idx] - rep.contact, axis=1)
+        kind = rep.kind
+        tensions = None
+        if mass is not None and kind != "not_equilibrium":
+            tensions = w * (mass * GRAVITY) * lengths / (hold_height - rep.height)
+        out.append(_equilibrium(tuple(int(i) for i in idx), rep.object.copy(),
+                                rep.contact.copy(), w, tensions, lengths, kind))
+    out.sort(key=lambda e: (len(e.taut), e.taut))
+    return tuple(out)
+
+
+def _with_lowest(eqs: tuple[Equilibrium, ...], sheet: Sheet, formation: np.ndarray,
+                 hold_height: float, mass: float | None) -> tuple[tuple[Equilibrium, ...], bool]:
+    """``eqs`` and, when none of them is stable, the lowest rest state found by direct
+    minimisation (:mod:`taut.sheet.fk._lowest`) in place of a state at the same point;
+    the flag says whether the minimisation supplied it."""
+    if any(e.kind == "stable" for e in eqs):
+        return eqs, False
+    found = lowest_by_descent(sheet.vertices, formation, hold_height, sheet.size,
+                              [(e.object, e.contact) for e in eqs])
+    if found is None:
+        return eqs, False
+    idx, obj, contact, w, strict = found
+    lengths = np.linalg.norm(sheet.vertices[idx] - contact, axis=1)
+    tensions = (None if mass is None
+                else w * (mass * GRAVITY) * lengths / (hold_height - obj[2]))
+    new = _equilibrium(tuple(int(i) for i in idx), obj, contact, w, tensions, lengths,
+                       "stable" if strict else "saddle")
+    tol = MERGE_RTOL * sheet.size
+    keep = [e for e in eqs if max(np.abs(e.object - obj).max(),
+                                  np.abs(e.contact - contact).max()) > tol]
+    out = sorted(keep + [new], key=lambda e: (len(e.taut), e.taut))
+    return tuple(out), True
+
+
 class FKResult:
     """All rest states of the object for one formation (FK paper's output
     :math:`\\mathbb{P}_o, \\mathbb{V}_o, \\mathbb{I}_t`). Frozen.
@@ -122,8 +191,9 @@ class FKResult:
     Attributes
     ----------
     equilibria : tuple of Equilibrium
-        Every state that passes the paper's Algorithm 1, sorted by number of taut cables
-        then by taut set. (Built on first access when the result came from the compiled
+        Every state that passes the paper's Algorithm 1, states at one point merged
+        into one (``MERGE_RTOL``), plus the lowest rest state when only the direct
+        minimisation found it; sorted by number of taut cables then by taut set. (Built on first access when the result came from the compiled
         kernel; the numbers are fixed when the result is made.)
     funnel : Funnel or None
         Step counts of Algorithm 1 (``method="exhaustive"`` only).
@@ -133,8 +203,12 @@ class FKResult:
         The inputs (formation as an (N, 2) array).
     success : bool
         At least one stable state: the formation holds the object.
-    status : {"ok", "infeasible"}
-        ``"ok"`` exactly when ``success``.
+    status : {"ok", "not_strict", "infeasible"}
+        ``"ok"`` exactly when ``success``; ``"not_strict"`` when the lowest rest state
+        (found by direct minimisation) is not a strict minimum of the height.
+    direct : bool
+        The enumeration missed the lowest rest state and a direct minimisation of the
+        object's height supplied it (docs/sheet_fk_solver.md "The lowest state exists").
     message : str
         One line: how many states were found and how many are stable; without any state,
         why (e.g. the states the object would reach below the floor, FK paper eq. 15).
@@ -143,6 +217,7 @@ class FKResult:
     _equilibria: tuple[Equilibrium, ...] | None
     _rows: np.ndarray | None
     _message: str | None
+    _direct: bool
     funnel: Funnel | None
     method: str
     sheet: Sheet
@@ -153,7 +228,9 @@ class FKResult:
     def __init__(self, equilibria: tuple[Equilibrium, ...], funnel: Funnel | None,
                  method: str, sheet: Sheet, formation: np.ndarray, hold_height: float,
                  mass: float | None) -> None:
-        self.__dict__.update(_equilibria=tuple(equilibria), _rows=None, _message=None,
+        eqs = _merge_equilibria(tuple(equilibria), sheet, formation, hold_height, mass)
+        eqs, direct = _with_lowest(eqs, sheet, formation, hold_height, mass)
+        self.__dict__.update(_equilibria=eqs, _rows=None, _message=None, _direct=direct,
                              funnel=funnel, method=method, sheet=sheet, formation=formation,
                              hold_height=hold_height, mass=mass)
 
@@ -164,7 +241,8 @@ class FKResult:
         ``_kernels.small``: kind, taut-set size, object, contact, depth, taut mask,
         weights, lengths, ...)."""
         self = object.__new__(cls)
-        self.__dict__.update(_equilibria=None, _rows=rows, _message=None, funnel=None,
+        self.__dict__.update(_equilibria=None, _rows=rows, _message=None, _direct=False,
+                             funnel=None,
                              method=method, sheet=sheet, formation=formation,
                              hold_height=hold_height, mass=mass)
         return self
@@ -185,7 +263,10 @@ class FKResult:
 
     def _build(self, rows: np.ndarray | None) -> tuple[Equilibrium, ...]:
         if rows is None or len(rows) == 0:
-            return ()
+            eqs, direct = _with_lowest((), self.sheet, self.formation, self.hold_height,
+                                       self.mass)
+            self.__dict__["_direct"] = direct
+            return eqs
         N = self.sheet.n
         scale = self.sheet.size
         force = None if self.mass is None else self.mass * GRAVITY
@@ -200,20 +281,49 @@ class FKResult:
                 tensions = w * force * (lengths / scale) / row[7]
             out.append(_equilibrium(tuple(idx.tolist()), row[2:5].copy(), row[5:7].copy(),
                                     w, tensions, lengths, KIND_NAMES[kind]))
-        return tuple(out)
+        eqs = tuple(out)
+        kinds = rows[:, 0].tolist()
+        if len(kinds) > 1:                       # the merge's height screen, on the rows
+            z = sorted(rows[:, 4].tolist())
+            tol = MERGE_RTOL * scale
+            if not all(b - a > tol for a, b in zip(z, z[1:])):
+                eqs = _merge_equilibria(eqs, self.sheet, self.formation, self.hold_height,
+                                        self.mass)
+        if KIND_STABLE not in kinds:
+            eqs, direct = _with_lowest(eqs, self.sheet, self.formation, self.hold_height,
+                                       self.mass)
+            self.__dict__["_direct"] = direct
+        return eqs
 
     @property
     def success(self) -> bool:
         """At least one stable state (the formation holds the object)."""
         rows = self._rows
         if self._equilibria is None and rows is not None:
-            return bool(np.any(rows[:, 0] == KIND_STABLE))
+            if np.any(rows[:, 0] == KIND_STABLE):
+                return True
+            if not near_copy(self.sheet.vertices, self.formation, self.sheet.size):
+                return False                     # no direct minimisation out here
         return any(e.stable for e in self.equilibria)
 
     @property
+    def direct(self) -> bool:
+        """True when the enumeration of taut sets missed the lowest rest state and the
+        direct minimisation of the object's height supplied it (docs/sheet_fk_solver.md)."""
+        self.equilibria
+        return bool(self._direct)
+
+    @property
     def status(self) -> str:
-        """``"ok"`` when :attr:`success`, else ``"infeasible"`` (no stable state)."""
-        return "ok" if self.success else "infeasible"
+        """``"ok"`` when :attr:`success`; ``"not_strict"`` when the lowest rest state is
+        not a strict minimum of the height (it is reported, kind ``"saddle"``);
+        else ``"infeasible"`` (no rest state above the floor)."""
+        if self.success:
+            return "ok"
+        if (self._equilibria is None and self._rows is not None
+                and not near_copy(self.sheet.vertices, self.formation, self.sheet.size)):
+            return "infeasible"                  # no direct minimisation out here
+        return "not_strict" if self.lowest is not None else "infeasible"
 
     @property
     def message(self) -> str:
@@ -231,8 +341,13 @@ class FKResult:
             return "no equilibrium: " + explain_no_equilibrium(
                 self.sheet, self.formation, self.hold_height)
         stable = sum(e.stable for e in eqs)
+        how = (" (the lowest found by direct minimisation of the height: the enumeration "
+               "missed it)" if self._direct else "")
         if stable:
-            return f"{len(eqs)} solution(s), {stable} stable"
+            return f"{len(eqs)} solution(s), {stable} stable{how}"
+        if self._direct:
+            return (f"lowest rest state not strict: {len(eqs)} solution(s), none stable"
+                    f"{how}")
         saddle = sum(e.kind == "saddle" for e in eqs)
         return (f"no stable state: {len(eqs)} solution(s), {saddle} saddle, "
                 f"{len(eqs) - saddle} not an equilibrium")
@@ -244,9 +359,17 @@ class FKResult:
 
     @property
     def lowest(self) -> Equilibrium | None:
-        """The stable equilibrium with the lowest object (least potential energy)."""
+        """The lowest rest state (least potential energy): the lowest stable equilibrium;
+        without one, the non-strict minimum found by direct minimisation (kind
+        ``"saddle"``, :attr:`status` ``"not_strict"``). None only when the object would
+        rest on the ground (no state with :math:`z_o > 0`)."""
         st = self.stable
-        return min(st, key=lambda e: e.height) if st else None
+        if st:
+            return min(st, key=lambda e: e.height)
+        if self._direct:                         # set when the states were built
+            return min((e for e in self.equilibria if e.kind == "saddle"),
+                       key=lambda e: e.height, default=None)
+        return None
 
     def closest_stable(self, point: ArrayLike) -> Equilibrium | None:
         """The stable equilibrium whose object is nearest to ``point``.
@@ -284,8 +407,10 @@ class FKResult:
         return st[int(np.argmin(d))]
 
     def __len__(self) -> int:
-        if self._equilibria is None and self._rows is not None:
-            return len(self._rows)
+        rows = self._rows
+        if (self._equilibria is None and rows is not None and len(rows) == 1
+                and rows[0, 0] == KIND_STABLE):
+            return 1
         return len(self.equilibria)
 
     def __repr__(self) -> str:
@@ -324,7 +449,8 @@ class BatchFKResult:
     success : ndarray of bool, shape (B,)
         Formation ``b`` is feasible and has at least one stable state.
     status : ndarray of str, shape (B,)
-        ``"ok"`` where ``success``, else ``"infeasible"``.
+        ``"ok"`` where ``success``; ``"not_strict"`` where the direct minimisation found
+        a lowest rest state that is not a strict minimum; else ``"infeasible"``.
     message : str
         One line over the batch: how many formations hold the object, and the first
         formation the sheet cannot span.

@@ -124,13 +124,14 @@ def polish(V: np.ndarray, rho: np.ndarray, w: np.ndarray, th: np.ndarray
 
 
 def _constraints(V: np.ndarray, rho: np.ndarray, spacing_factor: float, min_weight: float,
-                 need_curv: bool) -> list[dict[str, Any]]:
+                 need_curv: bool, margin: float = 0.0) -> list[dict[str, Any]]:
     """SLSQP constraints over z = (theta, w): the five equations, the weights, the pair
-    limits :math:`D_{ij}^2 \\cdot` ``spacing_factor`` :math:`- |r_i - r_j|^2 \\ge 0` and,
-    for N <= 4, the curvature."""
+    limits :math:`(D_{ij} - m)^2 \\cdot` ``spacing_factor`` :math:`- |r_i - r_j|^2 \\ge 0`
+    (``margin`` :math:`m`, normalised length) and, for N <= 4, the curvature."""
     N = len(rho)
     iu, ju = np.triu_indices(N, 1)
-    vdist2 = np.sum((V[iu] - V[ju]) ** 2, axis=1) * spacing_factor
+    D = np.maximum(np.sqrt(np.sum((V[iu] - V[ju]) ** 2, axis=1)) - margin, 0.0)
+    vdist2 = D * D * spacing_factor
 
     def d_robots(th: np.ndarray) -> np.ndarray:
         return rho[:, None] * np.column_stack([-np.sin(th), np.cos(th)])
@@ -216,14 +217,15 @@ def _slsqp(obj: Callable[[np.ndarray], tuple[float, np.ndarray]], z0: np.ndarray
 
 
 def joint_optimise(V: np.ndarray, rho: np.ndarray, phi: np.ndarray, w0: np.ndarray,
-                   th0: np.ndarray, ref: np.ndarray | None, need_curv: bool
-                   ) -> tuple[np.ndarray, np.ndarray] | None:
+                   th0: np.ndarray, ref: np.ndarray | None, need_curv: bool,
+                   margin: float = 0.0) -> tuple[np.ndarray, np.ndarray] | None:
     """SLSQP over (theta, w) from (th0, w0): the alignment with ``phi`` (or the motion
-    from ``ref``), pair limits kept strictly inside (factor 1 - 1e-7). Returns polished
-    (theta, w) or None."""
+    from ``ref``), pair limits kept strictly inside (factor 1 - 1e-7) and ``margin``
+    (normalised length) inside their sheet distances. Returns polished (theta, w) or
+    None."""
     N = len(rho)
     obj = _alignment_objective(rho, phi) if ref is None else _motion_objective(rho, ref)
-    cons = _constraints(V, rho, 1 - IK_PAIR_SHRINK, MIN_WEIGHT * 10, need_curv)
+    cons = _constraints(V, rho, 1 - IK_PAIR_SHRINK, MIN_WEIGHT * 10, need_curv, margin)
     z = _slsqp(obj, np.concatenate([th0, w0]), cons, N)
     return None if z is None else polish(V, rho, z[N:], z[:N])
 

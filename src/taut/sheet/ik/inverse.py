@@ -53,7 +53,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import as_array, as_finite_scalar, as_nonnegative, check_range
+from ..._validate import (MAX_SHEET_LENGTH, as_array, as_bounded, as_finite_scalar,
+    as_nonnegative, check_range)
 from ...errors import InvalidInputError
 from ._certificate import (IKCertificate, closure_branch_certificate, closure_lp_certificate,
     depth_certificate, radial_certificate, triangle_certificate)
@@ -61,9 +62,10 @@ from .results import IKConstraints, IKResult
 from ._search import Candidate, check_solution, curvature, joint_optimise, multistart_search
 from ._weights import closure_directions, maxent_weights
 from .._tol import (CONTACT_INSET_RTOL, DEFAULT_BRANCH_BOXES, DEFAULT_BUDGET, EARLY_BRANCH_BOXES,
-    EARLY_SEARCHES, REFERENCE_MIN_RADIUS, VERIFY_RTOL)
+    EARLY_SEARCHES, IK_MARGIN_RTOL, MARGIN_SLACK, REFERENCE_MIN_RADIUS, ROBUST_DRAWS,
+    ROBUST_REACH, ROBUST_SEED, VERIFY_RTOL)
 from ..fk.solver import cached_solver
-from ..model import Sheet
+from ..model import Sheet, feasible_formations
 from ..._units import GRAVITY
 from ..team import SheetTeam, as_sheet, require_team
 
@@ -314,16 +316,77 @@ def _certify(t: _Target, w: np.ndarray) -> IKCertificate | None:
     return triangle_certificate(t.V, t.rho, w) or closure_lp_certificate(t.V, t.rho)
 
 
-def _success(sheet: Sheet, t: _Target, c: Candidate, mass: float | None, runs: int
-             ) -> IKResult:
+def _unmet(team: SheetTeam, t: _Target, c: Candidate, limits: tuple[float, float]
+           ) -> tuple[tuple[str, str], ...]:
+    """The conditions candidate ``c`` does not meet, as (name, one-line reason) pairs:
+    ``"sheet_margin"`` and ``"robustness"`` (empty: both met)."""
+    margin_n, error = limits
+    _, R, spacing, _, _ = check_solution(t.V, t.rho, c.weights, c.angles)
+    out = []
+    if spacing < margin_n * (1.0 - MARGIN_SLACK):
+        out.append(("sheet_margin", f"sheet_margin {margin_n * t.scale:.4g} not met: the "
+                    f"closest robot pair is {max(spacing, 0.0) * t.scale:.4g} inside its "
+                    "sheet distance"))
+    if error > 0 and not _robust(team, t, t.p[:2] + t.scale * R, error):
+        out.append(("robustness", f"not robust: with the robots off by {error:.4g} the "
+                    f"object is not held (no stable state within {ROBUST_REACH:g} x that "
+                    "of the target)"))
+    return tuple(out)
+
+
+def _robust(team: SheetTeam, t: _Target, R: np.ndarray, error: float) -> bool:
+    """The robustness admission: in ``ROBUST_DRAWS`` seeded draws, each robot of ``R``
+    displaced by ``error`` in a random direction, the sheet is spanned and forward
+    kinematics has a stable state within ``ROBUST_REACH * error`` of the target."""
+    rng = np.random.default_rng(ROBUST_SEED)
+    solver = cached_solver(team, "fast")
+    for _ in range(ROBUST_DRAWS):
+        a = rng.uniform(-np.pi, np.pi, len(R))
+        P = R + error * np.column_stack([np.cos(a), np.sin(a)])
+        if not feasible_formations(team.sheet, P[None])[0]:
+            return False
+        if not any(float(np.linalg.norm(e.object - t.p)) <= ROBUST_REACH * error
+                   for e in solver.solve(P).stable):
+            return False
+    return True
+
+
+def _admit(team: SheetTeam, t: _Target, c: Candidate, phi: np.ndarray,
+           ref_n: np.ndarray | None, limits: tuple[float, float]
+           ) -> tuple[Candidate, tuple[tuple[str, str], ...]]:
+    """A verified candidate that keeps the sheet margin and passes the robustness
+    admission: ``c`` itself, or the joint optimisation from it with the margin (then twice
+    the margin) as a constraint; failing both, ``c`` and the conditions it does not meet."""
+    why = _unmet(team, t, c, limits)
+    if not why:
+        return c, why
+    margin_n = limits[0]
+    for m in (margin_n, 2.0 * margin_n):
+        out = joint_optimise(t.V, t.rho, phi, c.weights, c.angles, ref_n, len(t.rho) <= 4,
+                             m * (1.0 + MARGIN_SLACK))
+        if out is None:
+            continue
+        ok, R, *_ = check_solution(t.V, t.rho, out[1], out[0])
+        if not ok or not _verified(team, t, t.p[:2] + t.scale * R):
+            continue
+        better = Candidate(out[0], out[1], "optimised")
+        if not _unmet(team, t, better, limits):
+            return better, ()
+    return c, why
+
+
+def _success(sheet: Sheet, t: _Target, c: Candidate, unmet: tuple[tuple[str, str], ...],
+             mass: float | None, runs: int) -> IKResult:
     _, R, spacing, curv, _ = check_solution(t.V, t.rho, c.weights, c.angles)
     formation = t.p[:2] + R * t.scale
     formation.setflags(write=False)
     tensions = None if mass is None else c.weights * mass * GRAVITY * t.lengths / t.d
     msg = f"all {sheet.n} cables taut, stable ({c.how}), verified by forward kinematics"
+    if unmet:
+        msg += "; but " + "; ".join(why for _, why in unmet)
     return IKResult(formation, t.p, t.vo, np.angle(np.exp(1j * c.angles)), c.weights,
                     tensions, t.lengths, t.rho * t.scale, curv, max(spacing, 0.0) * t.scale,
-                    c.how, True, "ok", msg, None, runs)
+                    c.how, True, "ok", msg, None, runs, tuple(name for name, _ in unmet))
 
 
 def _failure(sheet: Sheet, t: _Target, status: str, message: str,
@@ -339,7 +402,9 @@ def _failure(sheet: Sheet, t: _Target, status: str, message: str,
 def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
                        contact: ArrayLike | None = None, heading: float = 0.0,
                        reference: ArrayLike | None = None, budget: int = DEFAULT_BUDGET,
-                       seed: int = 0, branch_boxes: int = DEFAULT_BRANCH_BOXES) -> IKResult:
+                       seed: int = 0, branch_boxes: int = DEFAULT_BRANCH_BOXES,
+                       sheet_margin: float | None = None,
+                       position_error: float | None = None) -> IKResult:
     """Robot formation that holds the object stably at ``object_position`` with every
     virtual cable taut (planning paper eq. 10; docs/sheet_kinematics.md §6).
 
@@ -368,12 +433,30 @@ def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
     branch_boxes : int
         Boxes of cable angles (one LP each) the branch-and-bound unreachability proof may
         examine (step 4b) before IK gives up with ``budget_exhausted``; 0 skips the proof.
+    sheet_margin : float, optional
+        Every robot pair of the answer stays at least this far inside its sheet distance
+        (same length unit as the sheet; >= 0). Default: 1% of the sheet size
+        (``IK_MARGIN_RTOL``; the planner's 10 mm on a 1 m sheet). Applies in every mode
+        (``heading``, ``reference``, the search).
+    position_error : float, optional
+        Robustness admission (as the planner's): with every robot off by this much (same
+        unit; ``ROBUST_DRAWS`` seeded draws), the object must stay held -- a stable state
+        within ``ROBUST_REACH`` times this of the target. Default: half of
+        ``sheet_margin`` (the planner's 5 mm with its 10 mm margin); 0 skips the check.
 
     Returns
     -------
     IKResult
-        ``success`` with a formation verified by forward kinematics; otherwise status
-        ``unreachable`` with a ``certificate``, or ``budget_exhausted``.
+        ``success`` with a formation verified by forward kinematics; it keeps
+        ``sheet_margin`` and passes the robustness admission whenever some formation of
+        the search does (a joint optimisation with the margin as a constraint is tried
+        first). Where none does (e.g. a target whose every formation has a pair at its
+        limit), the verified formation is still returned and ``unmet`` names the
+        conditions it does not meet (``"sheet_margin"``, ``"robustness"``), the message
+        says why. An unreachable target is not an error: the
+        result has status ``"unreachable"`` with a ``certificate`` (a checkable proof),
+        or ``"budget_exhausted"`` when neither a formation nor a proof was found; no
+        exception is raised for it.
 
     Raises
     ------
@@ -398,6 +481,12 @@ def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
     heading = as_finite_scalar(heading, "heading")
     budget = int(as_nonnegative(budget, "budget"))
     branch_boxes = int(as_nonnegative(branch_boxes, "branch_boxes"))
+    margin = (IK_MARGIN_RTOL * sheet.size if sheet_margin is None
+              else as_bounded(sheet_margin, "sheet_margin", MAX_SHEET_LENGTH, "sheet units",
+                              positive=False))
+    error = (0.5 * margin if position_error is None
+             else as_bounded(position_error, "position_error", MAX_SHEET_LENGTH,
+                             "sheet units", positive=False))
     ref_n = None
     if reference is not None:
         ref_n = (as_array(reference, "reference", shape=(sheet.n, 2)) - t.p[:2]) / t.scale
@@ -405,19 +494,22 @@ def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
             or radial_certificate(t.V, t.rho, t.scale))
     if cert is not None:
         return _failure(sheet, t, "unreachable", cert.message, cert, 0)
-    return _search(team, t, heading, ref_n, (budget, branch_boxes), seed)
+    return _search(team, t, heading, ref_n, (budget, branch_boxes), seed,
+                   (margin / t.scale, error))
 
 
 def _search(team: SheetTeam, t: _Target, heading: float, ref_n: np.ndarray | None,
-            budgets: tuple[int, int], seed: int) -> IKResult:
-    """Steps 1-4 of the module docstring on a target with real reaches."""
+            budgets: tuple[int, int], seed: int, limits: tuple[float, float]) -> IKResult:
+    """Steps 1-4 of the module docstring on a target with real reaches; every answer then
+    passes :func:`_admit` (``limits``: the normalised sheet margin and the position error
+    in the sheet's unit)."""
     sheet, mass = team.sheet, team.mass
     w = maxent_weights(sheet.vertices, t.vo, t.scale)
     phi = _preferred_directions(t, heading, ref_n)
     best, _, runs = _construct(t, w, phi, ref_n)
     if best is not None and _verified(team, t, t.p[:2] + t.scale * (
             t.rho[:, None] * np.column_stack([np.cos(best.angles), np.sin(best.angles)]))):
-        return _success(sheet, t, best, mass, runs)
+        return _success(sheet, t, *_admit(team, t, best, phi, ref_n, limits), mass, runs)
     cert = _certify(t, w)
     if cert is not None:
         return _failure(sheet, t, "unreachable", "no stable all-taut formation exists for "
@@ -443,7 +535,8 @@ def _search(team: SheetTeam, t: _Target, heading: float, ref_n: np.ndarray | Non
                                         seed=seed + 1)
         tried += more
     if found is not None:
-        return _success(sheet, t, found, mass, runs + tried)
+        return _success(sheet, t, *_admit(team, t, found, phi, ref_n, limits), mass,
+                        runs + tried)
     return _failure(sheet, t, "budget_exhausted", "no stable all-taut formation found and "
                     f"no proof that none exists: closed-form closure, {runs} joint "
                     f"optimisation(s), {tried} multi-start feasibility search(es), the "

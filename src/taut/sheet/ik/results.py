@@ -56,6 +56,10 @@ class IKResult:
         The proof that the target is unreachable (status ``unreachable``).
     attempts : int
         Optimiser runs used (joint optimisation and multi-start search).
+    unmet : tuple of str
+        Conditions of the answer IK could not meet, from ``"sheet_margin"`` (a robot pair
+        closer than the margin to its sheet distance) and ``"robustness"`` (the object not
+        held under the position error); empty when both are met or there is no formation.
     """
 
     formation: np.ndarray
@@ -74,6 +78,7 @@ class IKResult:
     message: str = ""
     certificate: IKCertificate | None = field(default=None, repr=False)
     attempts: int = 0
+    unmet: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         check_status(self.status)

@@ -20,7 +20,9 @@ branch has ended and the object *jumps*: it rolls to the minimum reached by stee
 descent of ``F`` (an epsilon-subgradient method for this max of quadratics) from its last
 state, and the event records the drop height. If the object reaches the ground
 (:math:`z_o \\le 0`) it is *lost* until a stable state exists again (*recovered*, at the
-lowest one). Tracking then continues to the end of the step. Taut-set-change events are
+lowest one); so it is too when the descent stops short of a stable state and the nearest
+one lies above the start (a roll never raises the object). Tracking then continues to
+the end of the step. Taut-set-change events are
 reported wherever the reported taut set (the exact maximiser set, as in FK) changes
 between steps without a jump.
 

@@ -1,0 +1,185 @@
+"""Sheet answers at the edges (issue 25): regular sheets held as scaled copies, coordinates
+written to finite digits, noise far below any physical scale. One physical state is
+reported once, by every method, backend and the batch; a hanging object always has a
+lowest rest state."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import taut.sheet as ts
+from taut.errors import InvalidInputError
+from taut.sheet import FKSolver, HAVE_NUMBA, Sheet, SheetTeam
+from taut.sheet._tol import MERGE_RTOL
+
+BACKENDS = ["numba", "numpy"] if HAVE_NUMBA else ["numpy"]
+
+
+def regular(n: int) -> np.ndarray:
+    a = 2 * np.pi * np.arange(n) / n
+    return np.c_[np.cos(a), np.sin(a)]
+
+
+def digits_team(n: int, scale: float = 0.9, digits: int = 6):
+    """A regular n-gon and its scaled copy, both written to ``digits`` decimals."""
+    V = np.round(regular(n), digits)
+    return SheetTeam(Sheet(V), 1.0, mass=1.0), np.round(scale * V, digits)
+
+
+def noisy_team(n: int, noise: float, seed: int, scale: float = 0.9):
+    V = regular(n)
+    R = scale * V + noise * np.random.default_rng(seed).standard_normal(V.shape)
+    return SheetTeam(Sheet(V), 1.0, mass=1.0), R
+
+
+def answers(team: SheetTeam, R: np.ndarray) -> dict[str, ts.FKResult]:
+    """The result of every method, backend and the batch for one formation."""
+    out = {}
+    for backend in BACKENDS:
+        for method in ("fast", "subsets"):
+            out[f"{method}-{backend}"] = FKSolver(team, method=method,
+                                                  backend=backend).solve(R)
+    if team.n <= 12:
+        out["exhaustive"] = ts.forward_kinematics(team, R, method="exhaustive")
+    out["batch"] = ts.forward_kinematics_batch(team, R[None]).result(0)
+    return out
+
+
+def assert_physical(res: ts.FKResult) -> None:
+    """No state twice; every state balances (sum w = 1, sum w r_i = r_o, sum w v_i = v_o)."""
+    size = res.sheet.size
+    eqs = res.equilibria
+    for i, a in enumerate(eqs):
+        for b in eqs[i + 1:]:
+            d = max(np.abs(a.object - b.object).max(), np.abs(a.contact - b.contact).max())
+            assert d > MERGE_RTOL * size, (a, b)
+        if a.is_equilibrium:
+            idx = list(a.taut)
+            assert a.weights.min() >= -1e-8
+            assert a.weights.sum() == pytest.approx(1.0, abs=1e-9)
+            np.testing.assert_allclose(a.weights @ res.formation[idx], a.object[:2],
+                                       atol=1e-8 * size)
+            np.testing.assert_allclose(a.weights @ res.sheet.vertices[idx], a.contact,
+                                       atol=1e-8 * size)
+
+
+def assert_agree(results: dict[str, ts.FKResult], size: float) -> None:
+    """Every answer has one or more stable states, the same ones (positions within the
+    merge tolerance), no state twice."""
+    ref_name, ref = next(iter(results.items()))
+    ref_pts = sorted(e.object.tolist() for e in ref.stable)
+    assert ref_pts, ref_name
+    for name, res in results.items():
+        assert res.success and res.lowest is not None and res.lowest.stable, name
+        assert_physical(res)
+        pts = sorted(e.object.tolist() for e in res.stable)
+        assert len(pts) == len(ref_pts), (name, res.stable, ref.stable)
+        np.testing.assert_allclose(pts, ref_pts, atol=2 * MERGE_RTOL * size, err_msg=name)
+
+
+@pytest.mark.parametrize("n", [16, 24, 30])
+def test_regular_polygon_written_to_six_decimals_has_one_state(n):
+    """Issue 25: a regular 30-gon at 0.9x written to 6 decimals was 129 "stable" states at
+    one point (24-gon 77, 16-gon 17; the 16-gon later none stable at all): one state, at
+    the centre, hanging sqrt(1 - 0.81) = 0.4359 below the robots."""
+    team, R = digits_team(n)
+    res = answers(team, R)
+    assert_agree(res, team.sheet.size)
+    for r in res.values():
+        assert len(r.stable) == 1
+        np.testing.assert_allclose(r.lowest.object, [0, 0, 1 - np.sqrt(1 - 0.81)], atol=2e-5)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_decagon_with_tiny_noise_has_one_state(seed):
+    """Issue 25: a regular decagon at 0.9x with 1e-7 noise gave two stable states 1e-9 to
+    7e-7 apart, from every method."""
+    team, R = noisy_team(10, 1e-7, seed)
+    res = answers(team, R)
+    assert_agree(res, team.sheet.size)
+    assert all(len(r.stable) == 1 for r in res.values())
+
+
+@pytest.mark.parametrize("n", [5, 6])
+@pytest.mark.parametrize("noise", [1e-13, 1e-12, 1e-11, 1e-10, "digits"])
+def test_exhaustive_finds_the_hanging_state(n, noise):
+    """Issue 25: Algorithm 1 found no stable state on pentagons and hexagons at 0.9x with
+    noise 1e-13..1e-10 or written to 6 decimals, where "fast" found the one there is."""
+    team, R = digits_team(n) if noise == "digits" else noisy_team(n, noise, 7)
+    assert_agree(answers(team, R), team.sheet.size)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_octagon_with_noise_is_held(seed):
+    """Issue 25: an octagon at 0.9x plus 1e-7 noise was reported with a single
+    not_equilibrium state and no stable one."""
+    team, R = noisy_team(8, 1e-7, seed)
+    assert_agree(answers(team, R), team.sheet.size)
+
+
+def test_merged_state_is_every_cable_at_full_length():
+    """The hexagon written to 6 decimals split into two stable states 3.5e-6 apart, each on
+    4 cables with two zero weights; the one state is on the union of their cables, with
+    non-negative weights that balance it."""
+    team, R = digits_team(6)
+    res = ts.forward_kinematics(team, R, method="subsets")
+    (e,) = res.equilibria
+    assert e.stable and len(e.taut) >= 4
+    lengths = np.linalg.norm(team.sheet.vertices[list(e.taut)] - e.contact, axis=1)
+    reach = np.linalg.norm(np.c_[R[list(e.taut)], np.full(len(e.taut), 1.0)] - e.object,
+                           axis=1)
+    np.testing.assert_allclose(reach, lengths, atol=MERGE_RTOL * 4)
+    np.testing.assert_allclose(e.cable_lengths, lengths)
+    assert e.tensions is not None and np.all(e.tensions >= 0)
+
+
+def test_batch_merges_like_single_results():
+    """The batch reports the same states as the single calls, formation by formation."""
+    team, R0 = digits_team(6)
+    _, R1 = noisy_team(6, 1e-3, 3)
+    b = ts.forward_kinematics_batch(team, np.stack([R0, R1, R0]))
+    for k, R in enumerate([R0, R1, R0]):
+        one = ts.forward_kinematics(team, R)
+        assert int(b.count[k]) == len(one.equilibria)
+        np.testing.assert_allclose(b.object[k, :b.count[k]],
+                                   [e.object for e in one.equilibria], atol=1e-12)
+
+
+def test_lowest_by_direct_minimisation_says_so():
+    """A regular 16-gon at 0.9x written to 6 decimals: the enumeration reports only a
+    not-an-equilibrium state at the centre; the direct minimisation supplies the stable
+    state hanging there and the message says so."""
+    team, R = digits_team(16)
+    res = ts.forward_kinematics(team, R)
+    assert res.success and res.status == "ok"
+    assert res.direct and "direct minimisation" in res.message
+    assert len(res.lowest.taut) == 16
+
+
+def test_clear_cases_are_unchanged():
+    """Away from a similar copy nothing is merged or added (the square's one state)."""
+    team = SheetTeam(Sheet([[0, 0], [1, 0], [1, 1], [0, 1]]), 1.0)
+    res = ts.forward_kinematics(team, [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]])
+    assert not res.direct and res.message == "1 solution(s), 1 stable"
+    low = ts.forward_kinematics(SheetTeam(team.sheet, 0.2),
+                                [[0, 0], [0.9, 0], [0.9, 0.9], [0, 0.9]])
+    assert low.lowest is None and low.status == "infeasible"     # it would hang below the floor
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_mass_limit_on_every_path(backend):
+    """Issue 25: forward_kinematics(..., mass=1e308) returned tensions [inf, inf, inf] on
+    the compiled path; the limit lives in the team, which every path takes."""
+    with pytest.raises(InvalidInputError, match="mass"):
+        SheetTeam(Sheet([[0, 0], [1, 0], [0, 1]]), 1.0, mass=1e308)
+    team = SheetTeam(Sheet([[0, 0], [1, 0], [0, 1]]), 1.0, mass=1e6)
+    res = FKSolver(team, backend=backend).solve([[0, 0], [0.9, 0], [0, 0.9]])
+    assert all(np.all(np.isfinite(e.tensions)) for e in res.stable)
+
+
+def test_no_unreachable_error_class():
+    """IK answers an unreachable target with a result (status "unreachable"), never an
+    exception: the class the README once named does not exist."""
+    import taut.errors as errors
+    assert not hasattr(errors, "UnreachableTargetError")
