@@ -109,3 +109,10 @@ def test_edge_teams_have_one_answer(start):
     failures = [f for f in (check_team(s) for s in range(start, min(start + CHUNK, TEAMS)))
                 if f is not None]
     assert not failures, f"{len(failures)} failure(s); first: " + "; ".join(failures[:5])
+
+
+@pytest.mark.xfail(strict=True, reason="open: the one failure in seeds 0-99,999 (a regular "
+                   "hexagon held at 0.55x, noise 1e-9, 6 digits): fast finds no stable state "
+                   "and the direct minimisation a non-strict lowest one")
+def test_the_known_open_case_seed_34152():
+    assert check_team(34152) is None
