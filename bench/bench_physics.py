@@ -11,7 +11,7 @@ Measures, in one process on this machine:
   tendons), time to mesh and compile one state's model, wall time of ``replay_equilibria`` over every state, and the largest height /
   lateral differences physics vs taut (tied point load and released ball); the spacings
   are interleaved and repeated, medians and ranges quoted;
-* on random teams (``taut.sheet.random.random_team``, 3-8 robots, sheets 500-1000 mm
+* on random teams (``taut.sheet.random_hanging_team``, 3-8 robots, sheets 500-1000 mm
   across, hold heights 0.8-1.5 sheet radii: issue 31's sample), failed simulations, the
   distribution of the differences, the sheet's sideways pull
   at stable and at non-equilibrium states, how often physics holds a state taut does not
@@ -33,8 +33,8 @@ from taut.io import load_sheet_scenario
 from taut.physics import replay_equilibria
 from taut.physics._mesh import sheet_mesh
 from taut.physics._sheet_model import build_sheet_sim
-from taut.sheet import Sheet, SheetTeam, forward_kinematics
-from taut.sheet import random_team
+from taut.sheet import forward_kinematics
+from taut.sheet import random_hanging_team
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = {"Example 1": ROOT / "examples/sheet/example1.yaml",
@@ -100,14 +100,8 @@ def random_study(teams: int, seed: int) -> dict:
     states, walls = [], []
     k = 0
     while k < teams:
-        n = int(rng.integers(3, 9))
-        sheet, R = random_team(n, rng)
-        s = rng.uniform(500.0, 1000.0) / float(np.max(sheet.side_lengths()))
-        sheet, R = Sheet(sheet.vertices * s), R * s
-        radius = float(np.max(np.linalg.norm(sheet.vertices - sheet.vertices.mean(0), axis=1)))
-        team = SheetTeam(sheet, rng.uniform(0.8, 1.5) * radius)
-        if not forward_kinematics(team, R).equilibria:
-            continue
+        team, R = random_hanging_team(rng)
+        sheet, n = team.sheet, team.n
         width = float(np.max(sheet.side_lengths()))
         t0 = time.perf_counter()
         r = replay_equilibria(team, R)

@@ -190,6 +190,7 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.io", "cdpr_model_from_mapping"): {"data": None},
         ("taut.io", "plan_scenario_to_mapping"): {"scenario": f["scenario"]},
         ("taut.sheet", "random_convex_polygon"): {"n": 4, "rng": np.random.default_rng(0)},
+        ("taut.sheet", "random_hanging_team"): {"rng": np.random.default_rng(0)},
         ("taut.sheet", "random_team"): {"n": 4, "rng": np.random.default_rng(0)},
         ("taut.sheet", "random_scattered_team"): {"n": 4, "rng": np.random.default_rng(0)},
         ("taut.sheet", "Simulator"): {"formation": f["formation"]},

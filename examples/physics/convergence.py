@@ -24,7 +24,7 @@ import numpy as np
 
 from taut.io import load_sheet_scenario
 from taut.physics import replay_equilibria
-from taut.sheet import Sheet, SheetTeam, forward_kinematics, random_team
+from taut.sheet import SheetTeam, random_hanging_team
 
 SHEET = Path(__file__).resolve().parent.parent / "sheet"
 
@@ -38,14 +38,8 @@ def teams(n_random: int, examples: bool = True) -> list[tuple[str, SheetTeam, np
         out.append((name, sc.team, sc.formation))
     rng = np.random.default_rng(31)
     while len(out) < (2 if examples else 0) + n_random:
-        n = int(rng.integers(3, 9))
-        sheet, R = random_team(n, rng)
-        s = rng.uniform(500.0, 1000.0) / float(np.max(sheet.side_lengths()))
-        sheet, R = Sheet(sheet.vertices * s), R * s
-        radius = float(np.max(np.linalg.norm(sheet.vertices - sheet.vertices.mean(0), axis=1)))
-        team = SheetTeam(sheet, rng.uniform(0.8, 1.5) * radius)
-        if forward_kinematics(team, R).equilibria:
-            out.append((f"random N={n}", team, R))
+        team, R = random_hanging_team(rng)
+        out.append((f"random N={team.n}", team, R))
     return out
 
 

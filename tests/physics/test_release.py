@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from taut.sheet import Sheet, SheetTeam, forward_kinematics, random_team
+from taut.sheet import Sheet, SheetTeam, forward_kinematics, random_hanging_team
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -21,16 +21,8 @@ HEIGHT_TOL = 5.0          # mm
 
 
 def _team(rng):
-    while True:
-        n = int(rng.integers(3, 9))
-        sheet, R = random_team(n, rng)
-        s = rng.uniform(500.0, 1000.0) / float(np.max(sheet.side_lengths()))
-        sheet, R = Sheet(sheet.vertices * s), R * s
-        radius = float(np.max(np.linalg.norm(sheet.vertices - sheet.vertices.mean(0), axis=1)))
-        team = SheetTeam(sheet, rng.uniform(0.8, 1.5) * radius)
-        fk = forward_kinematics(team, R)
-        if fk.equilibria:
-            return team, R, fk
+    team, R = random_hanging_team(rng)
+    return team, R, forward_kinematics(team, R)
 
 
 def _point_load(team, R, v):

@@ -74,6 +74,8 @@ random_team
     A random sheet and a feasible formation of it.
 random_scattered_team
     A random sheet and robots scattered in any order (the harder case for FK).
+random_hanging_team
+    A random team, scaled and held so that its object has a rest state (physics samples).
 
 Constants and types
 -------------------
@@ -102,7 +104,8 @@ from .geometry import (FormationMetrics, formation_metrics, formation_size,
 from .ik.inverse import (IKCertificate, IKConstraints, IKResult, contact_weights,
                          formation_from_angles, ik_constraints, inverse_kinematics)
 from .model import Sheet, check_formation, check_formations, check_hold_height
-from .random import random_convex_polygon, random_scattered_team, random_team
+from .random import (random_convex_polygon, random_hanging_team, random_scattered_team,
+                     random_team)
 from .sim.results import EventKind, SimulationEvent, SimulationResult, SimulatorState
 from .sim.simulate import simulate
 from .sim.simulator import Simulator
@@ -124,7 +127,7 @@ __all__ = [
     "formation_metrics", "FormationMetrics", "minimum_enclosing_circle", "formation_size",
     "min_robot_distance", "max_obstacle_height", "max_obstacle_diameter",
     # Random teams
-    "random_convex_polygon", "random_team", "random_scattered_team",
+    "random_convex_polygon", "random_team", "random_scattered_team", "random_hanging_team",
     # Constants and types
     "GRAVITY", "Method", "METHODS", "Backend", "HAVE_NUMBA", "COMPILED_MAX_N",
     "EquilibriumKind",

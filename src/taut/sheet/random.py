@@ -7,8 +7,13 @@ import numpy as np
 from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance
 from ..errors import InvalidInputError
 from .model import Sheet
+from .team import SheetTeam
 
-__all__ = ["random_convex_polygon", "random_team", "random_scattered_team"]
+#: Draws :func:`random_hanging_team` makes before it gives up.
+HANGING_DRAWS = 1000
+
+__all__ = ["random_convex_polygon", "random_team", "random_scattered_team",
+           "random_hanging_team"]
 
 
 def random_convex_polygon(n: int, rng: np.random.Generator, *, radius: float = 1.0
@@ -75,6 +80,59 @@ def random_scattered_team(n: int, rng: np.random.Generator,
     ratio = np.linalg.norm(V[iu] - V[ju], axis=1) / np.linalg.norm(R[iu] - R[ju], axis=1)
     R = R * ratio.min() * rng.uniform(*slack) + rng.normal(scale=0.3, size=2)
     return Sheet(V), R
+
+
+def random_hanging_team(rng: np.random.Generator, *, robots: tuple[int, int] = (3, 8),
+                        width: tuple[float, float] = (500.0, 1000.0),
+                        hold: tuple[float, float] = (0.8, 1.5)
+                        ) -> tuple[SheetTeam, np.ndarray]:
+    """A random team whose object has a rest state: the sample of the physics checks.
+
+    Draws ``n`` in ``robots`` (inclusive) and :func:`random_team`, scales it so that the
+    sheet's longest side is uniform in ``width`` (sheet units), holds it at a height
+    uniform in ``hold`` times the sheet radius (largest vertex distance from the vertices'
+    centroid), and draws again until forward kinematics finds a rest state.
+
+    Returns
+    -------
+    team : SheetTeam
+    formation : ndarray, shape (n, 2)
+
+    Raises
+    ------
+    InvalidInputError
+        A bad range, or no team with a rest state in :data:`HANGING_DRAWS` draws.
+    """
+    from .fk.forward import forward_kinematics
+
+    require_instance(rng, np.random.Generator, "rng")
+    if not isinstance(robots, (tuple, list)) or len(robots) != 2:
+        raise InvalidInputError("robots", f"must be (low, high), got {robots!r}")
+    lo_n, hi_n = (as_count(v, "robots", minimum=3, maximum=MAX_ROBOTS) for v in robots)
+    w = _range(width, "width", MAX_SHEET_LENGTH)
+    h = _range(hold, "hold", MAX_SHEET_LENGTH)
+    if lo_n > hi_n:
+        raise InvalidInputError("robots", f"must be (low, high) with low <= high, got "
+                                          f"({lo_n}, {hi_n})")
+    for _ in range(HANGING_DRAWS):
+        n = int(rng.integers(lo_n, hi_n + 1))
+        sheet, R = random_team(n, rng)
+        scale = rng.uniform(*w) / float(np.max(sheet.side_lengths()))
+        sheet, R = Sheet(sheet.vertices * scale), R * scale
+        radius = float(np.max(np.linalg.norm(sheet.vertices - sheet.vertices.mean(0), axis=1)))
+        team = SheetTeam(sheet, rng.uniform(*h) * radius)
+        if forward_kinematics(team, R).equilibria:
+            return team, R
+    raise InvalidInputError("hold", f"no team with a rest state in {HANGING_DRAWS} draws")
+
+
+def _range(value: object, field: str, limit: float) -> tuple[float, float]:
+    """``value`` as ``(low, high)`` with 0 < low <= high <= ``limit``."""
+    lo, hi = as_array(value, field, shape=(2,))
+    if not 0.0 < lo <= hi <= limit:
+        raise InvalidInputError(field, f"must be (low, high) with 0 < low <= high <= "
+                                       f"{limit:g}, got ({lo:g}, {hi:g})")
+    return float(lo), float(hi)
 
 
 def _slack(slack: object) -> tuple[float, float]:
