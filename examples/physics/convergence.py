@@ -24,6 +24,7 @@ import numpy as np
 
 from taut.io import load_sheet_scenario
 from taut.physics import replay_equilibria
+from taut.physics._mesh import sheet_mesh_spacing
 from taut.sheet import SheetTeam, random_hanging_team
 
 SHEET = Path(__file__).resolve().parent.parent / "sheet"
@@ -58,7 +59,7 @@ def main() -> None:
             t0 = time.perf_counter()
             r = replay_equilibria(team, R, mesh=mesh)
             wall = time.perf_counter() - t0
-            h = float(np.max(team.sheet.side_lengths())) / mesh
+            h = sheet_mesh_spacing(team.sheet.vertices, mesh)
             for s in r.states:
                 if s.kind != "stable":
                     continue

@@ -30,15 +30,16 @@ def sheet_table(name: str, path: Path, figure: str) -> None:
     sc = load_sheet_scenario(path)
     r = replay_equilibria(sc.team, sc.formation)
     print(f"\n### {name}\n\n{r.message} (mesh {r.mesh}, ball radius {r.ball:.1f} mm)\n")
-    print("| taut set | taut: z_o [mm] | taut says | physics | pull / mg | tied dx, dy, dz [mm] "
-          "| released dx, dy, dz [mm] | s |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| taut set | taut: z_o [mm] | taut says | physics | pull / mg | taut's pull / mg "
+          "| tied dx, dy, dz [mm] | released dx, dy, dz [mm] | s |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for s in r.states:
         label = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
         fmt = lambda d: ", ".join(f"{v:+.1f}" for v in d)  # noqa: E731
         released = fmt(s.difference) if s.success else f"FAILED: {s.message}"
+        held = ("held" if s.held else "not held") + ("" if s.resolved else " (unresolved)")
         print(f"| {label} | {s.predicted[2]:.1f} | {s.kind.replace('_', ' ')} | "
-              f"{'held' if s.held else 'not held'} | {s.sliding:.3f} | "
+              f"{held} | {s.sliding:.3f} | {s.predicted_sliding:.3f} | "
               f"{fmt(s.tied_difference)} | {released} | {s.time:.1f} |")
     fig = plot_equilibria_check(r, sc.formation, sc.team.hold_height, HERE / figure, units="mm",
                                 title=name)
@@ -65,7 +66,8 @@ if __name__ == "__main__":
     from taut.cli._progress import working  # progress on stderr past 2 s
     with working("physics examples"):
         np.set_printoptions(precision=2)
-        sheet_table("FK paper Example 1 (4 robots)", SHEET / "example1.yaml", "example1_settled.png")
+        sheet_table("FK paper Example 1 (4 robots)", SHEET / "example1.yaml",
+                    "example1_settled.png")
         sheet_table("FK paper Example 2 (8 robots, r2 and r4 at +-353 mm)",
                     SHEET / "example2_r2_r4_353mm.yaml", "example2_settled.png")
         tipping_table()

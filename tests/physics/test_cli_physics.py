@@ -66,7 +66,7 @@ def test_a_failed_simulation_is_shown_as_failed(capsys, triangle, tmp_path, monk
     monkeypatch.setattr(_tol, "MAX_SETTLE_TIME", 0.1)
     code, out, err = run(capsys, "physics", triangle)
     assert code == 1, err
-    assert "FAILED (not converged)" in out and "1 of 1 simulation(s) failed" in out
+    assert "FAILED (not converged)" in out and "1 of 1 state(s) not confirmed" in out
     assert "failed: {1,2,3}: the tied sheet was still moving" in out
     png = tmp_path / "tri.png"
     code, out, _ = run(capsys, "physics", triangle, "--json", "--plot", png)
@@ -76,3 +76,27 @@ def test_a_failed_simulation_is_shown_as_failed(capsys, triangle, tmp_path, monk
     assert state["status"] == "not_converged" and not state["success"]
     assert state["settled"] == [None, None, None] and state["moved"] is None
     assert png.stat().st_size > 10_000
+
+
+def test_object_radius_is_checked_by_the_loader(capsys, triangle, tmp_path):
+    data = yaml.safe_load(triangle.read_text())
+    for bad, why in (({"radius": -1.0}, "greater than 0"), ({"radius": True}, "boolean"),
+                     ({"size": 3.0}, "")):
+        path = tmp_path / "bad.yaml"
+        path.write_text(yaml.safe_dump({**data, "object": bad}))
+        code, out, err = run(capsys, "physics", path)
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+        assert err.startswith("taut: error: object.") and why in err
+
+
+@pytest.mark.slow
+def test_the_scenario_object_is_the_simulated_ball(capsys, triangle, tmp_path):
+    # object.radius (scenario units) becomes the ball's radius, mass (kg) its mass.
+    pytest.importorskip("mujoco")
+    path = tmp_path / "obj.yaml"
+    path.write_text(yaml.safe_dump({**yaml.safe_load(triangle.read_text()),
+                                    "object": {"radius": 12.0}, "mass": 2.5}))
+    code, out, err = run(capsys, "physics", path, "--json", "--mesh", "7")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["ball_radius"] == 12.0 and data["states"][0]["held"]

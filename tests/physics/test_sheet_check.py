@@ -110,3 +110,62 @@ def test_units_and_placement_do_not_change_the_answer():
     for a, b in zip(mm.states, m.states):
         np.testing.assert_allclose(b.tied_difference * 1000, a.tied_difference, atol=0.5)
         assert abs(b.sliding - a.sliding) <= 0.01
+
+
+def _seed2026_team(k):
+    """Team ``k`` of issue 31's sample (seed 2026 of ``random_hanging_team``)."""
+    from taut.sheet import random_hanging_team
+
+    rng = np.random.default_rng(2026)
+    for _ in range(k + 1):
+        team, R = random_hanging_team(rng)
+    return team, R
+
+
+def test_a_four_cable_stable_state_is_held():
+    # Team 18 of the sample: one stable state with four taut cables. The tied point load
+    # is statically indeterminate; the tensions MuJoCo returned pulled it sideways with
+    # 0.22 mg, but a member of their family pulls it nowhere (0.001 mg), so it is held.
+    team, R = _seed2026_team(18)
+    check = replay_equilibria(team, R)
+    (s,) = check.states
+    assert s.kind == "stable" and len(s.taut) == 4
+    assert s.held and s.sliding <= 0.01 and s.predicted_sliding <= 1e-6
+    assert check.success, check.message
+
+
+def test_mass_does_not_change_the_answer():
+    # Node masses scale with the ball's: every force scales with the load, the motion is
+    # the same (a massless sheet's statics do not depend on the load).
+    sheet = Sheet.regular(3, 600.0)
+    R = 0.75 * sheet.vertices + [30.0, -20.0]
+    light = replay_equilibria(SheetTeam(sheet, 700.0, 0.05), R, mesh=7)
+    heavy = replay_equilibria(SheetTeam(sheet, 700.0, 50.0), R, mesh=7)
+    for a, b in zip(light.states, heavy.states):
+        np.testing.assert_allclose(a.tied, b.tied, atol=1e-6)
+        np.testing.assert_allclose(a.settled, b.settled, atol=1e-6)
+        assert abs(a.sliding - b.sliding) <= 1e-6
+
+
+@pytest.mark.slow
+def test_issue31_sample_disagreements_explained():
+    # Team 9: {1,4,5,6} is not an equilibrium 0.36 mm from the stable {1,4,6}; taut's own
+    # pull there is 0.002 mg, below the hold tolerance: unresolved, not a disagreement.
+    # Team 3: the stable {1,4,5} is 181 mm above the team's lowest state {1,2,4} over a
+    # rim at most 1.4 mm high; the released ball (reach 9.7 mm) leaves it for {1,2,4}:
+    # reported as marginal (not_strict), not as an agreement.
+    team, R = _seed2026_team(9)
+    check = replay_equilibria(team, R)
+    by = {s.taut: s for s in check.states}
+    s = by[(0, 3, 4, 5)]
+    assert s.kind == "not_equilibrium" and not s.resolved and s.agrees
+    assert s.predicted_sliding < check.hold_tolerance
+    assert all(t.resolved for t in check.states if t is not s)
+    team, R = _seed2026_team(3)
+    check = replay_equilibria(team, R)
+    by = {s.taut: s for s in check.states}
+    s = by[(0, 3, 4)]
+    assert s.kind == "stable" and s.held and s.status == "not_strict"
+    assert s.reached == (0, 1, 3) and s.basin < 2.0
+    assert abs(s.settled[2] - by[(0, 1, 3)].predicted[2]) <= HEIGHT_TOL
+    assert check.status == "not_strict" and "marginal" in check.message

@@ -15,22 +15,30 @@ from ._paths import ANIMATION_SUFFIXES, output_path
 def format_check(check: Any, *, name: str | None, units: str | None) -> str:
     """Plain-text table, robots numbered 1..N as in the papers."""
     u = f" [{units}]" if units else ""
-    head = ("taut", "taut says", "physics", "pull/mg", f"tied dx, dy, dz{u}",
+    head = ("taut", "taut says", "physics", "pull/mg", "taut pull/mg", f"tied dx, dy, dz{u}",
             f"released dx, dy, dz{u}", "agrees", "s")
     rows = [head]
     for s in check.states:
-        released = (", ".join(f"{v:+.1f}" for v in s.difference) if s.success
+        released = (", ".join(f"{v:+.1f}" for v in s.difference)
+                    if s.success or s.status == "not_strict"
                     else f"FAILED ({s.status.replace('_', ' ')})")
+        if s.reached is not None:
+            released += " -> {" + ",".join(str(i + 1) for i in s.reached) + "}"
+        if s.status == "not_strict":
+            released += " MARGINAL"
+        held = "held" if s.held else "not held"
         rows.append(("{" + ",".join(str(i + 1) for i in s.taut) + "}",
-                     s.kind.replace("_", " "), "held" if s.held else "not held",
-                     f"{s.sliding:.3f}", ", ".join(f"{v:+.1f}" for v in s.tied_difference),
+                     s.kind.replace("_", " "), held if s.resolved else f"{held} (unresolved)",
+                     f"{s.sliding:.3f}", f"{s.predicted_sliding:.3f}",
+                     ", ".join(f"{v:+.1f}" for v in s.tied_difference),
                      released, "yes" if s.agrees else "NO", f"{s.time:.1f}"))
     widths = [max(len(r[c]) for r in rows) for c in range(len(head))]
     lines = [name] if name else []
     lines.append(f"MuJoCo check, mesh {check.mesh}, ball radius {check.ball:.3g}{u}: "
                  f"{check.message}")
     lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
-    lines += [f"failed: {s.message}" for s in check.states if not s.success]
+    lines += [f"{'marginal' if s.status == 'not_strict' else 'failed'}: {s.message}"
+              for s in check.states if not s.success]
     return "\n".join(lines)
 
 
@@ -50,8 +58,10 @@ def register(app: typer.Typer) -> None:
                                            "sheet's widest vertex pair (default 10)."),
     ) -> None:
         """Check taut's rest states in MuJoCo: tie the object at each state's contact
-        point, settle, release; exit 1 when physics disagrees with taut or a simulation
-        failed (the object left the sheet, diverged or did not settle)."""
+        point, settle, release; exit 1 when physics disagrees with taut, a simulation
+        failed (the object left the sheet, diverged or did not settle) or a released
+        object left a marginal stable state. The ball has the scenario's object.radius
+        and mass when given."""
         from ..io.serialize import equilibria_check_to_dict, to_json
         from ..io.sheet_scenario import load_sheet_scenario
 
@@ -73,10 +83,11 @@ def register(app: typer.Typer) -> None:
             with Progress(transient=True) as bar:
                 task = bar.add_task("settling each state", total=None)
                 check = replay_equilibria(sc.team, sc.formation, mesh=div,
+                                          ball=sc.object_radius,
                                           progress=lambda d, t: bar.update(task, completed=d,
                                                                            total=t))
         else:
-            check = replay_equilibria(sc.team, sc.formation, mesh=div)
+            check = replay_equilibria(sc.team, sc.formation, mesh=div, ball=sc.object_radius)
         if as_json:
             typer.echo(to_json(equilibria_check_to_dict(check)))
         else:
@@ -90,7 +101,7 @@ def register(app: typer.Typer) -> None:
                 typer.echo(f"figure written to {plot}")
         if video is not None:
             from ..viz.physics import animate_settle
-            drop = settle(sc.team, sc.formation, trace=True, mesh=div)
+            drop = settle(sc.team, sc.formation, trace=True, mesh=div, ball=sc.object_radius)
             animate_settle(drop, sc.formation, sc.team.hold_height, video)
             if not as_json:
                 typer.echo(f"animation written to {video}")

@@ -18,7 +18,7 @@ from scipy.spatial import Delaunay
 
 from . import _tol
 
-__all__ = ["SheetMesh", "sheet_mesh"]
+__all__ = ["SheetMesh", "sheet_mesh", "sheet_mesh_spacing"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,6 +101,12 @@ def _unobstructed(nodes: np.ndarray, pairs: np.ndarray, spacing: float) -> np.nd
     return keep
 
 
+def sheet_mesh_spacing(vertices: np.ndarray, divisions: int) -> float:
+    """Target node spacing: the sheet's largest vertex distance over ``divisions``."""
+    V = np.asarray(vertices, dtype=float)
+    return float(np.max(np.linalg.norm(V[:, None] - V[None], axis=2))) / divisions
+
+
 def sheet_mesh(vertices: np.ndarray, divisions: int, *, contact: np.ndarray | None = None,
                reach: float = 4.5) -> SheetMesh:
     """Mesh a convex sheet with about ``divisions`` spacings across its widest pair.
@@ -117,8 +123,7 @@ def sheet_mesh(vertices: np.ndarray, divisions: int, *, contact: np.ndarray | No
         Pairs within ``reach`` spacings get a tendon.
     """
     V = np.asarray(vertices, dtype=float)
-    D = float(np.max(np.linalg.norm(V[:, None] - V[None], axis=2)))
-    h = D / divisions
+    h = sheet_mesh_spacing(V, divisions)
     bnd, corners = _boundary(V, h)
     inner = _interior(V, h)
     nodes = np.vstack([bnd, inner])

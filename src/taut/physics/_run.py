@@ -7,6 +7,7 @@ import numpy as np
 from .._units import GRAVITY
 from . import _tol
 from ._sheet_model import SheetSim
+from ._statics import least_pull
 from ._surface import surface_below
 
 __all__ = ["ramp", "settle_phase", "ball_position", "node_positions", "release",
@@ -25,18 +26,48 @@ def node_positions(sim: SheetSim) -> np.ndarray:
 
 
 def ramp(sim: SheetSim) -> None:
-    """Move the corners from the flat copy to the robots with gravity off."""
+    """Move the corners from the flat copy to the robots with gravity and contacts off,
+    then put an untied ball just above the sheet under it (:func:`_above_sheet`).
+
+    Contacts are off while the sheet moves into place: a contact node kept under a held
+    ball (``pin_contact``) can be dragged tens of millimetres across the flat sheet, which
+    folds it, and a fold sweeping under a small ball pushed it through the sheet (seen
+    next to a corner, 70 mm from a robot with 50 mm spacing)."""
     import mujoco
 
     m, d = sim.model, sim.data
     m.opt.gravity[:] = 0.0
+    flags = int(m.opt.disableflags)
+    m.opt.disableflags = flags | int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     steps = max(1, int(round(_tol.RAMP_TIME / m.opt.timestep)))
     for k in range(1, steps + 1):
         s = k / steps
         s = s * s * (3 - 2 * s)            # smooth start and stop
         d.mocap_pos[sim.corner_mocap] = (1 - s) * sim.corner_start + s * sim.corner_goal
         mujoco.mj_step(m, d)
+    m.opt.disableflags = flags
+    if sim.tie < 0:
+        _above_sheet(sim)
     m.opt.gravity[:] = (0.0, 0.0, -GRAVITY)
+
+
+def _above_sheet(sim: SheetSim) -> None:
+    """Raise the ball (never lower it) so its centre is two contact offsets (ball plus
+    sheet collision radius, ``ball_offset``) above every node within a mesh spacing of it
+    horizontally, as on the flat start; it is left at rest."""
+    import mujoco
+
+    nodes = node_positions(sim)
+    ball = ball_position(sim)
+    reach = sim.mesh.spacing * sim.scale + sim.ball_offset
+    near = np.linalg.norm(nodes[:, :2] - ball[:2], axis=1) <= reach
+    if not np.any(near):
+        return
+    lift = float(nodes[near, 2].max()) + 2 * sim.ball_offset - ball[2]
+    if lift > 0:
+        sim.data.qpos[sim.ball_qpos + 2] += lift
+    sim.data.qvel[sim.ball_dof:sim.ball_dof + 6] = 0.0
+    mujoco.mj_forward(sim.model, sim.data)
 
 
 def _speeds(sim: SheetSim) -> tuple[float, float]:
@@ -55,7 +86,9 @@ def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None,
     as soon as the ball has left the sheet (:func:`left_sheet`).
 
     Returns (outcome, simulated time taken in s); outcome is ``"settled"``,
-    ``"moving"`` (time limit), ``"diverged"`` (non-finite state) or ``"left"``."""
+    ``"moving"`` (time limit), ``"diverged"`` (non-finite state, or one of MuJoCo's own
+    instability warnings: bad qpos/qvel/qacc, constraint or contact buffer full) or
+    ``"left"``."""
     import mujoco
 
     m, d = sim.model, sim.data
@@ -68,7 +101,7 @@ def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None,
             trace.append((d.time, *ball_position(sim)))
         if frames is not None:
             frames.append(node_positions(sim))
-        if not np.all(np.isfinite(d.qpos)):
+        if not np.all(np.isfinite(d.qpos)) or _unstable(sim):
             return "diverged", d.time - t0
         if watch and left_sheet(sim):
             return "left", d.time - t0
@@ -78,28 +111,50 @@ def settle_phase(sim: SheetSim, max_time: float, trace: list | None = None,
     return "moving", d.time - t0
 
 
+def _unstable(sim: SheetSim) -> bool:
+    """MuJoCo flagged a bad position, velocity or acceleration (it then resets the state,
+    which must not pass for a rest state) or ran out of room for constraints."""
+    import mujoco
+
+    w = sim.data.warning
+    return any(w[int(k)].number > 0 for k in (
+        mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQPOS,
+        mujoco.mjtWarning.mjWARN_BADQVEL, mujoco.mjtWarning.mjWARN_CNSTRFULL,
+        mujoco.mjtWarning.mjWARN_CONTACTFULL))
+
+
 def left_sheet(sim: SheetSim) -> bool:
-    """The untied ball is off the sheet: no sheet triangle lies straight below its centre,
-    or its centre is lower than the sheet's lowest node (it went through; a ball on the
-    sheet is always above that node, the sheet being a surface over its nodes)."""
+    """The untied ball is off the sheet: its centre is lower than the sheet's lowest node
+    (it went through; a ball on the sheet is always above that node, the sheet being a
+    surface over its nodes), or no sheet triangle lies straight below its centre and it
+    does not touch the sheet (it fell off; a ball resting in the tip of a crease touches
+    the sheet although the folded triangles around the tip's node need not cover the
+    point straight above it)."""
     if sim.tie >= 0 and sim.data.eq_active[sim.tie]:
         return False
     nodes = node_positions(sim)
     ball = ball_position(sim)
-    return (ball[2] < float(nodes[:, 2].min())
-            or surface_below(nodes, sim.mesh.triangles, ball) is None)
+    if ball[2] < float(nodes[:, 2].min()):
+        return True
+    return sim.data.ncon == 0 and surface_below(nodes, sim.mesh.triangles, ball) is None
 
 
 def object_on_sheet(sim: SheetSim) -> tuple[np.ndarray, np.ndarray] | None:
     """The sheet point under the ball's centre: world position (3,) and flat sheet
-    coordinates (2,), both in scenario units; None when the ball is off the sheet."""
+    coordinates (2,), both in scenario units; None when the ball is off the sheet
+    (:func:`left_sheet`). In the tip of a crease, where no triangle covers the point
+    under the centre, the nearest node stands for it (its height, under the centre)."""
     if sim.tie >= 0 and sim.data.eq_active[sim.tie]:
         k = sim.mesh.contact
         return node_positions(sim)[k] / sim.scale, sim.mesh.nodes[k].copy()
     nodes = node_positions(sim)
+    if left_sheet(sim):
+        return None
     hit = surface_below(nodes, sim.mesh.triangles, ball_position(sim))
     if hit is None:
-        return None
+        ball = ball_position(sim)
+        k = int(np.argmin(np.linalg.norm(nodes - ball, axis=1)))
+        return np.append(ball[:2], nodes[k, 2]) / sim.scale, sim.mesh.nodes[k].copy()
     z, tri, bary = hit
     corners = sim.mesh.triangles[tri]
     xy = ball_position(sim)[:2]
@@ -107,19 +162,12 @@ def object_on_sheet(sim: SheetSim) -> tuple[np.ndarray, np.ndarray] | None:
     return np.append(xy, z) / sim.scale, flat
 
 
-def sliding_force(sim: SheetSim) -> np.ndarray:
-    r"""Net pull of the sheet's tendons on the contact node resolved in the flat sheet,
-    :math:`\sum_j T_j (\mathbf{v}_j - \mathbf{v}_o) / |\mathbf{v}_j - \mathbf{v}_o|`, N,
-    shape (2,), with :math:`T_j` the tendon-limit forces MuJoCo's solver found.
-
-    A frictionless object at the contact point is in equilibrium on the sheet only when
-    this vanishes: with taut's weights it is :math:`(mg/d) \sum_i w_i (\mathbf{v}_i -
-    \mathbf{v}_o) = 0` (docs/sheet_kinematics.md §3); a non-zero value means the sheet
-    slides under the object.
-    """
+def _contact_tendons(sim: SheetSim) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tendons at their limit that end at the contact node: MuJoCo's constraint force on
+    each (N), the node at the other end, and the tendon ids."""
     import mujoco
 
-    m, d = sim.model, sim.data
+    d = sim.data
     k = sim.mesh.contact
     rows = np.flatnonzero(np.asarray(d.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON))
     ids = np.asarray(d.efc_id)[rows]
@@ -127,9 +175,43 @@ def sliding_force(sim: SheetSim) -> np.ndarray:
     pairs = sim.tendon_pairs[ids]
     at = (pairs[:, 0] == k) | (pairs[:, 1] == k)
     other = np.where(pairs[at, 0] == k, pairs[at, 1], pairs[at, 0])
+    return force[at], other, ids[at]
+
+
+def sliding_force(sim: SheetSim) -> np.ndarray:
+    r"""Least net pull of the sheet's tendons on the contact node resolved in the flat
+    sheet, :math:`\sum_j T_j (\mathbf{v}_j - \mathbf{v}_o) / |\mathbf{v}_j - \mathbf{v}_o|`,
+    N, shape (2,), over the tendon forces that hold the node as MuJoCo's solver found.
+
+    A frictionless object at the contact point is in equilibrium on the sheet only when
+    this vanishes: with taut's weights it is :math:`(mg/d) \sum_i w_i (\mathbf{v}_i -
+    \mathbf{v}_o) = 0` (docs/sheet_kinematics.md §3); a non-zero value means the sheet
+    slides under the object.
+
+    With four or more taut straight tendons from the contact node to held corners (a
+    state with four or more taut cables), the point load is statically indeterminate:
+    the corner tensions :math:`T_J` that balance it form a family :math:`T_J + N s \ge 0`
+    (:math:`N` spans the null space of their unit directions in space, read from the
+    simulated positions), and which member the solver returns is set by the soft
+    limits' compliance, not by the object. The object is held when *some* member pulls
+    it nowhere, so the pull returned is the least over the family (non-negative least
+    squares, :func:`taut.physics._statics.least_pull`). With three or fewer the family is
+    the measured forces alone.
+    """
+    k = sim.mesh.contact
+    force, other, _ = _contact_tendons(sim)
     u = sim.mesh.nodes[other] - sim.mesh.nodes[k]
     u /= np.linalg.norm(u, axis=1)[:, None]
-    return (force[at, None] * u).sum(axis=0)
+    pull = (force[:, None] * u).sum(axis=0)
+    corner = np.isin(other, sim.mesh.corners)
+    if corner.sum() < 4:
+        return pull
+    x = node_positions(sim)
+    space = x[other[corner]] - x[k]
+    space /= np.linalg.norm(space, axis=1)[:, None]
+    fixed = pull - (force[corner, None] * u[corner]).sum(axis=0)
+    least, _ = least_pull(fixed, u[corner], space, space.T @ force[corner])
+    return least
 
 
 def release(sim: SheetSim) -> None:

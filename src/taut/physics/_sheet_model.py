@@ -61,6 +61,7 @@ class SheetSim:
     tie: int                       # equality id of the tie (-1: none)
     tendon_pairs: np.ndarray       # (P, 2) node pair of each tendon, in tendon order
     xy_lock: tuple[int, ...] = ()  # equality ids locking the ball's x and y slides
+    ball_mass: float = _tol.BALL_MASS  # kg
 
 
 def _node_positions(mesh: SheetMesh, Q: np.ndarray, t: np.ndarray, hold: float,
@@ -71,10 +72,14 @@ def _node_positions(mesh: SheetMesh, Q: np.ndarray, t: np.ndarray, hold: float,
     return np.column_stack([xy, np.full(len(xy), hold * scale)])
 
 
-def _add_nodes(spec: Any, body_pos: np.ndarray, corners: set[int], dt: float) -> list[str]:
+def _add_nodes(spec: Any, body_pos: np.ndarray, corners: set[int], dt: float,
+               ball_mass: float) -> list[str]:
+    """Node bodies; their mass scales with the ball's (``NODE_MASS_PER_DT2`` is per
+    ``BALL_MASS``), so every mass, and with it every force, scales with the load and the
+    motion does not change: the statics of a massless sheet do not depend on the load."""
     import mujoco
 
-    mass = _tol.NODE_MASS_PER_DT2 * dt * dt
+    mass = _tol.NODE_MASS_PER_DT2 * dt * dt * ball_mass / _tol.BALL_MASS
     damping = mass / _tol.NODE_DAMPING_TIME
     names = []
     for k, p in enumerate(body_pos):
@@ -108,18 +113,19 @@ def _add_tendons(spec: Any, pairs: np.ndarray, rest: np.ndarray) -> None:
 def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray,
                     hold_height: float, *, ball_radius: float, ball_start: np.ndarray | None,
                     tie: bool, corner_tendons: bool, timestep: float = _tol.TIMESTEP,
-                    hold_xy: bool = False, pin_contact: bool = False) -> SheetSim:
+                    hold_xy: bool = False, pin_contact: bool = False,
+                    ball_mass: float = _tol.BALL_MASS) -> SheetSim:
     """Compile the model (reason for length: one linear recipe, step by step).
 
-    ``ball_start`` (3,) in scenario units; with ``tie`` the ball's centre is connected to
-    the contact node and contacts are off (a point load). With ``hold_xy`` (and no tie)
-    the ball moves on three slide joints and a ball joint instead of a free joint, and
-    its two horizontal slides are locked (equality constraints ``xy_lock``) until
-    :func:`taut.physics._run.release`: the ball presses the sheet down straight below its
-    start with contacts on, so the sheet forms its pocket under the ball (a ball put on a
-    sheet shaped by a point load can miss the pocket: it may be a narrow fold). With
-    ``pin_contact`` the mesh's contact node is also kept straight below the ball until
-    then.
+    ``ball_start`` (3,) in scenario units, ``ball_mass`` in kg; with ``tie`` the ball's
+    centre is connected to the contact node and contacts are off (a point load). With
+    ``hold_xy`` (and no tie) the ball moves on three slide joints and a ball joint instead
+    of a free joint, and its two horizontal slides are locked (equality constraints
+    ``xy_lock``) until :func:`taut.physics._run.release`: the ball presses the sheet down
+    straight below its start with contacts on, so the sheet forms its pocket under the
+    ball (a ball put on a sheet shaped by a point load can miss the pocket: it may be a
+    narrow fold). With ``pin_contact`` the mesh's contact node is also kept straight below
+    the ball until then.
     """
     import mujoco
 
@@ -139,7 +145,7 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     opt.gravity = [0.0, 0.0, -GRAVITY]
     opt.iterations = 50
     opt.ls_iterations = 20
-    names = _add_nodes(spec, pos, set(corners), timestep)
+    names = _add_nodes(spec, pos, set(corners), timestep, ball_mass)
     pairs, rest = mesh.pairs, mesh.rest * scale
     if corner_tendons:
         M = len(mesh.nodes)
@@ -178,7 +184,7 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     else:
         start = np.append(goal[:, :2].mean(axis=0), hold_height * scale + 2 * offset)
     ball = spec.worldbody.add_body(name="ball", pos=start.tolist())
-    ball_damping = _tol.BALL_MASS / _tol.BALL_DAMPING_TIME
+    ball_damping = ball_mass / _tol.BALL_DAMPING_TIME
     if hold_xy:
         for name, axis in (("x", (1, 0, 0)), ("y", (0, 1, 0)), ("z", (0, 0, 1))):
             ball.add_joint(name=f"ball_{name}", type=mujoco.mjtJoint.mjJNT_SLIDE,
@@ -204,7 +210,7 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
     else:
         ball.add_joint(name="ball", type=mujoco.mjtJoint.mjJNT_FREE, damping=ball_damping)
     ball.add_geom(name="ball", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r, 0, 0],
-                  mass=_tol.BALL_MASS, contype=1, conaffinity=1, condim=1,
+                  mass=ball_mass, contype=1, conaffinity=1, condim=1,
                   solref=list(_tol.SOLREF), solimp=list(_tol.SOLIMP), rgba=[0.9, 0.3, 0.2, 1.0])
     if tie:
         # Tied, the ball's centre is pinned to the contact node and contacts are off
@@ -231,6 +237,6 @@ def build_sheet_sim(mesh: SheetMesh, vertices: np.ndarray, formation: np.ndarray
                    pos[corners].copy(), goal, bb, int(model.jnt_qposadr[jid]),
                    int(model.jnt_dofadr[jid]), offset, model.geom("ball").id,
                    0 if tie else -1, pairs,
-                   tuple(range(model.neq)) if hold_xy and not tie else ())
+                   tuple(range(model.neq)) if hold_xy and not tie else (), ball_mass)
     mujoco.mj_forward(model, data)
     return sim

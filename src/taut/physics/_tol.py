@@ -21,13 +21,17 @@ SLIVER = 1e-6
 SIM_DIAMETER = 1.0
 #: Time step, s (the recipe: about 4 ms with implicitfast and Newton).
 TIMESTEP = 0.004
-#: Node mass per squared time step, kg/s^2: node mass 3 g at 4 ms. Kept constant when the
-#: step changes so the constraint impedance (set by mass / dt^2) stays the same.
+#: Node mass per squared time step, kg/s^2: node mass 3 g at 4 ms for a ball of
+#: ``BALL_MASS``. Kept constant when the step changes so the constraint impedance (set by
+#: mass / dt^2) stays the same; scaled with the ball's mass so the motion does not depend
+#: on the load.
 NODE_MASS_PER_DT2 = 0.003 / 0.004 ** 2
 #: Damping time constant of the nodes' slide joints, s (light: much slower than a step).
 NODE_DAMPING_TIME = 0.02
-#: Object (ball) mass in the simulation, kg. FK of the massless inextensible sheet does not
-#: depend on the mass, so it is fixed rather than taken from the scenario.
+#: Ball mass when the team has no object mass, kg. FK of the massless inextensible sheet
+#: does not depend on the mass; with node masses scaled to the ball's, neither does the
+#: simulated motion (every force scales with the load: MuJoCo's soft constraints act in
+#: acceleration space).
 BALL_MASS = 1.0
 #: Damping time constant of the ball's free joint, s.
 BALL_DAMPING_TIME = 0.15
@@ -60,13 +64,32 @@ CHECK_INTERVAL = 0.1
 #: Longest simulated settling time of one phase, s.
 MAX_SETTLE_TIME = 6.0
 #: Longest simulated time after release, s: only the released ball's rest position comes
-#: from it (a ball rolling off a non-equilibrium can run for long).
-RELEASE_TIME = 3.0
+#: from it (a ball rolling off a non-equilibrium can run for long: one released near a
+#: corner of a 3-robot sheet, 41 mm above the lowest state, rolled along the valley for
+#: 4.3 s before it came to rest, tests/physics/test_release.py).
+RELEASE_TIME = 6.0
 #: The object counts as held when the sheet's net sideways pull on it at the contact point
 #: is at most this fraction of its weight. Measured (mesh 10): 0.01-0.05 at the stable
 #: states of the FK paper's Example 1 (<= 0.02 with corner tendons), 0.33 at its
 #: not-an-equilibrium state; see the 20-team table in examples/physics/README.md.
 HOLD_FRACTION = 0.05
+#: Weight of the force-balance rows (dimensionless, both sides in N) when the least pull of
+#: a statically indeterminate contact node is found by non-negative least squares
+#: (``sliding_force`` in _run.py): the balance then holds to about 1e-6 of the weight
+#: while the pull is minimised.
+BALANCE_WEIGHT = 1e3
+#: Unbalanced resultant (fraction of the weight) above which taut cables cannot carry the
+#: weight with non-negative tensions: a balance that can be met leaves at most
+#: |pull| / BALANCE_WEIGHT^2 (about 1e-6), a weight outside the cables' cone far more.
+BALANCE_SLACK = 1e-4
+#: Stopping tolerance of the bounded least squares behind that pull (relative change of
+#: the cost): far below any pull the checks compare.
+LSQ_TOL = 1e-14
+#: Samples along the straight path between two rest states when the rim of a basin is
+#: bounded (``barrier`` in _statics.py): 40 steps of the contact point.
+BARRIER_SAMPLES = 41
+#: SLSQP's tolerance on the object's height (scenario units) in the lowest point load.
+POINT_LOAD_FTOL = 1e-12
 
 # --- mobile cable robot (taut.physics.replay_tipping) ---
 #: Time step of the cable-robot simulation, s.

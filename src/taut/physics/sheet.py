@@ -1,14 +1,14 @@
 """Sheet-carrying teams in MuJoCo: drop the object, and check taut's rest states.
 
 See :mod:`taut.physics._sheet_model` for the recipe and examples/physics/README.md for the
-measured accuracy. Lengths in the scenario's unit (any consistent unit); the object's mass
-does not enter (forward kinematics of the massless inextensible sheet does not depend on
-it), the simulation uses a fixed 1 kg ball.
+measured accuracy. Lengths in the scenario's unit (any consistent unit); the ball has the
+team's mass (kg; 1 kg when the team has none: forward kinematics of the massless
+inextensible sheet does not depend on it).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -20,8 +20,9 @@ from ..errors import InvalidInputError
 from ..sheet import Equilibrium, Sheet, SheetTeam, check_formation, forward_kinematics
 from ..sheet.team import require_team
 from . import _run, _tol
-from ._mesh import SheetMesh, sheet_mesh
+from ._mesh import SheetMesh, sheet_mesh, sheet_mesh_spacing
 from ._sheet_model import build_sheet_sim
+from ._statics import barrier, model_pull
 
 __all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "replay_equilibria",
            "DEFAULT_MESH"]
@@ -89,14 +90,26 @@ class StateCheck:
     tied : ndarray, shape (3,)
         Where the object settled tied to the sheet at taut's contact point.
     settled : ndarray, shape (3,)
-        Where it came to rest after being released there (NaN when the run failed: see
-        ``status``).
+        Where it came to rest after being released there (NaN when a run failed: see
+        ``status``; kept when the state is ``"not_strict"``).
     held : bool
         The simulated sheet holds the object at taut's contact point: its tendons' net pull
         on the tied contact node, resolved in the flat sheet, is at most ``hold_tolerance``
         times the object's weight (a frictionless object is pulled sideways otherwise).
     sliding : float
-        That net pull divided by the object's weight (0 at an exact equilibrium).
+        That net pull divided by the object's weight (0 at an exact equilibrium). At a
+        state with four or more taut cables the point load is statically indeterminate
+        and this is the least pull over the tensions that hold it (see
+        :func:`taut.physics._run.sliding_force`).
+    predicted_sliding : float
+        The least sideways pull taut's own model exerts on the object there, as a
+        fraction of its weight (0 at an equilibrium; ``inf`` when the taut cables cannot
+        carry the weight): what ``sliding`` measures.
+    resolved : bool
+        The held verdict can tell taut's verdict apart: false for a state that is not an
+        equilibrium but whose model pull is at most ``hold_tolerance`` (it lies within the
+        check's resolution of an equilibrium, usually a stable state a fraction of a
+        millimetre away), where held or not held is not evidence either way.
     difference : ndarray, shape (3,)
         ``settled - predicted`` (ball radius accounted for), scenario units (NaN when the
         run failed).
@@ -106,11 +119,20 @@ class StateCheck:
     tied_difference : ndarray, shape (3,)
         ``tied - predicted``.
     agrees : bool
-        ``held`` for a stable state, not held for a non-equilibrium (saddles: always).
+        ``held`` for a stable state, not held for a non-equilibrium (saddles and
+        unresolved states: always).
         Read from the tied run: it stands when only the release failed, not when the
         tied run itself did not settle (``message`` says which).
     time : float
         Wall-clock seconds spent on this state (build and simulation).
+    reached : tuple of int or None
+        The taut set of another of taut's rest states where the released object came to
+        rest (its settled position is nearer that state's object than this one's), else
+        None.
+    basin : float
+        When the released object left a stable state for another one: how far it must
+        rise to get there along a straight path of its contact point in the flat sheet, an
+        upper bound on the depth of this state's basin (scenario units); NaN otherwise.
     nodes : ndarray, shape (M, 3)
         The tied, settled sheet's node positions, scenario units (for figures).
     triangles : ndarray of int, shape (T, 3)
@@ -118,7 +140,10 @@ class StateCheck:
         The simulation's own outcome (:mod:`taut._outcome`): ``"ok"`` when the tied run
         came to rest and the released object settled on the sheet; ``"diverged"`` when
         the object left the sheet (fell through or off it) or the state became
-        non-finite; ``"not_converged"`` when a run was still moving at its time limit.
+        non-finite; ``"not_converged"`` when a run was still moving at its time limit;
+        ``"not_strict"`` when the released object left a stable state whose basin is
+        shallower than the ball's reach (ball plus sheet collision radius): a marginal
+        state that a finite object does not keep (``reached``, ``basin``).
     """
 
     taut: tuple[int, ...]
@@ -128,11 +153,15 @@ class StateCheck:
     settled: np.ndarray
     held: bool
     sliding: float
+    predicted_sliding: float
+    resolved: bool
     difference: np.ndarray
     moved: float
     tied_difference: np.ndarray
     agrees: bool
     time: float
+    reached: tuple[int, ...] | None
+    basin: float
     nodes: np.ndarray
     triangles: np.ndarray
     success: bool
@@ -148,7 +177,9 @@ class EquilibriaCheck:
     states held, states that are not equilibria not held; saddles either way) and every
     state's simulation succeeded; ``status`` is ``"ok"``, ``"unverified"`` (taut's answer
     failed the physics check) or else the first failed state's status (``"diverged"``,
-    ``"not_converged"``: the check could not be completed).
+    ``"not_converged"``: the check could not be completed; ``"not_strict"``: a released
+    object left a marginal stable state). States whose verdict is not resolved (see
+    :attr:`StateCheck.resolved`) are named in ``message``.
     ``hold_tolerance`` is the sliding pull, as a fraction of the object's weight, up to
     which the object counts as held.
     """
@@ -162,6 +193,11 @@ class EquilibriaCheck:
     message: str
 
 
+def _mass(team: SheetTeam) -> float:
+    """The ball's mass, kg: the team's object mass, else ``BALL_MASS``."""
+    return _tol.BALL_MASS if team.mass is None else float(team.mass)
+
+
 def _check_inputs(team: SheetTeam, formation: object, mesh: int, ball: float | None
                   ) -> tuple[np.ndarray, int, float]:
     sheet = require_team(team).sheet
@@ -170,7 +206,8 @@ def _check_inputs(team: SheetTeam, formation: object, mesh: int, ball: float | N
         raise InvalidInputError("mesh", f"must be an integer from 4 to 60 (spacings across "
                                         f"the sheet), got {mesh!r}")
     D = float(np.max(sheet.side_lengths()))
-    r = (_tol.BALL_RADIUS * D / mesh) if ball is None else as_positive(ball, "ball")
+    r = (_tol.BALL_RADIUS * sheet_mesh_spacing(sheet.vertices, int(mesh)) if ball is None
+         else as_positive(ball, "ball"))
     if r > 0.2 * D:
         raise InvalidInputError("ball", f"radius {r:g} is too large for a sheet {D:g} across")
     return R, int(mesh), r
@@ -184,8 +221,8 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
     Parameters
     ----------
     team : SheetTeam
-        The sheet and the holding height :math:`z_r`, scenario units (its mass is not
-        used: the simulation drops a 1 kg ball).
+        The sheet, the holding height :math:`z_r`, scenario units, and the ball's mass
+        (kg; 1 kg when the team has none).
     formation : array_like, shape (N, 2)
         Robot positions :math:`\\mathbf{r}_i`, scenario units.
     start : array_like, shape (3,), optional
@@ -219,7 +256,7 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
     max_t = as_positive(max_time, "max_time")
     m = sheet_mesh(sheet.vertices, div)
     sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=p0,
-                          tie=False, corner_tendons=False)
+                          tie=False, corner_tendons=False, ball_mass=_mass(team))
     _run.ramp(sim)
     rows: list | None = [] if trace else None
     frames: list | None = [] if trace else None
@@ -244,7 +281,7 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
 
 
 def _release_over(sheet: Sheet, R: np.ndarray, z: float, m: SheetMesh, xy: np.ndarray,
-                  radius: float, *, corner_tendons: bool
+                  radius: float, *, corner_tendons: bool, mass: float = _tol.BALL_MASS
                   ) -> tuple[str, float, tuple[np.ndarray, np.ndarray] | None]:
     """Hold the ball over ``xy`` (scenario units) while it presses the sheet down, let it
     go, and settle: (outcome of :func:`taut.physics._run.settle_phase`, simulated seconds
@@ -258,7 +295,7 @@ def _release_over(sheet: Sheet, R: np.ndarray, z: float, m: SheetMesh, xy: np.nd
     for pin in ((True, False) if m.contact is not None else (False,)):
         sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=start,
                               tie=False, corner_tendons=corner_tendons, hold_xy=True,
-                              pin_contact=pin)
+                              pin_contact=pin, ball_mass=mass)
         _run.ramp(sim)
         outcome, _ = _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, watch=True)
         if outcome not in ("left", "diverged"):
@@ -273,58 +310,104 @@ def _release_over(sheet: Sheet, R: np.ndarray, z: float, m: SheetMesh, xy: np.nd
     return outcome, t, found
 
 
+def _run_status(label: str, tied_run: str, outcome: str, t_rel: float) -> tuple[str, str]:
+    """Status and message of one state's two runs (tied, then released)."""
+    if tied_run == "diverged":
+        return "diverged", f"{label}: the tied run diverged (non-finite state)"
+    if tied_run != "settled":
+        return "not_converged", (f"{label}: the tied sheet was still moving after "
+                                 f"{_tol.MAX_SETTLE_TIME:g} s")
+    if outcome == "left":
+        when = f"{t_rel:.1f} s after release" if t_rel > 0 else "while it was being placed"
+        return "diverged", f"{label}: the object left the sheet {when}"
+    if outcome == "diverged":
+        return "diverged", f"{label}: the released run diverged (non-finite state)"
+    if outcome == "moving":
+        return "not_converged", (f"{label}: the released object was still moving after "
+                                 f"{t_rel:.1f} s simulated")
+    return "ok", f"{label}: released object settled after {t_rel:.1f} s"
+
+
+def _label(taut: tuple[int, ...]) -> str:
+    return "{" + ",".join(str(i + 1) for i in taut) + "}"
+
+
 def _replay_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
-                  tol: float, *, corner_tendons: bool) -> StateCheck:
+                  tol: float, *, corner_tendons: bool, mass: float) -> StateCheck:
     import time
 
     t0 = time.perf_counter()
     m = sheet_mesh(sheet.vertices, div, contact=eq.contact)
     # Tied: a point load at the contact node, contacts off (the model's object).
     sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=None,
-                          tie=True, corner_tendons=corner_tendons)
+                          tie=True, corner_tendons=corner_tendons, ball_mass=mass)
     _run.ramp(sim)
     tied_run, _ = _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
     tied_at = _run.object_on_sheet(sim)
     assert tied_at is not None                                         # tied: always on
     tied = tied_at[0]
     nodes = _run.node_positions(sim) / sim.scale
-    sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (_tol.BALL_MASS * GRAVITY))
+    sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (mass * GRAVITY))
+    pred = np.asarray(eq.object, dtype=float)
+    model = model_pull(sheet.vertices, R, z, tuple(eq.taut), pred, np.asarray(eq.contact))
     # Released: a second model, the ball held over taut's object position while it presses
     # the sheet down from the flat start (contacts on), so the sheet forms its pocket under
     # the ball; then let go. (A ball put on the point-loaded sheet can miss the pocket: the
     # slack sheet around a point load may fold into a narrow crease.)
-    pred = np.asarray(eq.object, dtype=float)
     outcome, t_rel, found = _release_over(sheet, R, z, m, pred[:2], radius,
-                                          corner_tendons=corner_tendons)
+                                          corner_tendons=corner_tendons, mass=mass)
     held = sliding <= tol
     kind = str(eq.kind)
-    agrees = kind == "saddle" or held == (kind == "stable")
-    label = "{" + ",".join(str(i + 1) for i in eq.taut) + "}"
-    if tied_run == "diverged":
-        status, message = "diverged", f"{label}: the tied run diverged (non-finite state)"
-    elif tied_run != "settled":
-        status = "not_converged"
-        message = f"{label}: the tied sheet was still moving after {_tol.MAX_SETTLE_TIME:g} s"
-    elif outcome == "left":
-        when = f"{t_rel:.1f} s after release" if t_rel > 0 else "while it was being placed"
-        status, message = "diverged", f"{label}: the object left the sheet {when}"
-    elif outcome == "diverged":
-        status, message = "diverged", f"{label}: the released run diverged (non-finite state)"
-    elif outcome == "moving":
-        status = "not_converged"
-        message = f"{label}: the released object was still moving after {t_rel:.1f} s simulated"
-    else:
-        status, message = "ok", f"{label}: released object settled after {t_rel:.1f} s"
+    resolved = kind != "not_equilibrium" or model > tol
+    agrees = kind == "saddle" or not resolved or held == (kind == "stable")
+    status, message = _run_status(_label(tuple(eq.taut)), tied_run, outcome, t_rel)
     ok = status == "ok"
     if ok:
         assert found is not None
         settled = found[0]
     else:
         settled = np.full(3, np.nan)
-    return StateCheck(tuple(eq.taut), kind, pred, tied, settled, held,
-                      sliding, settled - pred, float(np.linalg.norm(settled - tied)),
-                      tied - pred, agrees, time.perf_counter() - t0, nodes, m.triangles,
-                      ok, check_status(status), message)
+    return StateCheck(tuple(eq.taut), kind, pred, tied, settled, held, sliding, model,
+                      resolved, settled - pred, float(np.linalg.norm(settled - tied)),
+                      tied - pred, agrees, time.perf_counter() - t0, None, np.nan, nodes,
+                      m.triangles, ok, check_status(status), message)
+
+
+def _where_released(team: SheetTeam, R: np.ndarray, states: list[StateCheck],
+                    contacts: list[np.ndarray], reach: float) -> list[StateCheck]:
+    """Mark each released object that came to rest nearer another of taut's states than
+    its own (``reached``); a stable state it left over a rim lower than ``reach`` (the
+    ball's radius plus the sheet's collision radius, scenario units: a ball of that size
+    does not see a shallower dip) is marginal (status ``"not_strict"``, ``basin``)."""
+    out = []
+    for k, s in enumerate(states):
+        if not s.success or len(states) < 2:
+            out.append(s)
+            continue
+        # Another state is reached only if it lies beyond the ball's reach from this one
+        # (nearer states are one place to a ball of that size).
+        dist = [float(np.linalg.norm(s.settled - o.predicted))
+                if o is s or np.linalg.norm(o.predicted - s.predicted) > reach else np.inf
+                for o in states]
+        j = int(np.argmin(dist))
+        if j == k:
+            out.append(s)
+            continue
+        other = states[j]
+        if s.kind != "stable":
+            out.append(replace(s, reached=other.taut))
+            continue
+        rim = barrier(team.sheet.vertices, R, team.hold_height,
+                      (s.predicted, contacts[k]), (other.predicted, contacts[j]))
+        if rim > reach:
+            out.append(replace(s, reached=other.taut, basin=rim))
+            continue
+        msg = (f"{_label(s.taut)}: marginal: the released object left for "
+               f"{_label(other.taut)} ({s.difference[2]:+.1f} in height); the state's basin "
+               f"is at most {rim:.2g} deep, less than the ball's reach {reach:.2g}")
+        out.append(replace(s, reached=other.taut, basin=rim, success=False,
+                           status=check_status("not_strict"), message=msg))
+    return out
 
 
 def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT_MESH,
@@ -345,12 +428,13 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     Parameters
     ----------
     team, formation
-        As for :func:`taut.sheet.forward_kinematics` (scenario units; the team's mass is
-        not used).
+        As for :func:`taut.sheet.forward_kinematics` (scenario units; the team's mass,
+        kg, is the ball's, 1 kg when it has none).
     mesh : int
         Mesh spacings across the sheet's widest vertex pair.
     ball : float, optional
-        Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings).
+        Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings; a sheet
+        scenario's ``object.radius``, :attr:`taut.io.SheetScenario.object_radius`).
     hold_tolerance : float, optional
         The object counts as held when the sheet's net sideways pull on the tied object is
         at most this fraction of its weight (dimensionless; default ``HOLD_FRACTION`` =
@@ -374,25 +458,36 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     states = []
     for k, eq in enumerate(fk.equilibria):
         states.append(_replay_state(sheet, R, z, eq, div, radius, tol,
-                                     corner_tendons=corner_tendons))
+                                     corner_tendons=corner_tendons, mass=_mass(team)))
         if progress is not None:
             progress(k + 1, len(fk.equilibria))
+    reach = radius + _tol.FLEX_RADIUS * sheet_mesh_spacing(sheet.vertices, div)
+    states = _where_released(team, R, states, [np.asarray(e.contact) for e in fk.equilibria],
+                             reach)
+    return _summary(states, tol, div, radius)
+
+
+def _summary(states: list[StateCheck], tol: float, div: int, radius: float
+             ) -> EquilibriaCheck:
     bad = [s for s in states if not s.agrees]
     failed = [s for s in states if not s.success]
     if bad:
         s = bad[0]
-        taut = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
         status = "unverified"
-        msg = (f"{len(bad)} of {len(states)} state(s) disagree; first: {taut} ({s.kind}) "
-               f"was {'held' if s.held else 'not held'} in physics")
+        msg = (f"{len(bad)} of {len(states)} state(s) disagree; first: {_label(s.taut)} "
+               f"({s.kind}) was {'held' if s.held else 'not held'} in physics")
     elif failed:
         status = failed[0].status
-        msg = (f"{len(failed)} of {len(states)} simulation(s) failed; first: "
+        msg = (f"{len(failed)} of {len(states)} state(s) not confirmed; first: "
                f"{failed[0].message}")
     else:
         status = "ok"
         msg = f"physics agrees with taut on all {len(states)} state(s)"
     if bad and failed:
-        msg += f"; {len(failed)} simulation(s) failed"
+        msg += f"; {len(failed)} state(s) not confirmed"
+    unresolved = [_label(s.taut) for s in states if not s.resolved]
+    if unresolved:
+        msg += (f"; {', '.join(unresolved)} not resolved (taut's own pull there is "
+                f"within the hold tolerance)")
     return EquilibriaCheck(tuple(states), tol, div, radius, status == "ok",
                            check_status(status), msg)

@@ -15,6 +15,7 @@ import numpy as np  # noqa: E402
 
 from ..physics.sheet import EquilibriaCheck, SettleResult  # noqa: E402
 from .sheet import KIND_COLOURS  # noqa: E402
+from ._save import save_figure, save_animation  # noqa: E402
 
 __all__ = ["plot_equilibria_check", "animate_settle"]
 
@@ -39,7 +40,8 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
     """One 3D panel per state: the simulated sheet settled with the object tied at taut's
     contact point, taut's object position (coloured by taut's verdict) and the released
     ball's rest position (black cross; a failed release is named in red in the panel's
-    title instead). Returns the figure; saves it when ``path``."""
+    title instead, and a marginal state, left by the released ball, is titled in red).
+    Returns the figure; saves it when ``path``."""
     n = max(len(check.states), 1)
     cols = min(n, 3)
     rows = math.ceil(n / cols)
@@ -50,14 +52,16 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
         _draw_sheet(ax, s.nodes, s.triangles, np.asarray(formation), hold_height)
         ax.scatter(*s.predicted, s=60, color=KIND_COLOURS.get(s.kind, "k"),
                    edgecolor="k", depthshade=False, label="taut")
-        if s.success:
+        if s.success or s.status == "not_strict":
             ax.scatter(*s.settled, s=50, marker="x", color="k", depthshade=False,
                        label="physics, released")
             released = f"released dz = {s.difference[2]:+.1f}{u}"
+            if s.status == "not_strict":
+                released += f" MARGINAL (basin <= {s.basin:.2g}{u})"
         else:
             released = f"run FAILED ({s.status.replace('_', ' ')}): see the message"
         label = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
-        verdict = "held" if s.held else "not held"
+        verdict = ("held" if s.held else "not held") + ("" if s.resolved else " (unresolved)")
         ax.set_title(f"{label} taut: {s.kind.replace('_', ' ')}; physics: {verdict}\n"
                      f"tied dz = {s.tied_difference[2]:+.1f}{u}, pull {s.sliding:.2f} mg\n"
                      f"{released}", fontsize=8, color="k" if s.success else "tab:red")
@@ -66,14 +70,14 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save_figure(fig, path, dpi=130)
     return fig
 
 
 def animate_settle(result: SettleResult, formation: np.ndarray, hold_height: float,
                    path: str | Path, *, fps: int = 10) -> None:
     """Write a GIF of a drop (:func:`taut.physics.settle` with ``trace=True``)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.animation import FuncAnimation
 
     if result.frames is None or result.trace is None:
         raise ValueError("settle(..., trace=True) records the frames an animation needs")
@@ -88,5 +92,5 @@ def animate_settle(result: SettleResult, formation: np.ndarray, hold_height: flo
         ax.set_title(f"t = {trace[k, 0]:.1f} s", fontsize=9)
 
     anim = FuncAnimation(fig, draw, frames=len(frames), interval=1000 / fps)
-    anim.save(str(path), writer=PillowWriter(fps=fps))
+    save_animation(anim, path, fps=fps)
     plt.close(fig)
