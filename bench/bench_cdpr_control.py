@@ -1,7 +1,8 @@
 """Benchmark of the CDPR control simulation (taut.cdpr.simulate / monte_carlo) on FASTKIT.
 
 Measures, in one run on this machine (interleaved repeats, median and min-max spread):
-  * simulated seconds per wall second at a 1 kHz control rate for the velocity and torque
+  * simulated seconds per wall second (and per process CPU second, the figure a loaded
+    shared machine distorts least) at a 1 kHz control rate for the velocity and torque
     controllers, numba backend (the compiled loop) and numpy backend (the reference loop), for
     the whole call (set-up: reference tensions, context, initial equilibrium) and the loop,
     with the default encoder sensing (pose by cable forward kinematics every step) and, on
@@ -33,6 +34,14 @@ def timed(fn):
     return time.perf_counter() - t0, out
 
 
+def cpu_timed(fn):
+    """Wall and process CPU seconds of one call (on a shared machine the CPU time is the
+    load-robust figure: what the run costs when it has a core to itself)."""
+    w0, c0 = time.perf_counter(), time.process_time()
+    fn()
+    return time.perf_counter() - w0, time.process_time() - c0
+
+
 def fmt(xs):
     return f"{statistics.median(xs):7.1f}x  [{min(xs):.1f} .. {max(xs):.1f}]"
 
@@ -58,19 +67,23 @@ def main() -> None:
             setup_t.append(dt_s)
             loop_t[name].append(timed(lambda: _loop_numba(setup, c, 1, 1))[0])
             for eng in ("numba", "numpy"):
-                dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, backend=eng))
+                dt, cpu = cpu_timed(lambda: simulate(robot, ref, c, model_errors=errs,
+                                                     backend=eng))
                 rates.setdefault((name, eng + " encoders"), []).append(sim_s / dt)
-            dt, _ = timed(lambda: simulate(robot, ref, c, model_errors=errs, backend="numba",
-                                           sensing=Sensing(ideal_pose=True)))
+                rates.setdefault((name, eng + " encoders CPU"), []).append(sim_s / cpu)
+            dt, cpu = cpu_timed(lambda: simulate(robot, ref, c, model_errors=errs,
+                                                 backend="numba",
+                                                 sensing=Sensing(ideal_pose=True)))
             rates.setdefault((name, "numba ideal pose"), []).append(sim_s / dt)
+            rates.setdefault((name, "numba ideal pose CPU"), []).append(sim_s / cpu)
     print(f"FASTKIT pick-and-place, {ref.duration:.2f} s + 1 s pre-roll = {sim_s:.2f} s "
           "simulated at 1 kHz (median of", args.repeats, "interleaved runs)")
     print(f"  set-up of one run (reference tensions, context, equilibrium): "
           f"{1e3 * statistics.median(setup_t):.0f} ms [{1e3 * min(setup_t):.0f} .. "
           f"{1e3 * max(setup_t):.0f}]")
-    print("  real-time factor (simulated s per wall s, whole call):")
+    print("  real-time factor, whole call (simulated s per wall s; 'CPU': per process CPU s):")
     for (name, eng), xs in rates.items():
-        print(f"    {name:8s} {eng:17s} {fmt(xs)}")
+        print(f"    {name:8s} {eng:21s} {fmt(xs)}")
     for name in ctls:
         print(f"    {name:8s} numba loop only {fmt([sim_s / x for x in loop_t[name]])}")
     # Monte Carlo

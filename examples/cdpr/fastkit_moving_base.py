@@ -1,8 +1,9 @@
 """Deployment with the active base moving during the task (issue 17, FASTKIT §2: task
 mode moves the active base): the tallest verified box with a fixed placement vs a
-two-stage schedule of the active base (``taut.cdpr.plan_moving_deployment``), same box
-extent, payload, stabilisers, required twist and search settings as the fixed-placement
-numbers of ``fastkit_motion.md``.
+two-stage schedule of the active base (``taut.cdpr.plan_moving_deployment``: between the
+stages the active base drives on its wheels, stabilisers retracted, while the platform
+waits on the shared face), same box extent, payload, stabilisers, required twist and
+search settings as the fixed-placement numbers of ``fastkit_motion.md``.
 
 Writes ``fastkit_moving_base.json``. Run: ``python examples/cdpr/fastkit_moving_base.py``
 (about 25 minutes on a loaded 2-core machine).
@@ -51,6 +52,8 @@ def main() -> None:
         "failed_below": None if np.isnan(tw.failed_below) else round(tw.failed_below, 4),
         "tried": [[round(z, 4), ok] for z, ok in tw.tried],
         "stage_poses": None if dep is None else [poses(p) for p in dep.base_poses],
+        "transition_wait_m": None if dep is None else np.round(dep.transition_wait_m,
+                                                               4).tolist(),
         "margin": None if dep is None else round(float(dep.margin), 4)}
     (HERE / "fastkit_moving_base.json").write_text(json.dumps(out, indent=1) + "\n")
     print(json.dumps(out, indent=1))

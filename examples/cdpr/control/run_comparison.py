@@ -1,6 +1,6 @@
 """FASTKIT paper §2.2, measured: velocity control vs torque control on the same pick-and-place
-at 1 m/s with the same seeded 5 mm exit-point errors; and deployment synchronisation (task
-mode, eq. 8): the active base moves 0.5 m while the platform holds its pose.
+at 1 m/s with the same seeded 5 mm exit-point errors. The deployment drive (task mode, eq. 8:
+the active base on its wheels while the platform holds) is ``examples/cdpr/fastkit_base_drive.py``.
 
 Run from the repository root:  python examples/cdpr/control/run_comparison.py
 Writes results.json and the figures next to this script.
@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from taut.cdpr import (BaseMotion, ModelErrors, TorqueController, VelocityController,
-                       pick_and_place, reference_from_samples, simulate, with_stabilisers)
+from taut.cdpr import (ModelErrors, TorqueController, VelocityController, pick_and_place,
+                       simulate, with_stabilisers)
 from taut.io.cdpr_model import load_cdpr_model
 from taut.viz.cdpr_sim import animate_control, plot_comparison, plot_control
 
@@ -53,22 +53,6 @@ def main() -> None:
     for name, run in first.items():
         plot_control(run, HERE / f"{name}_control.png")
     animate_control(robot, first["torque"], HERE / "torque_control.gif", frames=40, fps=8)
-    # Deployment: active base 0.5 m towards the platform in 5 s (0.1 m/s average, inside
-    # the 0.2 m/s limit of eq. 11) while the platform holds (0.3, 0, 1.0).
-    hold = np.array([0.3, 0.0, 1.0, 0.0, 0.0, 0.0])
-    t = np.linspace(0.0, 5.5, 12)
-    ref_hold = reference_from_samples(robot, t, np.tile(hold, (12, 1)))
-    bm = BaseMotion.line(robot, "active", (0.5, 0.0, 0.0), duration=5.0, start=0.2)
-    out["deployment"] = {}
-    for ctl in (VelocityController(), TorqueController()):
-        run = simulate(robot, ref_hold, ctl, base_motion=bm)
-        out["deployment"][ctl.name] = {
-            "base_displacement_m": float(run.base_poses[-1, 0, 0] - run.base_poses[0, 0, 0]),
-            **summary(run)}
-        print("deployment", ctl.name, run.message)
-        if ctl.name == "velocity":
-            plot_control(run, HERE / "deployment_velocity.png",
-                         "deployment: active base +0.5 m, platform holding its pose")
     (HERE / "results.json").write_text(json.dumps(out, indent=2) + "\n")
 
 

@@ -115,6 +115,8 @@ Deployment
    TallestWorkspace -- its outcome
    plan_moving_deployment -- placements for an active base moving during the task
    MovingDeploymentResult -- its outcome
+   plan_base_drive -- a base driving on its wheels, stabilisers deployed once in place
+   BaseDrivePlan -- its outcome
    staged_lift_bound -- the lift certificate per stage
    resolve_redundancy -- joint rates for a desired platform twist
    RedundancyResult -- its outcome
@@ -126,6 +128,7 @@ Control
    simulate -- a controller driving the robot along a reference (§2.2)
    ControlResult -- its outcome: histories, monitors, events
    monte_carlo -- seeded runs batched through one plant
+   reference_simulate -- the same run on an RK4 reference integrator (verification)
    MonteCarloResult -- per-run summaries
    Backend -- type of the loop backend name (numba or numpy)
    BaseMotion -- base poses over time (deployment, eq. 8)
@@ -137,8 +140,10 @@ Control
    reference_from_samples -- a trajectory from sampled poses
    Controller -- base class of the controllers
    VelocityController -- cable-length control
-   TorqueController -- computed-torque control
+   TorqueController -- task-space PD on the reference tension distribution
+   ComputedTorqueController -- computed-torque control (inverse dynamics at the estimated state)
    CONTROLLERS -- the built-in controllers by name
+   tune_for_rate -- built-in gains for another control rate and latency (one delay rule)
    ControlEvent -- one limit episode of a run
 """
 
@@ -170,16 +175,19 @@ from .deployment.deploy import (DeploymentOptions, DeploymentResult, evaluate_de
 from .deployment.placement import footprint_overlap, place_bases, workspace_box
 from .deployment.lift import LiftBound, lift_bound, upward_force_bound
 from .deployment.tallest import TallestWorkspace, tallest_workspace
-from .deployment.moving_base import (MovingDeploymentResult, plan_moving_deployment,
+from .deployment.moving_base import (BaseDrivePlan, MovingDeploymentResult, plan_base_drive,
+                                     plan_moving_deployment,
     staged_lift_bound)
 from .deployment.redundancy import OBJECTIVES, RedundancyResult, resolve_redundancy
 from .control.simulate import (Backend, BaseMotion, ControlResult, MonteCarloResult,
     monte_carlo, simulate)
+from .control.reference_integrator import reference_simulate
 from .control.dynamics import DynamicsModel
 from .control.model_errors import ModelErrors
 from .control.sensing import Sensing
 from .control.references import Reference, pick_and_place, reference_from_samples
-from .control.controllers import CONTROLLERS, Controller, TorqueController, VelocityController
+from .control.controllers import (CONTROLLERS, ComputedTorqueController, Controller,
+                                  TorqueController, VelocityController, tune_for_rate)
 from .control.monitors import ControlEvent
 
 __all__ = [
@@ -207,10 +215,13 @@ __all__ = [
     "plan_deployment", "DeploymentResult", "DeploymentOptions", "evaluate_deployment",
     "place_bases", "workspace_box", "footprint_overlap", "lift_bound", "LiftBound",
     "upward_force_bound", "tallest_workspace", "TallestWorkspace", "plan_moving_deployment",
+    "plan_base_drive", "BaseDrivePlan",
     "MovingDeploymentResult", "staged_lift_bound", "resolve_redundancy", "RedundancyResult",
     "OBJECTIVES",
     # Control
-    "simulate", "ControlResult", "monte_carlo", "MonteCarloResult", "Backend", "BaseMotion",
+    "simulate", "ControlResult", "monte_carlo", "MonteCarloResult", "reference_simulate",
+    "Backend", "BaseMotion",
     "DynamicsModel", "ModelErrors", "Sensing", "Reference", "pick_and_place",
-    "reference_from_samples", "Controller", "VelocityController", "TorqueController", "CONTROLLERS", "ControlEvent",
+    "reference_from_samples", "Controller", "VelocityController", "TorqueController", "ComputedTorqueController",
+    "CONTROLLERS", "tune_for_rate", "ControlEvent",
 ]

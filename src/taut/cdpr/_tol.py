@@ -158,9 +158,10 @@ EQUILIBRIUM_FORCE_TOL = 1e-8
 #: period-elongation error below ~4 % on the stiffest mode.
 STABILITY_OMEGA_H = 1.0
 
-#: Width of the tanh regularisation of Coulomb and static friction, motor side, rad/s. Makes
-#: friction a smooth function of speed (no sticking logic in an explicit integrator); its
-#: slope tau_c / width stays below J / h for FASTKIT's rotor at 1 kHz (see winch docs).
+#: Width of the tanh regularisation of the gearbox loss's direction (plant) and of the smooth
+#: friction model the controllers compensate and the tension estimate inverts, motor side,
+#: rad/s (the plant's rotor friction itself is set-valued: it sticks, see
+#: taut.cdpr.control.dynamics). 1 rad/s is 0.4 % of FASTKIT's 250 rad/s speed limit.
 FRICTION_SPEED_WIDTH = 1.0
 
 #: A simulated platform has diverged when its position leaves the frame box by more than

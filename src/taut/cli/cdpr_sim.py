@@ -51,8 +51,10 @@ def add_simulate(sub: typer.Typer) -> None:
             None, "--waypoints", help="Pick-and-place waypoints 'x,y,z; x,y,z; ...' (m)."),
         reference: Optional[Path] = typer.Option(
             None, "--reference", help="CSV reference: time,x,y,z,roll,pitch,yaw (s, m, rad)."),
-        controller: str = typer.Option("torque", "--controller", help="velocity or torque "
-                                       "(taut.cdpr.CONTROLLERS)."),
+        controller: str = typer.Option("torque", "--controller", help="velocity, torque or "
+                                       "computed_torque (taut.cdpr.CONTROLLERS); gains for "
+                                       "the control rate and latency by "
+                                       "taut.cdpr.tune_for_rate."),
         exit_error: Optional[float] = typer.Option(
             None, "--exit-error", help="Std. dev. of seeded exit-point errors, mm (default: "
                                        "the library's, none)."),
@@ -74,6 +76,9 @@ def add_simulate(sub: typer.Typer) -> None:
                                          "(default: the library's, 0 = pure velocity "
                                          "control; the tension is estimated from the drive "
                                          "torques)."),
+        latency: Optional[float] = typer.Option(
+            None, "--latency", help="Delay from measurement to actuation, ms (default: the "
+                                    "library's, taut.cdpr.Sensing)."),
         ideal_pose: bool = typer.Option(False, "--ideal-pose", help="Give the controller "
                                         "the true platform pose (default: estimated from "
                                         "the encoders, as on FASTKIT)."),
@@ -93,6 +98,8 @@ def add_simulate(sub: typer.Typer) -> None:
                                                    "--reference")
         if exit_error is not None and not (np.isfinite(exit_error) and 0 <= exit_error <= 1000):
             raise InvalidInputError("--exit-error", "must be a number of mm in [0, 1000]")
+        if latency is not None and not (np.isfinite(latency) and 0 <= latency <= 1000):
+            raise InvalidInputError("--latency", "must be a number of ms in [0, 1000]")
         output_path(json_out, "--out", JSON_SUFFIXES)
         output_path(plot, "--plot", FIGURE_SUFFIXES)
         output_path(animate, "--animate", ANIMATION_SUFFIXES)
@@ -115,10 +122,12 @@ def add_simulate(sub: typer.Typer) -> None:
                                    seed=seed))
         if tension_gain is not None and controller != "velocity":
             raise InvalidInputError("--tension-gain", "applies to --controller velocity")
-        ctl = CONTROLLERS[controller](**given(tension_gain=tension_gain))
-        from ..cdpr import Sensing
-        run = _run(robot, ref, ctl, errs, control_rate, dyn,
-                   Sensing(ideal_pose=True) if ideal_pose else None)
+        from ..cdpr import Sensing, tune_for_rate
+        sens = Sensing(ideal_pose=ideal_pose,
+                       **given(latency=None if latency is None else latency * 1e-3))
+        ctl, sens = tune_for_rate(CONTROLLERS[controller](**given(tension_gain=tension_gain)),
+                                  sens, **given(control_rate=control_rate), dynamics=dyn)
+        run = _run(robot, ref, ctl, errs, control_rate, dyn, sens)
         if json_out is not None:
             write_json(control_result_to_dict(run), json_out)
         if as_json:

@@ -4,16 +4,17 @@
 Keys (SI, motor side): ``cable_stiffness`` (EA, N), ``cable_damping`` (N s),
 ``drum_diameter`` (m), ``gear_ratio``, ``efficiency`` and ``backdrive_efficiency``
 (dimensionless, in (0, 1]; the second applies when the load drives the motor, default the
-first), ``motor_torque_limit`` (N m),
-``motor_speed_limit`` (rad/s), ``rotor_inertia`` (kg m^2), ``friction_static``,
+first), ``rated_torque`` and ``peak_torque`` (N m), ``peak_duration`` (s),
+``motor_speed_limit`` (rad/s), ``rotor_inertia`` (kg m^2), ``friction_static`` (breakaway),
 ``friction_coulomb`` (N m), ``friction_viscous`` (N m s/rad), ``stribeck_speed`` (rad/s),
-``drive_speed_gain`` (N m s/rad), ``drive_integral_gain`` (N m/rad).
+``drive_speed_gain`` (N m s/rad), ``drive_integral_gain`` (N m/rad), ``routing_length``
+(m: one number for every cable or a list with one per cable, in the model's cable order).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 from pydantic import BaseModel, ConfigDict
 
@@ -34,7 +35,9 @@ class _Dynamics(BaseModel):
     gear_ratio: Optional[float] = None
     efficiency: Optional[float] = None
     backdrive_efficiency: Optional[float] = None
-    motor_torque_limit: Optional[float] = None
+    rated_torque: Optional[float] = None
+    peak_torque: Optional[float] = None
+    peak_duration: Optional[float] = None
     motor_speed_limit: Optional[float] = None
     rotor_inertia: Optional[float] = None
     friction_static: Optional[float] = None
@@ -43,6 +46,7 @@ class _Dynamics(BaseModel):
     stribeck_speed: Optional[float] = None
     drive_speed_gain: Optional[float] = None
     drive_integral_gain: Optional[float] = None
+    routing_length: Optional[Union[float, list[float]]] = None
 
 
 class _Section(BaseModel):

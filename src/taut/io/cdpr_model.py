@@ -98,8 +98,9 @@ class _ModelFile(_Strict):
     desired_workspace: _Box | None = None
     platform_inside_exits: bool = False
     # Elastic cables and winches, read by taut.io.cdpr_dynamics (key names and ranges
-    # validated there); here already a flat mapping of numbers, never free-form data.
-    dynamics: dict[str, Optional[float]] | None = None
+    # validated there); here already a flat mapping of numbers (routing_length: a number
+    # or a list of numbers), never free-form data.
+    dynamics: dict[str, Optional[float | list[float]]] | None = None
 
 
 def _file_field(exc: TautError, raw: _ModelFile) -> str:

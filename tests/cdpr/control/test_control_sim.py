@@ -195,11 +195,19 @@ def test_paper_claim_velocity_vs_torque_with_5mm_exit_errors(fk_stab):
 
 @pytest.mark.slow
 def test_deployment_active_base_moves_half_a_metre(fk_stab):
+    """The physical drive: the active base on its wheels (plan_base_drive), the platform
+    held low enough for a tension distribution to keep it upright; every law holds it."""
+    from taut.cdpr import ComputedTorqueController, plan_base_drive
+    low = np.array([0.3, 0.0, 0.7, 0.0, 0.0, 0.0])
     bm = BaseMotion.line(fk_stab, "active", (0.5, 0.0, 0.0), duration=5.0, start=0.2)
-    for ctl in (VelocityController(), TorqueController()):
-        run = simulate(fk_stab, _hold(fk_stab, HOLD, 5.5), ctl, base_motion=bm)
+    plan = plan_base_drive(fk_stab, low, bm)
+    assert plan.success, plan.message
+    for ctl in (VelocityController(), TorqueController(), ComputedTorqueController()):
+        run = simulate(plan.drive_robot, _hold(fk_stab, low, 5.5), ctl, base_motion=bm)
         assert run.base_poses[-1, 0, 0] - run.base_poses[0, 0, 0] == pytest.approx(0.5)
+        assert run.success, run.message
         assert run.tracking_error.max() < 2e-3, ctl.name
+        assert run.tipping_margin.min() >= 0.0, ctl.name
 
 
 @pytest.mark.slow

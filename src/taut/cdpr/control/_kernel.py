@@ -50,8 +50,9 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
     :func:`_estimate`).
 
     ``com_local`` (B, 3) and ``attach_c`` (B, 3, m) are per plant (payload mass errors move
-    the centre of mass). ``winch`` (4, B, m) holds the plant's forward and back-drive efficiencies, friction
-    scales and rotor inertias; ``sens`` = (ideal pose 0/1, encoder quantum m, tension
+    the centre of mass). ``winch`` (5, B, m) holds the plant's forward and back-drive efficiencies, friction
+    scales, rotor inertias and routing lengths (m); ``dyn[15:15 + m]`` the nominal routing
+    lengths (the estimator's); ``dyn[4]`` is the peak torque the drives saturate at; ``sens`` = (ideal pose 0/1, encoder quantum m, tension
     source 0 none / 1 current / 2 load cell, twist filter gain, delay steps, FK iterations
     per step, FK iterations at the first step); ``buf`` (delay + 1, B, m) the commands in
     flight. ``rec`` (T // rec_every, Brec, 12 + 3m) receives x_c, R (row-major), tensions,
@@ -129,7 +130,7 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
                         Rm[i, j] = R[b, i, j]
             else:
                 _estimate(b, k, it_first if k == 0 else it_step, 1.0 if k == 0 else fgain,
-                          Lm, Tm, tsrc == 2, t_ref[k], EA, kl, speed, exits[k],
+                          Lm, Tm, tsrc == 2, t_ref[k], EA, dyn[15:], kl, speed, exits[k],
                           exit_vel[k], attach_P, ref_v[k], est_p, est_R, est_v, est_w,
                           Jr, res, A6, g6, x6)
                 for i in range(3):
@@ -251,7 +252,8 @@ def _current_tension(tau: float, w: float, acc: float, kl: float, J: float, eta:
 
 @jit
 def _estimate(b: int, k: int, iterations: int, gain: float, Lm: np.ndarray, Tm: np.ndarray,
-              load_cell: bool, t_ref: np.ndarray, EA: float, kl: float, speed: np.ndarray,
+              load_cell: bool, t_ref: np.ndarray, EA: float, rho: np.ndarray, kl: float,
+              speed: np.ndarray,
               ex: np.ndarray, ev: np.ndarray, attach_P: np.ndarray, vref: np.ndarray,
               est_p: np.ndarray, est_R: np.ndarray, est_v: np.ndarray, est_w: np.ndarray,
               Jr: np.ndarray, res: np.ndarray, A: np.ndarray, g: np.ndarray, x: np.ndarray
@@ -275,7 +277,7 @@ def _estimate(b: int, k: int, iterations: int, gain: float, Lm: np.ndarray, Tm: 
             L = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
             u0, u1, u2 = v0 / L, v1 / L, v2 / L
             known = Tm[c] if load_cell else t_ref[c]
-            res[c] = L - Lm[c] * (1.0 + known / EA)
+            res[c] = L - (Lm[c] + known * (Lm[c] + rho[c]) / EA)
             Jr[c, 0], Jr[c, 1], Jr[c, 2] = -u0, -u1, -u2
             Jr[c, 3] = -(r1 * u2 - r2 * u1)
             Jr[c, 4] = -(r2 * u0 - r0 * u2)
@@ -377,10 +379,10 @@ def _plant_step(b: int, mode: int, cmd: np.ndarray, tau: np.ndarray, T: np.ndarr
             sdot = -kl * speed[b, c]
             for i in range(3):
                 sdot += u[i, c] * (ev[i, c] - va[i])
-            f = (EA * stretch + damp * sdot) / L0[b, c]
+            f = (EA * stretch + damp * sdot) / (L0[b, c] + winch[4, b, c])
             T[c] = max(f, 0.0) if stretch > 0.0 else 0.0
         else:
-            T[c] = max(EA * stretch / L0[b, c], 0.0)
+            T[c] = max(EA * stretch / (L0[b, c] + winch[4, b, c]), 0.0)
         for i in range(3):
             F[i] += T[c] * u[i, c]
         Mw[0] += T[c] * (r[1, c] * u[2, c] - r[2, c] * u[1, c])
@@ -427,9 +429,13 @@ def _plant_step(b: int, mode: int, cmd: np.ndarray, tau: np.ndarray, T: np.ndarr
     _rotate(R, b, h * wb[b, 0], h * wb[b, 1], h * wb[b, 2])
     for c in range(m):
         sw = speed[b, c]
-        fr = winch[2, b, c] * _friction(sw, fs, fc, fv, wst, weps)
         gl = _gear_loss(tau[c], kl * T[c], sw, winch[0, b, c], winch[1, b, c], weps)
-        speed[b, c] += h * (kl * T[c] - tau[c] - gl - fr) / winch[3, b, c]
+        # implicit friction with stick (DynamicsModel.friction_step)
+        Jc, sc = winch[3, b, c], winch[2, b, c]
+        z = Jc * sw + h * (kl * T[c] - tau[c] - gl)
+        F = sc * (fc + (fs - fc) * np.exp(-(sw / wst) ** 2))
+        f = min(max(z / h, -F), F)
+        speed[b, c] = (z - h * f) / (Jc + h * sc * fv)
         L0[b, c] += h * kl * speed[b, c]
 
 

@@ -6,7 +6,7 @@ the wrench-feasibility check of the reference.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Final
 
 import numpy as np
 
@@ -22,7 +22,7 @@ from ..model.robot import CableRobot
 from .references import Reference
 from ..statics.tension import distribute_tensions
 
-__all__ = ["BaseMotion"]
+__all__ = ["BaseMotion", "drive_tensions", "DRIVE_TENSION_METHOD"]
 
 #: Base-motion runs distribute tensions on a robot rebuilt every this many control steps and
 #: interpolate in between (then restore the wrench balance exactly with W+): a base moving
@@ -128,7 +128,8 @@ def _inertial_wrench(mass: float, com: np.ndarray, inertia: np.ndarray, vel: np.
 
 def _tensions(robot: CableRobot, geo: RefGeometry, P: np.ndarray, w_ext: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray]:
-    """Closed-form reference tensions (T, m) and feasibility (T,).
+    """Reference tensions (T, m) and feasibility (T,): the closed form (fixed bases; tipping
+    is monitored, not imposed) or :func:`drive_tensions` (moving bases: tipping imposed).
 
     Computed every ``_TENSION_STRIDE`` steps (fixed bases: one batched call; moving bases: a
     robot rebuilt every ``_BASE_STRIDE`` steps) and linearly interpolated; the caller then
@@ -142,13 +143,7 @@ def _tensions(robot: CableRobot, geo: RefGeometry, P: np.ndarray, w_ext: np.ndar
                                   tipping=False)
         ts, ok_s = res.tensions, res.success
     else:
-        t_s, o_s = [], []
-        for i in idx:
-            r1 = distribute_tensions(_robot_at(robot, geo.base_poses[i]), P[i], "closed_form",
-                                     external_wrench=w_ext[i], tipping=False)
-            t_s.append(r1.tensions)                   # one pose: (m,)
-            o_s.append(r1.success)
-        ts, ok_s = np.array(t_s), np.array(o_s)
+        ts, ok_s = drive_tensions(robot, geo.base_poses[idx], P[idx], w_ext[idx])[:2]
     t = np.column_stack([np.interp(np.arange(T), idx, ts[:, j]) for j in range(robot.m)])
     ok = np.interp(np.arange(T), idx, ok_s.astype(float)) > 0.999
     return t, ok
@@ -171,6 +166,29 @@ def _exact_where_needed(robot: CableRobot, geo: RefGeometry, P: np.ndarray,
     return t, ok
 
 
+#: Tension distribution of runs whose bases move: the exact min-norm QP, which imposes the
+#: tipping limits (the closed form only checks them) and is continuous along a motion.
+DRIVE_TENSION_METHOD: Final = "qp_min_norm"
+
+
+def drive_tensions(robot: CableRobot, base_poses: np.ndarray, poses: np.ndarray,
+                   w_ext: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tensions (S, m), success (S,) and edge moments (S, E) of the platform ``poses``
+    (S, 6) with the bases at ``base_poses`` (S, K, 3), by :data:`DRIVE_TENSION_METHOD` with
+    the tipping limits of ``robot``'s bases as they stand (wheels, or stabilisers deployed)
+    imposed: one :func:`distribute_tensions` call per sample (each has its own geometry)."""
+    t_s, o_s, m_s = [], [], []
+    for i in range(len(poses)):
+        r1 = distribute_tensions(_robot_at(robot, base_poses[i]), poses[i],
+                                 DRIVE_TENSION_METHOD, tipping=True,
+                                 external_wrench=None if w_ext is None else w_ext[i])
+        t_s.append(r1.tensions)                   # one pose: (m,)
+        o_s.append(r1.success)
+        m_s.append(r1.tipping_moments)
+    return np.array(t_s), np.array(o_s, dtype=bool), np.array(m_s)
+
+
 def _robot_at(robot: CableRobot, base_poses: np.ndarray) -> CableRobot:
     bases = tuple(replace(b, exit_points=dict(b.exit_points), pose=base_poses[k])
                   for k, b in enumerate(robot.bases))
@@ -179,9 +197,22 @@ def _robot_at(robot: CableRobot, base_poses: np.ndarray) -> CableRobot:
 
 def _check_feasible(robot: CableRobot, geo: RefGeometry, times: np.ndarray, P: np.ndarray,
                     w_ext: np.ndarray, t: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Confirm closed-form failures with an exact LP; raise at the first pose no tensions
-    can hold. Returns tensions with LP ones where only the closed form failed."""
+    """Confirm closed-form failures with an exact LP (moving bases: recompute with
+    :func:`drive_tensions`); raise at the first pose no tensions can hold (moving bases: with
+    every base upright). Returns tensions with exact ones where only the first try failed."""
     t = t.copy()
+    if geo.moving:                    # exact tipping-aware tensions where interpolation failed
+        bad = np.nonzero(~ok)[0]
+        t[bad], ok_b, _ = drive_tensions(robot, geo.base_poses[bad], P[bad], w_ext[bad])
+        if ok_b.all():
+            return t
+        j = int(bad[~ok_b][0])
+        raise InfeasiblePoseError(
+            "base_motion", f"no tension distribution holds the platform at "
+            f"{np.round(P[j], 4).tolist()} and keeps every base upright (tipping limits of "
+            f"the bases as they stand: wheels unless stabilisers are deployed) at t = "
+            f"{times[j]:.3f} s, base poses {np.round(geo.base_poses[j], 4).tolist()}; "
+            "taut.cdpr.plan_base_drive says where a drive is feasible")
     for i in np.nonzero(~ok)[0]:
         r = robot if not geo.moving else _robot_at(robot, geo.base_poses[i])
         res = distribute_tensions(r, P[i], "lp_min_max", external_wrench=w_ext[i],
@@ -224,10 +255,10 @@ def build_context(robot: CableRobot, dyn: DynamicsModel, times: np.ndarray, ref:
     # Eq. 8: l_dot = A t_P - B_b q_dot_b = u . (e_dot - v_attach).
     va = V[:, None, :3] + np.cross(V[:, None, 3:], r)
     L_dot = (u * (geo.exit_vel - va)).sum(axis=2)
-    EA = dyn.cable_stiffness
-    L0 = EA * L / (EA + t)
+    EA, rho = dyn.cable_stiffness, dyn.routing(robot.m)
+    L0 = dyn.unstretched_length(L, t, rho)
     t_dot = np.gradient(t, times, axis=0) if len(times) > 2 else np.zeros_like(t)
-    L0_dot = EA * L_dot / (EA + t) - EA * L * t_dot / (EA + t) ** 2
+    L0_dot = EA * L_dot / (EA + t) - EA * (L + rho) * t_dot / (EA + t) ** 2
     L0_ddot = np.gradient(L0_dot, times, axis=0) if len(times) > 2 else np.zeros_like(t)
     CT = np.zeros((len(com), 3, 3))
     CT[:, 1, 0], CT[:, 2, 0], CT[:, 2, 1] = -com[:, 2], com[:, 1], -com[:, 0]
@@ -235,4 +266,4 @@ def build_context(robot: CableRobot, dyn: DynamicsModel, times: np.ndarray, ref:
     return ControlContext(dyn, dt, P, V, A, W, W_pinv, t, L0, L0_dot, L0_ddot, com, CT,
                           inertia, R, M, robot.t_min, robot.t_max,
                           np.ascontiguousarray(geo.exits), np.ascontiguousarray(geo.exit_vel),
-                          np.array(robot.attach_local, dtype=float))
+                          np.array(robot.attach_local, dtype=float), robot, c_loc, I_loc)

@@ -21,15 +21,20 @@ adds cameras); ``Sensing(ideal_pose=True)`` gives the true pose and twist.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, fields, is_dataclass
+from dataclasses import dataclass, fields, is_dataclass, replace
 from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from ..._validate import as_nonnegative, as_positive
+from ...errors import InvalidInputError
 from .dynamics import DynamicsModel
+from .sensing import Sensing
+from ..model.robot import CableRobot
+from ..statics.tension import _closed_form
 
-__all__ = ["Controller", "VelocityController", "TorqueController", "CONTROLLERS"]
+__all__ = ["Controller", "VelocityController", "TorqueController", "ComputedTorqueController",
+           "CONTROLLERS", "tune_for_rate"]
 
 CommandMode = Literal["torque", "speed"]
 
@@ -53,8 +58,8 @@ class ControlContext:
         Reference tensions from the tension distribution for gravity plus the reference
         inertial wrench, N.
     L0, L0_dot, L0_ddot : (T, m)
-        Unstretched-length set-points and their rates (eq. 8 with the stretch ``T L0 / EA``
-        removed), m, m/s, m/s^2.
+        Unstretched-length set-points and their rates (eq. 8 with the stretch
+        ``T (L0 + rho) / EA`` removed, ``rho`` the routing length), m, m/s, m/s^2.
     com : (T, 3)
         Reference point P to centre of mass, world frame, m.
     com_skew_T : (T, 3, 3)
@@ -71,6 +76,13 @@ class ControlContext:
         Nominal world exit points (m) and their velocities (m/s).
     attach : (m, 3)
         Attachment points in the platform frame, m.
+    robot : CableRobot
+        The nominal robot (limits, gravity; the online tension distribution of
+        :class:`ComputedTorqueController`).
+    com_local : (3,)
+        Nominal centre of mass in the platform frame (from P), m.
+    inertia_local : (3, 3)
+        Nominal inertia about the centre of mass in the platform frame, kg m^2.
     """
 
     dynamics: DynamicsModel
@@ -94,6 +106,9 @@ class ControlContext:
     exits: np.ndarray
     exit_vel: np.ndarray
     attach: np.ndarray
+    robot: CableRobot
+    com_local: np.ndarray
+    inertia_local: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -134,6 +149,80 @@ class Controller(ABC):
         for k, v in gains.items():
             out[k] = v.tolist() if isinstance(v, np.ndarray) else v
         return out
+
+
+#: Control rate the default gains of the built-in controllers are designed for (and the
+#: default of :func:`taut.cdpr.simulate`), Hz.
+DESIGN_CONTROL_RATE = 1000.0
+
+#: Loop delay the default gains are designed for, s: :data:`DESIGN_CONTROL_RATE` without
+#: latency (one control period from measurement to command plus half a period of
+#: zero-order hold, see :func:`loop_delay`).
+DESIGN_LOOP_DELAY = 1.5 / DESIGN_CONTROL_RATE
+
+
+def loop_delay(control_rate: float, latency: float) -> float:
+    """Delay around a sampled control loop, s: the latency, one control period from
+    measurement to command, and half a period of zero-order hold (the standard
+    approximation of a sample-and-hold as a half-period delay; Franklin, Powell, Workman,
+    *Digital Control of Dynamic Systems*, 3rd ed., §6.3.2)."""
+    return float(latency) + 1.5 / float(control_rate)
+
+
+#: Most phase a delay may cost the motor-speed damping loop of the torque laws, rad (45 deg).
+JOINT_DELAY_PHASE = np.pi / 4
+
+
+def tune_for_rate(controller: Controller, sensing: Sensing,
+                  control_rate: float = DESIGN_CONTROL_RATE,
+                  dynamics: DynamicsModel | None = None) -> tuple[Controller, Sensing]:
+    """A built-in controller's gains and the estimate filter for another control rate and
+    latency, by one rule: a loop delay ``tau`` costs ``omega_c tau`` rad of phase at a loop's
+    crossover ``omega_c``, and every loop keeps at most the phase it loses at the design
+    point (1 kHz, no latency).
+
+    * Loops closed through the cable lengths and the estimates (pose, twist, tension): with
+      ``s = min(1, DESIGN_LOOP_DELAY / loop_delay(rate, latency))`` every bandwidth scales by
+      ``s``: ``length_gain``, ``tension_gain``, ``position_damping``, ``rotation_damping``
+      by ``s``, the stiffnesses by ``s^2`` (same damping ratio), ``Sensing.velocity_filter``
+      by ``s``. Their fastest mode is not the 3 Hz task-space one: an encoder-estimated pose
+      moves with the light rotors (``J (N / r)^2`` = 0.7 kg of cable-side mass against the
+      10 kg platform), so the task-space damping acts on the rotor-cable mode; the uniform
+      scale keeps that mode's phase loss too.
+    * The motor-speed damping of the torque laws (collocated, its bandwidth
+      ``joint_damping / J``) is kept unless that costs more than :data:`JOINT_DELAY_PHASE`,
+      then lowered to it (``J`` the nominal rotor inertia of ``dynamics``).
+
+    At 1 kHz without latency ``s = 1`` (the defaults); at 200 Hz with 5 ms latency
+    ``s = 0.12`` and the default joint damping (44 rad/s) loses 0.55 rad, so it stays.
+
+    Examples
+    --------
+    >>> c, s = tune_for_rate(TorqueController(), Sensing(latency=0.005), 200.0)
+    >>> round(c.position_damping, 2), round(c.position_stiffness, 2), round(s.velocity_filter, 1)
+    (4.08, 5.11, 3.6)
+    >>> c.joint_damping
+    0.002
+    """
+    if (type(controller) not in CONTROLLERS.values() or not is_dataclass(controller)
+            or isinstance(controller, type)):
+        raise InvalidInputError("controller", "tune_for_rate scales the gains of the built-in "
+                                              "controllers only; tune a custom one yourself")
+    if not isinstance(sensing, Sensing):
+        raise InvalidInputError("sensing", "must be a taut.cdpr.Sensing")
+    rate = as_positive(control_rate, "control_rate")
+    dyn = DynamicsModel() if dynamics is None else dynamics
+    if not isinstance(dyn, DynamicsModel):
+        raise InvalidInputError("dynamics", "must be a taut.cdpr.DynamicsModel")
+    tau = loop_delay(rate, sensing.latency)
+    s = min(1.0, DESIGN_LOOP_DELAY / tau)
+    gains = {f.name: getattr(controller, f.name) * (s * s if f.name.endswith("_stiffness")
+                                                    else s) for f in fields(controller)}
+    if "joint_damping" in gains:
+        jd = getattr(controller, "joint_damping")
+        gains["joint_damping"] = min(jd, JOINT_DELAY_PHASE * dyn.rotor_inertia / tau)
+    return (replace(controller, **gains),
+            replace(sensing, velocity_filter=sensing.velocity_filter * s))
 
 
 def _validated(obj: Any) -> None:
@@ -236,9 +325,7 @@ class TorqueController(Controller):
     def command(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
         ref = ctx.ref_poses[k]
         Rr = ctx.R_ref[k]
-        E = Rr @ np.swapaxes(meas.R, 1, 2)                        # R_ref R^T
-        er = 0.5 * np.stack([E[:, 2, 1] - E[:, 1, 2], E[:, 0, 2] - E[:, 2, 0],
-                             E[:, 1, 0] - E[:, 0, 1]], axis=1)
+        er = _rotation_error(Rr, meas.R)
         a = (self.position_stiffness * (ref[:3] - meas.p)
              + self.position_damping * (ctx.ref_vel[k, :3] - meas.v))
         alpha = (self.rotation_stiffness * er
@@ -248,13 +335,105 @@ class TorqueController(Controller):
         mom = alpha @ ctx.inertia[k].T + f @ CT                  # I alpha + c x f
         t = ctx.tensions[k] + np.hstack([f, mom]) @ ctx.W_pinv[k].T
         t = np.clip(t, ctx.t_min, ctx.t_max)
-        d = ctx.dynamics
-        kl = d.length_per_rad
-        speed_ref = ctx.L0_dot[k] / kl
-        load = (kl * t - d.friction(meas.speed) - d.rotor_inertia * ctx.L0_ddot[k] / kl
-                + self.joint_damping * (meas.speed - speed_ref))
-        return d.holding_torque(load, t, meas.speed)
+        return _winch_torques(ctx, k, t, meas.speed, self.joint_damping)
+
+
+def _rotation_error(R_ref: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Rotation vectors (B, 3) of ``R_ref R^T`` (small-angle: the skew part), rad."""
+    E = R_ref @ np.swapaxes(R, 1, 2)
+    return 0.5 * np.stack([E[:, 2, 1] - E[:, 1, 2], E[:, 0, 2] - E[:, 2, 0],
+                           E[:, 1, 0] - E[:, 0, 1]], axis=1)
+
+
+def _winch_torques(ctx: ControlContext, k: int, t: np.ndarray, speed: np.ndarray,
+                   joint_damping: float) -> np.ndarray:
+    """Motor torques holding tensions ``t`` on the nominal winch model: friction, rotor
+    inertia on the reference acceleration, gearbox loss in the direction of power flow
+    (:meth:`DynamicsModel.holding_torque`) and damping about the reference motor speed."""
+    d = ctx.dynamics
+    kl = d.length_per_rad
+    load = (kl * t - d.friction(speed) - d.rotor_inertia * ctx.L0_ddot[k] / kl
+            + joint_damping * (speed - ctx.L0_dot[k] / kl))
+    return d.holding_torque(load, t, speed)
+
+
+@dataclass(frozen=True)
+class ComputedTorqueController(Controller):
+    """Computed-torque control of a cable robot: inverse dynamics of the platform at the
+    *estimated* state, tensions distributed online, motor torques on the nominal winch model.
+
+    The standard computed-torque law of rigid manipulators applied to the platform's
+    Newton-Euler equations (Siciliano, Sciavicco, Villani, Oriolo, *Robotics: Modelling,
+    Planning and Control*, Springer 2009, §8.5.2, eq. 8.57; for cable robots Pott, *Cable-Driven
+    Parallel Robots: Theory and Application*, Springer 2018, §7, with the wrench matrix of
+    FASTKIT eq. 18): with ``x_hat`` the estimated pose of P, ``e`` its error (position, rotation
+    vector), ``e_dot`` the twist error,
+
+        y = x_ddot_ref + Kd e_dot + Kp e
+        w = M(x_hat) y + C(x_hat, x_dot_hat) - w_g(x_hat),
+
+    i.e. with the centre of mass ``c = R c_b`` and inertia ``I = R I_b R^T`` of the nominal
+    moving body, ``a_c = a + alpha x c + omega x (omega x c)``,
+    ``w = [M (a_c - g); I alpha + omega x I omega + c x M (a_c - g)]``. The tensions solve
+    ``W(x_hat) t = w`` within ``[t_min, t_max]`` by the library's closed-form tension
+    distribution (Pott's improved closed form, batched; clipped to the limits where it has
+    no solution), and the motor torques invert the nominal winch model with friction
+    compensation (as :class:`TorqueController`). Unlike :class:`TorqueController`, which adds
+    a PD correction through the reference ``W^+`` to tensions precomputed along the
+    reference, every term here is evaluated at the estimated state.
+
+    Parameters
+    ----------
+    position_stiffness, position_damping : float
+        ``Kp`` (1/s^2) and ``Kd`` (1/s) of the translation (default 3 Hz, damping ratio 0.9).
+    rotation_stiffness, rotation_damping : float
+        Same for the rotation.
+    joint_damping : float
+        Motor-speed damping about the reference speed, N m s/rad (default 2e-3).
+
+    Examples
+    --------
+    >>> ComputedTorqueController().mode
+    'torque'
+    """
+
+    position_stiffness: float = 355.0
+    position_damping: float = 34.0
+    rotation_stiffness: float = 355.0
+    rotation_damping: float = 34.0
+    joint_damping: float = 2.0e-3
+    name: ClassVar[str] = "computed_torque"
+    mode: ClassVar[CommandMode] = "torque"
+
+    def __post_init__(self) -> None:
+        _validated(self)
+
+    def command(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
+        return _winch_torques(ctx, k, self.tensions(ctx, k, meas), meas.speed,
+                              self.joint_damping)
+
+    def tensions(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
+        """Cable tensions (B, m) the law commands at step ``k``, N."""
+        ref, vel, acc = ctx.ref_poses[k], ctx.ref_vel[k], ctx.ref_acc[k]
+        a = (acc[:3] + self.position_damping * (vel[:3] - meas.v)
+             + self.position_stiffness * (ref[:3] - meas.p))
+        alpha = (acc[3:] + self.rotation_damping * (vel[3:] - meas.w)
+                 + self.rotation_stiffness * _rotation_error(ctx.R_ref[k], meas.R))
+        R, w = meas.R, meas.w
+        c = R @ ctx.com_local                                      # (B, 3)
+        inertia = R @ ctx.inertia_local @ np.swapaxes(R, 1, 2)     # (B, 3, 3)
+        a_c = a + np.cross(alpha, c) + np.cross(w, np.cross(w, c))
+        f = ctx.mass * (a_c - ctx.robot.gravity)
+        Iw = np.einsum("bij,bj->bi", inertia, w)
+        mom = np.einsum("bij,bj->bi", inertia, alpha) + np.cross(w, Iw) + np.cross(c, f)
+        r = np.einsum("bij,mj->bmi", R, ctx.attach)                # (B, m, 3)
+        vec = ctx.exits[k][None] - meas.p[:, None, :] - r
+        u = vec / np.linalg.norm(vec, axis=2)[..., None]
+        W = np.concatenate([np.swapaxes(u, 1, 2), np.swapaxes(np.cross(r, u), 1, 2)], axis=1)
+        t = _closed_form(ctx.robot, W, np.hstack([f, mom]), np.ones(len(W), dtype=bool))
+        return np.clip(t, ctx.t_min, ctx.t_max)
 
 
 #: Controller names accepted by the CLI.
-CONTROLLERS = {"velocity": VelocityController, "torque": TorqueController}
+CONTROLLERS = {"velocity": VelocityController, "torque": TorqueController,
+               "computed_torque": ComputedTorqueController}

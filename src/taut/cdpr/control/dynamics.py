@@ -13,8 +13,20 @@ drum radius, ``kl = r / N``, the unstretched (paid-out) cable length is
     J theta_ddot = kl T - tau - tau_g(tau, T, theta_dot) - tau_f(theta_dot),
 
 where ``T`` is the cable tension, ``tau`` the motor torque (positive winds the cable in) and
-``tau_f = (tau_c + (tau_s - tau_c) exp(-(w / w_s)^2)) tanh(w / w_eps) + b w`` the motor friction
-(static ``tau_s``, Coulomb ``tau_c``, viscous ``b``, Stribeck speed ``w_s``). The gearbox loss
+``tau_f`` the motor friction: static (breakaway) ``tau_s``, Coulomb ``tau_c``, viscous ``b``,
+Stribeck speed ``w_s``. A sliding rotor feels ``F(w) sign(w) + b w`` with the Stribeck level
+``F(w) = tau_c + (tau_s - tau_c) exp(-(w / w_s)^2)``; a rotor at rest stays at rest while the
+other torques on it stay within ``[-tau_s, tau_s]`` and breaks away when they exceed it.
+The plant integrates this set-valued law at a fixed step by its implicit Euler
+discretisation (Kikuuwe, Takesue, Sano, Mochiyama, Fujimoto, "Fixed-step friction
+simulation: from classical Coulomb model to modern continuous models", IROS 2005: Coulomb
+friction as a set-valued law integrated by backward Euler; :meth:`DynamicsModel.friction_step`): with ``z = J w + h (kl T - tau - tau_g)``,
+``f = clip(z / h, -F(w), F(w))`` and ``w_new = (z - h f) / (J + h b)``, so a rotor whose
+torques cannot overcome the friction within the step stops exactly (stick), the level at
+rest is the breakaway torque ``tau_s``, and the friction's power ``(f + b w_new) w_new`` is
+never negative. The controllers and the current-based tension estimate use the smooth
+compensation model :meth:`DynamicsModel.friction` (the same levels, ``sign`` replaced by
+``tanh(w / w_eps)``). The gearbox loss
 ``tau_g`` follows the direction of power flow (a load-dependent Coulomb friction of the mesh):
 with ``s = tanh(w / w_eps)``,
 
@@ -24,11 +36,21 @@ so when the motor drives the load (winding in, ``s = -1``) ``J theta_ddot = kl T
 and when the load drives the motor (paying out under tension, ``s = +1``)
 ``J theta_ddot = eta_b kl T - tau``: lowering 45 N needs ``eta_b kl T = 0.25 N m``, lifting
 it ``kl T / eta = 0.51 N m`` (Table 1's 0.6 N m working point). The dissipated power
-``tau_g w`` is never negative. At rest the regularised loss vanishes like the regularised
-Coulomb friction (a real mesh holds any torque in ``[eta_b kl T, kl T / eta]``).
+``tau_g w`` is never negative. At rest the regularised loss vanishes and the stiction holds
+up to ``tau_s`` (a real mesh holds any torque in ``[eta_b kl T, kl T / eta]``).
 
-Cable model: tension ``T = max(0, (EA (L - L0) + d (L_dot - L0_dot)) / L0)``: stiffness ``k = EA / L0``,
-unilateral (no force when the cable is shorter than its unstretched length).
+Motor torque: the drive saturates at ``peak_torque``; ``rated_torque`` is the continuous
+rating, and the run's monitor reports every episode above it longer than ``peak_duration``
+(a stated time rule, not a thermal model).
+
+Cable model: the cable runs from the drum over a fixed routing (pulleys, the mast) of length
+``rho`` (``routing_length``, m) to the exit point, then the free span ``L`` to the platform;
+with ``L0`` the unstretched free span (the drum pays out ``L0`` at ``kl`` per radian) the
+whole unstretched cable between drum and platform is ``L0 + rho`` and, with one tension along
+it (frictionless pulleys),
+``T = max(0, (EA (L - L0) + d (L_dot - L0_dot)) / (L0 + rho))``: stiffness
+``k = EA / (L0 + rho)``, unilateral (no force when the cable is shorter than its unstretched
+length).
 """
 
 from __future__ import annotations
@@ -44,7 +66,7 @@ from ...errors import InvalidModelError
 __all__ = ["DynamicsModel"]
 
 # Values the FASTKIT paper gives (Table 1, §2.1.1).
-_PAPER = ("drum_diameter", "gear_ratio", "efficiency", "motor_torque_limit",
+_PAPER = ("drum_diameter", "gear_ratio", "efficiency", "rated_torque",
           "motor_speed_limit")
 
 
@@ -72,8 +94,14 @@ class DynamicsModel:
     backdrive_efficiency : float, optional
         Efficiency in (0, 1] when the load drives the motor (paying out under tension);
         default (None) the forward ``efficiency`` (the paper gives one figure).
-    motor_torque_limit : float
-        N m (Table 1 gives the 0.6 N m working point; taken as the limit).
+    rated_torque : float
+        Continuous motor torque, N m (Table 1's 0.6 N m working point).
+    peak_torque : float
+        Torque the drive saturates at, N m (*assumed* 1.8 N m: three times the rated torque,
+        typical of servo drives); at least ``rated_torque``.
+    peak_duration : float
+        Longest time above the rated torque the drive sustains, s (*assumed* 1 s, a typical
+        servo's peak-current time); longer episodes are reported by the run's monitor.
     motor_speed_limit : float
         rad/s (250 rad/s = 2387 rpm: the 2 m/s maximum cable speed of Table 1 through the
         5:1 gearhead and 0.04 m drum radius; the 1600 rpm of Table 1 is the working point).
@@ -81,7 +109,8 @@ class DynamicsModel:
         Motor rotor + gearhead + drum reflected to the motor shaft, kg m^2 (*assumed*
         4.5e-5: 3e-5 rotor of a 0.6 N m servo, 1e-5 gearhead, drum 1.3e-4 / 25).
     friction_static, friction_coulomb : float
-        N m at the motor (*assumed* 0.02 and 0.015 N m, ~3 % of the working torque).
+        N m at the motor (*assumed* 0.02 and 0.015 N m, ~3 % of the working torque): the
+        breakaway torque of a rotor at rest and the sliding level at speed.
     friction_viscous : float
         N m s/rad at the motor (*assumed* 2e-5).
     stribeck_speed : float
@@ -90,6 +119,12 @@ class DynamicsModel:
         Proportional (N m s/rad) and integral (N m/rad) gains of the servo drive's speed loop,
         used when a controller sends speed set-points (*assumed* 0.027 and 4: a ~420 rad/s
         speed-loop bandwidth ``eta K / J`` for the rotor inertia above).
+    routing_length : float or sequence of float
+        Length of each cable between its drum and its exit point, m: one value for every
+        cable or one per cable (0: the free span only). It adds to the elastic length:
+        ``k = EA / (L0 + routing_length)``. *Assumed* 2.3 m: a FASTKIT winch at the foot of
+        its 2.4 m mast (the preset file gives 2.30 m to the upper and 2.15 m to the lower
+        exit pulleys).
     """
 
     cable_stiffness: float = 2.0e4
@@ -98,7 +133,9 @@ class DynamicsModel:
     gear_ratio: float = 5.0
     efficiency: float = 0.7
     backdrive_efficiency: float | None = None
-    motor_torque_limit: float = 0.6
+    rated_torque: float = 0.6
+    peak_torque: float = 1.8
+    peak_duration: float = 1.0
     motor_speed_limit: float = 250.0
     rotor_inertia: float = 4.5e-5
     friction_static: float = 0.02
@@ -107,15 +144,18 @@ class DynamicsModel:
     stribeck_speed: float = 5.0
     drive_speed_gain: float = 0.027
     drive_integral_gain: float = 4.0
+    routing_length: float | tuple[float, ...] = 2.3
 
     def __post_init__(self) -> None:
         if self.backdrive_efficiency is None:
             object.__setattr__(self, "backdrive_efficiency", self.efficiency)
         positive = ("cable_stiffness", "drum_diameter", "gear_ratio", "efficiency",
-                    "backdrive_efficiency",
-                    "motor_torque_limit", "motor_speed_limit", "rotor_inertia",
-                    "stribeck_speed")
+                    "backdrive_efficiency", "rated_torque", "peak_torque", "peak_duration",
+                    "motor_speed_limit", "rotor_inertia", "stribeck_speed")
+        object.__setattr__(self, "routing_length", _routing(self.routing_length))
         for f in fields(self):
+            if f.name == "routing_length":
+                continue
             v = as_finite_scalar(getattr(self, f.name), f"dynamics.{f.name}")
             if f.name in positive and not v > 0:
                 raise InvalidModelError(f"dynamics.{f.name}", f"must be positive, got {v:g}")
@@ -127,6 +167,9 @@ class DynamicsModel:
             if getattr(self, name) > 1.0:
                 raise InvalidModelError(f"dynamics.{name}",
                                         f"must be in (0, 1], got {getattr(self, name):g}")
+        if self.peak_torque < self.rated_torque:
+            raise InvalidModelError("dynamics.peak_torque", f"peak torque {self.peak_torque:g} "
+                                    f"N m is below the rated torque {self.rated_torque:g} N m")
         if self.friction_static < self.friction_coulomb:
             raise InvalidModelError("dynamics.friction_static", "static friction "
                                     f"{self.friction_static:g} N m is below Coulomb friction "
@@ -149,12 +192,78 @@ class DynamicsModel:
 
     @property
     def max_cable_tension(self) -> float:
-        """Tension the motor holds at its torque limit (static, no friction), N."""
-        return self.motor_torque_limit * self.efficiency / self.length_per_rad
+        """Tension the motor lifts continuously at its rated torque (no friction), N."""
+        return self.rated_torque * self.efficiency / self.length_per_rad
+
+    def routing(self, m: int) -> np.ndarray:
+        """Routing length of each of ``m`` cables (m,), m; raises InvalidModelError when a
+        per-cable list has another length."""
+        r = np.asarray(self.routing_length, dtype=float)
+        if r.ndim == 0:
+            return np.full(m, float(r))
+        if r.shape != (m,):
+            raise InvalidModelError("dynamics.routing_length", f"has {r.size} values, the "
+                                    f"robot has {m} cables")
+        return r.copy()
+
+    def unstretched_length(self, length: Any, tension: Any, routing: Any) -> np.ndarray:
+        """Unstretched free span ``L0`` (m) of cables of free length ``length`` (m) under
+        ``tension`` (N) with ``routing`` (m) of routed cable: ``T = EA (L - L0) / (L0 + rho)``
+        solved, ``L0 = (EA L - T rho) / (EA + T)``.
+
+        Examples
+        --------
+        >>> d = DynamicsModel(cable_stiffness=1000.0)
+        >>> L0 = d.unstretched_length(3.0, 10.0, 2.0)
+        >>> round(float(L0), 6), round(float(d.stretched_length(L0, 10.0, 2.0)), 12)
+        (2.950495, 3.0)
+        """
+        EA = self.cable_stiffness
+        T = np.asarray(tension, dtype=float)
+        return (EA * np.asarray(length, dtype=float) - T * routing) / (EA + T)
+
+    def stretched_length(self, L0: Any, tension: Any, routing: Any) -> np.ndarray:
+        """Free span (m) of cables with unstretched free span ``L0`` (m) under ``tension``
+        (N): ``L0 + T (L0 + rho) / EA``."""
+        L0 = np.asarray(L0, dtype=float)
+        return L0 + np.asarray(tension, dtype=float) * (L0 + routing) / self.cable_stiffness
+
+    def friction_level(self, speed: Any, scale: Any = 1.0) -> np.ndarray:
+        """Stribeck level ``F(w) = tau_c + (tau_s - tau_c) exp(-(w / w_s)^2)`` (N m, >= 0)
+        at motor speeds ``w`` (rad/s), times ``scale``: the breakaway torque at rest, the
+        Coulomb level at speed."""
+        w = np.asarray(speed, dtype=float)
+        return np.asarray(scale) * (self.friction_coulomb + (
+            self.friction_static - self.friction_coulomb) * np.exp(-(w / self.stribeck_speed) ** 2))
+
+    def friction_step(self, speed: Any, net: Any, h: float, inertia: Any, scale: Any = 1.0
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """One implicit Euler step of a rotor with set-valued friction (Kikuuwe et al. 2005,
+        see the module docstring): motor speeds ``w`` (rad/s), the other torques on the rotor
+        ``net`` (N m), step ``h`` (s), rotor inertias (kg m^2), friction ``scale``. Returns
+        the new speeds and the friction torque that acted (N m, Coulomb/static part plus
+        viscous on the new speed).
+
+        Examples
+        --------
+        >>> d = DynamicsModel()
+        >>> w, f = d.friction_step(np.zeros(2), np.array([0.019, 0.021]), 1e-3, 4.5e-5)
+        >>> bool(w[0] == 0.0), bool(w[1] > 0.0), round(float(f[0]), 3)   # holds below 0.02 N m
+        (True, True, 0.019)
+        """
+        w = np.asarray(speed, dtype=float)
+        z = inertia * w + h * np.asarray(net, dtype=float)
+        F = self.friction_level(w, scale)
+        f = np.clip(z / h, -F, F)
+        b = np.asarray(scale) * self.friction_viscous
+        w_new = (z - h * f) / (inertia + h * b)
+        return w_new, f + b * w_new
 
     def friction(self, speed: np.ndarray, scale: Any = 1.0) -> np.ndarray:
-        """Motor friction torque ``tau_f`` (N m, same sign as ``speed``) at motor speeds
-        (rad/s), multiplied by ``scale`` (broadcast).
+        """Smooth friction model ``F(w) tanh(w / w_eps) + b w`` (N m, same sign as
+        ``speed``) at motor speeds (rad/s), multiplied by ``scale`` (broadcast): what the
+        controllers compensate and the current-based tension estimate inverts (the plant's
+        rotors stick, :meth:`friction_step`).
 
         Examples
         --------
@@ -166,10 +275,8 @@ class DynamicsModel:
         """
         from .._tol import FRICTION_SPEED_WIDTH
         w = np.asarray(speed, dtype=float)
-        level = self.friction_coulomb + (self.friction_static - self.friction_coulomb) * \
-            np.exp(-(w / self.stribeck_speed) ** 2)
-        return np.asarray(scale) * (level * np.tanh(w / FRICTION_SPEED_WIDTH)
-                                    + self.friction_viscous * w)
+        return self.friction_level(w, scale) * np.tanh(w / FRICTION_SPEED_WIDTH) \
+            + np.asarray(scale) * self.friction_viscous * w
 
     def gear_loss(self, tau: Any, tension: Any, speed: Any, efficiency: Any = None,
                   backdrive_efficiency: Any = None) -> np.ndarray:
@@ -230,5 +337,21 @@ class DynamicsModel:
     def describe(self) -> dict[str, Any]:
         """JSON-friendly parameters, with which ones come from the FASTKIT paper."""
         out: dict[str, Any] = {f.name: getattr(self, f.name) for f in fields(self)}
+        if isinstance(self.routing_length, tuple):
+            out["routing_length"] = list(self.routing_length)
         out["from_paper"] = list(_PAPER)
         return out
+
+
+def _routing(value: Any) -> float | tuple[float, ...]:
+    """``routing_length`` validated: one non-negative length or a non-empty list of them, m."""
+    name = "dynamics.routing_length"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        vals = tuple(as_finite_scalar(v, name) for v in np.asarray(value, dtype=object).ravel())
+        if not vals:
+            raise InvalidModelError(name, "is an empty list")
+    else:
+        vals = (as_finite_scalar(value, name),)
+    if min(vals) < 0:
+        raise InvalidModelError(name, f"must be non-negative, got {min(vals):g} m")
+    return vals if isinstance(value, (list, tuple, np.ndarray)) else vals[0]

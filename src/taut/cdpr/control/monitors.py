@@ -24,7 +24,9 @@ class ControlEvent:
     ----------
     kind : str
         ``"slack"`` (tension below t_min), ``"over_tension"`` (above t_max), ``"tipping"``
-        (an edge moment > 0), ``"torque_saturation"``, ``"speed_saturation"``.
+        (an edge moment > 0), ``"torque_saturation"`` (at the peak torque),
+        ``"above_rated"`` (above the rated torque for longer than the model's
+        ``peak_duration``), ``"speed_saturation"``.
     index : int
         Cable index (tensions, motors) or edge index (tipping).
     name : str

@@ -4,13 +4,16 @@ elastic unilateral cables wound on winches, batched over B plants (Monte Carlo).
 State per plant: centre of mass ``x_c`` and velocity ``v_c`` (world), rotation ``R`` and body
 angular velocity ``w_b``, unstretched cable lengths ``L0`` (m), motor speeds (rad/s) and the
 servo-drive integrators (N m). Forces: gravity, cable tensions
-``T_i = max(0, (EA (L_i - L0_i) + d (L_dot_i - L0_dot_i)) / L0_i)`` along ``u_i`` (FASTKIT eq. 18), and an
-optional constant external wrench. Winches: see :mod:`taut.cdpr.control.dynamics`.
+``T_i = max(0, (EA (L_i - L0_i) + d (L_dot_i - L0_dot_i)) / (L0_i + rho_i))`` along ``u_i``
+(FASTKIT eq. 18; ``rho_i`` the routed length between drum and exit), and an optional constant
+external wrench. Winches (friction with stiction, gear loss with the direction of power flow,
+torque saturation at the peak torque): see :mod:`taut.cdpr.control.dynamics`.
 
 Integrator: semi-implicit (symplectic) Euler with ``substeps`` steps per control period: the
 velocities (platform and rotors) are advanced with the forces at the current configuration,
 then the configuration with the new velocities, the rotation on SO(3) by the exponential map
-(``R <- R exp(h [w_b])``, so R stays orthonormal). It is first-order accurate and symplectic:
+(``R <- R exp(h [w_b])``, so R stays orthonormal); the rotors' friction is implicit (stick
+and breakaway, :meth:`DynamicsModel.friction_step`). It is first-order accurate and symplectic:
 without losses its energy error stays bounded (no drift), which the tests check over 2 s. It
 is stable while ``omega_max h < 2`` for the stiffest mode ``omega_max`` of the linearised
 platform-cable-rotor system; :func:`stiffest_mode` computes it, and a step with
@@ -20,7 +23,9 @@ Energy: with no damping, friction or efficiency loss and constant motor torques 
 conservative up to one term: the strain energy ``EA (L - L0)^2 / (2 L0)`` of a cable whose
 unstretched length changes pulls the drum with ``T + T^2 / (2 EA)`` while the model (like
 the real drum) feels ``T``; for FASTKIT ``T / EA ~ 1e-3``, so total energy is conserved to
-~2e-5 relative over 2 s (tests/cdpr/control/test_control_sim.py).
+~2e-5 relative over 2 s (tests/cdpr/control/test_control_sim.py). With losses,
+:class:`EnergyLedger` books the motors' work and what the gearboxes, the friction and the cable
+damping dissipate over each step, so that work in = stored energy change + dissipated.
 """
 
 from __future__ import annotations
@@ -89,6 +94,7 @@ class Plant:
             * np.stack([p.friction_scales for p in perturbations])
         self.rotor_inertia = dynamics.rotor_inertia * np.stack(
             [p.inertia_scales for p in perturbations])
+        self.routing = np.repeat(dynamics.routing(robot.m)[None], B, axis=0)   # (B, m), m
         self.g = robot.gravity
         ext = np.zeros(6) if external_wrench is None else np.asarray(external_wrench, float)
         self.f_ext, self.m_ext = ext[:3], ext[3:]
@@ -114,6 +120,7 @@ class Plant:
         L = np.sqrt((vec * vec).sum(axis=1))
         u = vec / L[:, None, :]
         stretch = L - s.L0
+        elastic = s.L0 + self.routing
         d = self.dyn
         if d.cable_damping > 0.0:
             # velocity of the attachments: v_c + R (w_b x b_i) = v_c - R [b_i]x w_b
@@ -121,19 +128,25 @@ class Plant:
             va = s.vc[:, :, None] - s.R @ np.swapaxes(bxw, 1, 2)
             # strain rate: L_dot - L0_dot (paying out at the rotor speed is not stretching)
             sdot = (u * (exit_vel - va)).sum(axis=1) - d.length_per_rad * s.speed
-            f = (d.cable_stiffness * stretch + d.cable_damping * sdot) / s.L0
+            f = (d.cable_stiffness * stretch + d.cable_damping * sdot) / elastic
             T = np.where(stretch > 0.0, np.maximum(f, 0.0), 0.0)
         else:
-            T = np.maximum(d.cable_stiffness * stretch / s.L0, 0.0)
+            T = np.maximum(d.cable_stiffness * stretch / elastic, 0.0)
         return T, u, r
+
+    def stretches(self, s: PlantState, exits: np.ndarray) -> np.ndarray:
+        """Cable stretches ``L - L0`` (B, m), m, for world exits (3, m)."""
+        vec = (exits - s.R @ self.attach_c) + (self.exit_offsets - s.xc[:, :, None])
+        return np.sqrt((vec * vec).sum(axis=1)) - s.L0
 
     def motor_torque(self, s: PlantState, mode: str, command: np.ndarray, h: float
                      ) -> np.ndarray:
-        """Motor torques (B, m), N m, saturated: ``command`` directly in ``"torque"`` mode, or
+        """Motor torques (B, m), N m, saturated at the peak torque: ``command`` directly in
+        ``"torque"`` mode, or
         the drive's PI speed loop towards the speed set-points ``command`` (rad/s, clipped to
         the speed limit) in ``"speed"`` mode (its integrator advances by ``h``)."""
         d = self.dyn
-        lim = d.motor_torque_limit
+        lim = d.peak_torque
         if mode == "torque":
             return np.clip(command, -lim, lim)
         err = s.speed - np.clip(command, -d.motor_speed_limit, d.motor_speed_limit)
@@ -142,11 +155,12 @@ class Plant:
         return tau
 
     def step(self, s: PlantState, h: float, exits: np.ndarray, exit_vel: np.ndarray,
-             tau: np.ndarray) -> np.ndarray:
+             tau: np.ndarray, ledger: "EnergyLedger | None" = None) -> np.ndarray:
         """Advance every plant by ``h`` s with motor torques ``tau`` (B, m); returns the
-        tensions (B, m) at the start of the step."""
+        tensions (B, m) at the start of the step. A ``ledger`` books the step's energy flows."""
         B = s.xc.shape[0]
         T, u, r = self.cables(s, exits, exit_vel)
+        stretch0 = self.stretches(s, exits) if ledger is not None else None
         Tu = u * T[:, None, :]
         F = Tu.sum(axis=2) + self.f_ext
         # Body-frame moment about the CoM: sum_i b_i x (R^T f_i) = [[b_1]x ... [b_m]x] g.
@@ -161,10 +175,14 @@ class Plant:
         s.R[:] = s.R @ so3_exp(h * s.wb)
         d = self.dyn
         k = d.length_per_rad
-        acc = (k * T - tau - d.gear_loss(tau, T, s.speed, self.eta, self.eta_b)
-               - d.friction(s.speed, self.friction_scale)) / self.rotor_inertia
-        s.speed += h * acc
+        gear = d.gear_loss(tau, T, s.speed, self.eta, self.eta_b)
+        if ledger is not None and stretch0 is not None:
+            el0 = d.cable_stiffness * np.maximum(stretch0, 0.0) / (s.L0 + self.routing)
+        s.speed[:], fric = d.friction_step(s.speed, k * T - tau - gear, h, self.rotor_inertia,
+                                           self.friction_scale)
         s.L0 += (h * k) * s.speed
+        if ledger is not None and stretch0 is not None:
+            ledger.book(self, s, h, exits, tau, T, gear, fric, stretch0, el0)
         return T
 
     # -- measurements and energy -----------------------------------------------------------
@@ -178,19 +196,63 @@ class Plant:
     def energy(self, s: PlantState, exits: np.ndarray, tau: np.ndarray,
                L0_start: np.ndarray) -> np.ndarray:
         """Total mechanical energy (B,), J: platform and rotor kinetic energy, gravity (zero
-        at the ground), cable strain energy ``EA (L - L0)^2 / (2 L0)`` and the potential of
+        at the ground), cable strain energy ``EA (L - L0)^2 / (2 (L0 + rho))`` and the potential of
         constant motor torques ``tau N / r (L0 - L0_start)`` (valid for constant tau; a
         conservative check needs the lossless model, see ``DynamicsModel.without_losses``)."""
         d = self.dyn
-        T, _, _ = self.cables(s, exits, np.zeros_like(exits))
-        stretch = T * s.L0 / d.cable_stiffness
+        stretch = np.maximum(self.stretches(s, exits), 0.0)
         ke = 0.5 * self.mass * np.einsum("bi,bi->b", s.vc, s.vc) + 0.5 * np.einsum(
             "bi,bij,bj->b", s.wb, self.inertia, s.wb) + 0.5 * np.einsum(
             "bm,bm,bm->b", self.rotor_inertia, s.speed, s.speed)
         pe = -self.mass * (s.xc @ self.g) + 0.5 * np.einsum(
-            "bm,bm->b", d.cable_stiffness * stretch ** 2, 1.0 / s.L0)
+            "bm,bm->b", d.cable_stiffness * stretch ** 2, 1.0 / (s.L0 + self.routing))
         pm = np.einsum("bm,bm->b", tau / d.length_per_rad, s.L0 - L0_start)
         return ke + pe + pm
+
+
+@dataclass
+class EnergyLedger:
+    """Energy flows of B plants summed over the steps booked (J, each (B,)): the motors' work
+    on the rotors (``input``; positive when they wind cable in against the load), what the
+    gearboxes, the rotor friction and the cable damping dissipate, and ``spooling``, the
+    strain energy ``T^2 / (2 EA)`` per metre that the model's drum does not account for when
+    it pays out or winds in cable (see the module docstring; ~``T / EA`` of the work). Over
+    any run ``input = stored energy change + gear + friction + damping + spooling`` up to the
+    integrator's O(h) error (the stored energy is :meth:`Plant.energy` with zero torques);
+    the terms use the step's end velocities, as the semi-implicit Euler step does.
+    """
+
+    input: np.ndarray
+    gear: np.ndarray
+    friction: np.ndarray
+    damping: np.ndarray
+    spooling: np.ndarray
+
+    @classmethod
+    def zeros(cls, B: int) -> "EnergyLedger":
+        """An empty ledger for B plants."""
+        return cls(np.zeros(B), np.zeros(B), np.zeros(B), np.zeros(B), np.zeros(B))
+
+    @property
+    def dissipated(self) -> np.ndarray:
+        """Gear + friction + damping losses (B,), J (never negative)."""
+        return self.gear + self.friction + self.damping
+
+    def book(self, plant: "Plant", s: PlantState, h: float, exits: np.ndarray,
+             tau: np.ndarray, T: np.ndarray, gear: np.ndarray, fric: np.ndarray,
+             stretch0: np.ndarray, elastic0: np.ndarray) -> None:
+        """Add one step: torques ``tau``, tensions ``T``, stretches ``stretch0`` and elastic
+        tensions ``elastic0`` at its start, gear and friction torques ``gear``, ``fric``
+        (B, m), and the state ``s`` after it."""
+        w = s.speed
+        self.input += (-tau * w).sum(axis=1) * h          # tau winds in, w pays out
+        self.gear += (gear * w).sum(axis=1) * h
+        self.friction += (fric * w).sum(axis=1) * h
+        # cable damping: the tension above the elastic one times the stretch increment
+        self.damping += ((T - elastic0) * (plant.stretches(s, exits) - stretch0)).sum(axis=1)
+        EA = plant.dyn.cable_stiffness
+        self.spooling += (elastic0 ** 2 / (2.0 * EA) * (h * plant.dyn.length_per_rad) * w
+                          ).sum(axis=1)
 
 
 def moving_body(robot: CableRobot, payload_scale: np.ndarray
@@ -232,13 +294,13 @@ def stiffest_mode(plant: Plant, state: PlantState, exits: np.ndarray) -> float:
     """Largest natural frequency (rad/s) of the linearised platform-cable-rotor system at the
     state of plant 0: ``sqrt(max eig(M^-1 K))`` with generalised coordinates (platform twist
     about the CoM, 6; unstretched lengths, m) and the axial cable stiffnesses
-    ``k_i = EA / L0_i`` (taut cables only) and, per cable, the lightest rotor of all plants.
+    ``k_i = EA / (L0_i + rho_i)`` (taut cables only) and, per cable, the lightest rotor of all plants.
     The integrator needs ``omega_max h < 2``."""
     d = plant.dyn
     T, u, r = plant.cables(state, exits, np.zeros_like(exits))
     u0, r0 = u[0].T, r[0].T
     G = np.hstack([u0, np.cross(r0, u0)])                  # (m, 6): dL = -G dx
-    k = np.where(T[0] > 0, d.cable_stiffness / state.L0[0], 0.0)
+    k = np.where(T[0] > 0, d.cable_stiffness / (state.L0[0] + plant.routing[0]), 0.0)
     m = plant.robot.m
     J = np.hstack([-G, -np.eye(m)])                         # stretch = J [dx; dL0]
     K = J.T @ (k[:, None] * J)

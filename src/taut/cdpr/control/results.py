@@ -204,7 +204,7 @@ def _events(times: np.ndarray, T: np.ndarray, tau: np.ndarray, speed: np.ndarray
             enames: tuple[str, ...]) -> list[ControlEvent]:
     """Every monitor's episodes, sorted by start time."""
     tol = EVENT_TENSION_TOL
-    lim_t = np.full(robot.m, dyn.motor_torque_limit)
+    lim_t = np.full(robot.m, dyn.peak_torque)
     lim_w = np.full(robot.m, dyn.motor_speed_limit)
     ev = (episodes(times, T, T < robot.t_min - tol, "slack", names, robot.t_min, "min")
           + episodes(times, T, T > robot.t_max + tol, "over_tension", names, robot.t_max, "max")
@@ -214,6 +214,10 @@ def _events(times: np.ndarray, T: np.ndarray, tau: np.ndarray, speed: np.ndarray
                      "torque_saturation", names, lim_t, "max")
           + episodes(times, np.abs(speed), np.abs(speed) > lim_w, "speed_saturation", names,
                      lim_w, "max"))
+    # the drive's time rule: above the rated torque for at most dyn.peak_duration at a time
+    lim_r = np.full(robot.m, dyn.rated_torque)
+    ev += [e for e in episodes(times, np.abs(tau), np.abs(tau) > lim_r, "above_rated", names,
+                               lim_r, "max") if e.end - e.start > dyn.peak_duration]
     ev.sort(key=lambda e: (e.start, e.kind, e.index))
     return ev
 
@@ -247,7 +251,7 @@ class summarise:
         self.t_lo = np.fmin(self.t_lo, T.min(axis=1))
         self.t_hi = np.fmax(self.t_hi, T.max(axis=1))
         self.slack += np.any(T < robot.t_min - EVENT_TENSION_TOL, axis=1)
-        self.sat |= np.any(np.abs(tau) >= self.setup.dyn.motor_torque_limit, axis=1)
+        self.sat |= np.any(np.abs(tau) >= self.setup.dyn.peak_torque, axis=1)
         self.count += 1
         if robot.n_edges and k % 10 == 0:                       # tipping every 10 ms
             exits = self.setup.geo.exits[k][None] + np.swapaxes(pl.exit_offsets, 1, 2)

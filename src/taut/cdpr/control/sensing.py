@@ -11,8 +11,8 @@ gives the controller the true pose and twist instead (an external tracker), for 
 
 Estimator (private, numpy; the compiled loop mirrors it): with ``ra_i = R a_i`` and unit
 vectors ``u_i`` from attachment to exit, the estimated cable lengths are
-``L_i = L0_i (1 + T_i / EA)`` (``T`` the load-cell tension when there is one, else the
-reference tension of the nominal model), the pose minimises ``sum (|e_i - p - R a_i| - L_i)^2``
+``L_i = L0_i + T_i (L0_i + rho_i) / EA`` (``T`` the load-cell tension when there is one,
+else the reference tension of the nominal model; ``rho`` the routing length), the pose minimises ``sum (|e_i - p - R a_i| - L_i)^2``
 by Gauss-Newton (rows ``[-u_i, -(ra_i x u_i)]``, warm-started, rotation updated on SO(3)),
 and the twist solves the same rows in least squares against ``L_dot_i - u_i . e_dot_i`` with
 ``L_dot = kl theta_dot``.

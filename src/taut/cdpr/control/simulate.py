@@ -15,14 +15,14 @@ from typing import Any, Callable, Literal, Sequence, get_args
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._jit import HAVE_NUMBA
+from ..._jit import HAVE_NUMBA, not_compiled_reason
 from ..._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
     as_choice, as_positive, require_instances)
 from ...errors import InvalidInputError
 from .._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
 from ..kinematics.forward import rpy_from_matrices
-from .controllers import (ControlContext, Controller, Measurement, TorqueController,
-    VelocityController)
+from .controllers import (DESIGN_CONTROL_RATE, ControlContext, Controller, Measurement,
+    TorqueController, VelocityController)
 from .dynamics import DynamicsModel
 from ..model.robot import CableRobot
 from .model_errors import ModelErrors, stack_perturbations
@@ -39,6 +39,9 @@ Backend = Literal["auto", "numba", "numpy"]
 
 _CHECK_EVERY = 50          # control steps between divergence checks
 _MC_RECORD_EVERY = 10      # Monte Carlo keeps every 10th state for the tipping monitor
+
+#: Default pre-roll of a run before t = 0, s (see :func:`simulate`'s ``settle``).
+DEFAULT_SETTLE = 1.0
 
 #: Most integration substeps per control step (1 MHz integration at a 1 kHz controller).
 MAX_SUBSTEPS = 1000
@@ -155,8 +158,7 @@ def _parked_lengths(plant: Plant, exits: np.ndarray, ctx: ControlContext) -> np.
     R0 = rotation_matrices(ctx.ref_poses[:1, 3:])[0]
     att = ctx.ref_poses[0, :3, None] + R0 @ plant.robot.attach_local.T      # (3, m)
     L = np.linalg.norm(exits[None] + plant.exit_offsets - att[None], axis=1)  # (B, m)
-    EA = plant.dyn.cable_stiffness
-    return EA * L / (EA + ctx.tensions[0])
+    return plant.dyn.unstretched_length(L, ctx.tensions[0], plant.routing)
 
 
 def _measure(setup: _Setup, k: int) -> Measurement:
@@ -187,7 +189,7 @@ def _measure_at(setup: _Setup, k: int, pl: Plant, s: PlantState, sens: Sensing,
         return Measurement(p, s.R, v, w, L0m, s.speed, tension)
     t_known = setup.T_last + setup.noise[k % len(setup.noise)] \
         if sens.tension == "load_cell" else ctx.tensions[k][None]
-    lengths = L0m * (1.0 + t_known / d.cable_stiffness)
+    lengths = d.stretched_length(L0m, t_known, d.routing(L0m.shape[1]))
     it = SENSING_FK_FIRST_ITERATIONS if k == 0 else SENSING_FK_ITERATIONS
     setup.est_p, setup.est_R = estimate_pose(setup.est_p, setup.est_R, ctx.exits[k],
                                              ctx.attach, lengths, it)
@@ -246,12 +248,12 @@ def _backend(backend: str, controller: Controller) -> str:
     compiled = type(controller) in (VelocityController, TorqueController)
     if backend == "numpy" or (backend == "auto" and not (compiled and HAVE_NUMBA)):
         return "numpy"
-    if not HAVE_NUMBA:
-        raise InvalidInputError("backend", "numba is not installed (it is a dependency "
-                                           "of taut; pip install numba)")
     if not compiled:
-        raise InvalidInputError("backend", "the numba backend runs VelocityController and "
-                                           "TorqueController only; use backend='numpy'")
+        raise InvalidInputError("backend", f"the numba backend compiles VelocityController and "
+                                           f"TorqueController only; {type(controller).__name__} "
+                                           "runs on backend='numpy' (or 'auto')")
+    if not HAVE_NUMBA:
+        raise InvalidInputError("backend", not_compiled_reason())
     return "numba"
 
 
@@ -274,17 +276,17 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
                                    c.joint_damping], float)  # type: ignore[attr-defined]
     eta_b = d.efficiency if d.backdrive_efficiency is None else d.backdrive_efficiency
     dyn = np.array([d.cable_stiffness, d.cable_damping, d.length_per_rad, d.efficiency,
-                    d.motor_torque_limit, d.motor_speed_limit, d.rotor_inertia,
+                    d.peak_torque, d.motor_speed_limit, d.rotor_inertia,
                     d.friction_static, d.friction_coulomb, d.friction_viscous,
                     d.stribeck_speed, FRICTION_SPEED_WIDTH, d.drive_speed_gain,
-                    d.drive_integral_gain, eta_b])
+                    d.drive_integral_gain, eta_b, *d.routing(m)])
     sens = setup.sensing
     sv = np.array([float(sens.ideal_pose), setup.quantum,
                    {"none": 0.0, "current": 1.0, "load_cell": 2.0}[sens.tension],
                    setup.filter_gain, float(setup.delay), float(SENSING_FK_ITERATIONS),
                    float(SENSING_FK_FIRST_ITERATIONS)])
     winch = np.stack([pl.eta, pl.eta_b, pl.friction_scale * np.ones_like(pl.eta),
-                      pl.rotor_inertia])
+                      pl.rotor_inertia, pl.routing])
     rec = np.full(((n + rec_every - 1) // rec_every, n_rec_plants, 12 + 3 * m), np.nan)
     summ = np.zeros((B, 6))
     summ[:, 2], summ[:, 3] = np.inf, -np.inf
@@ -310,9 +312,9 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
 
 def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
              model_errors: ModelErrors | None = None, base_motion: BaseMotion | None = None,
-             control_rate: float = 1000.0, duration: float | None = None,
+             control_rate: float = DESIGN_CONTROL_RATE, duration: float | None = None,
              dynamics: DynamicsModel | None = None, substeps: int = 1,
-             external_wrench: ArrayLike | None = None, settle: float = 1.0,
+             external_wrench: ArrayLike | None = None, settle: float = DEFAULT_SETTLE,
              backend: Backend = "auto", sensing: Sensing | None = None,
              progress: Callable[[int, int], None] | None = None) -> ControlResult:
     """Simulate a controller driving the cable robot along a reference.
@@ -392,8 +394,16 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
         if progress is not None:
             progress(n, n)
         return assemble_result(setup, controller, hist, int(div_n[0]))
+    return _run_numpy(setup, controller, progress)
+
+
+def _run_numpy(setup: _Setup, controller: Controller,
+               progress: Callable[[int, int], None] | None) -> ControlResult:
+    """One run of the numpy loop on a prepared set-up (plant 0 recorded)."""
+    n, m = len(setup.times), setup.robot.m
     rec = {"xc": np.empty((n, 3)), "R": np.empty((n, 3, 3)), "T": np.empty((n, m)),
            "tau": np.empty((n, m)), "speed": np.empty((n, m))}
+
     def record(k: int, T: np.ndarray, tau: np.ndarray, snap: tuple) -> None:
         rec["xc"][k], rec["R"][k], rec["T"][k] = snap[0][0], snap[1][0], T[0]
         rec["tau"][k], rec["speed"][k] = tau[0], snap[2][0]
@@ -404,9 +414,9 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
 
 def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
                 model_errors: Sequence[ModelErrors], *, base_motion: BaseMotion | None = None,
-                control_rate: float = 1000.0, duration: float | None = None,
+                control_rate: float = DESIGN_CONTROL_RATE, duration: float | None = None,
                 dynamics: DynamicsModel | None = None, substeps: int = 1,
-                settle: float = 1.0, backend: Backend = "auto", sensing: Sensing | None = None,
+                settle: float = DEFAULT_SETTLE, backend: Backend = "auto", sensing: Sensing | None = None,
                 progress: Callable[[int, int], None] | None = None) -> MonteCarloResult:
     """Run one simulation per entry of ``model_errors``, batched through one plant (the
     per-step work is vectorised over runs), keeping summary numbers per run.
