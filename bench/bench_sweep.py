@@ -8,12 +8,21 @@ run against a cluster started beforehand). Then the chunk size at 2 workers. Run
 interleaved and repeated; medians and [min, max] are printed.
 
     python bench/bench_sweep.py [--points 20000] [--repeat 3]
+
+``--memory N [N ...]`` instead measures the client's peak memory (``ru_maxrss`` of the
+process that calls ``run_sweep``, workers excluded) and the throughput of the same map at
+each size N with 2 local workers, one fresh process per size (interleaved over
+``--repeat``), to check that the client's memory does not grow with the number of points.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import logging
+import resource
+import subprocess
+import sys
 import statistics
 import tempfile
 import time
@@ -72,12 +81,47 @@ def summary(name: str, times: list[float], points: int, ref: float | None = None
             f"{rate:8.0f} points/s{extra}{per}")
 
 
+def client_run(points: int, chunk: int) -> None:
+    """One sweep with 2 local workers; prints this process's peak RSS and the wall time."""
+    spec = spec_for(points, chunk)
+    seconds = sweep_seconds(spec, workers=2)
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024      # KiB -> MiB
+    print(json.dumps({"points": spec.size, "seconds": seconds, "peak_rss_MiB": peak}))
+
+
+def memory(sizes: list[int], chunk: int, repeat: int) -> None:
+    runs: dict[int, list[dict]] = {n: [] for n in sizes}
+    for _ in range(repeat):                                   # interleaved
+        for n in sizes:
+            out = subprocess.run([sys.executable, __file__, "--client", str(n), "--chunk",
+                                  str(chunk)], capture_output=True, text=True, check=True)
+            runs[n].append(json.loads(out.stdout.strip().splitlines()[-1]))
+    print(f"client peak RSS and throughput, 2 local workers, chunk {chunk}, {repeat} runs:")
+    ref = None
+    for n in sizes:
+        rss = [r["peak_rss_MiB"] for r in runs[n]]
+        rate = [r["points"] / r["seconds"] for r in runs[n]]
+        ref = ref or statistics.median(rss)
+        print(f"  {runs[n][0]['points']:>11,d} points: peak RSS {statistics.median(rss):7.1f} MiB "
+              f"[{min(rss):.1f}, {max(rss):.1f}] ({statistics.median(rss) / ref:.2f}x the "
+              f"smallest)  {statistics.median(rate):7.0f} points/s [{min(rate):.0f}, "
+              f"{max(rate):.0f}]")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--points", type=int, default=20000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--chunk", type=int, default=2048)
+    ap.add_argument("--memory", type=int, nargs="+", metavar="N")
+    ap.add_argument("--client", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.client:
+        client_run(args.client, args.chunk)
+        return
+    if args.memory:
+        memory(args.memory, args.chunk, args.repeat)
+        return
     from distributed import Client, LocalCluster
 
     spec = spec_for(args.points, args.chunk)

@@ -83,3 +83,46 @@ def test_digest_changes_with_what_changes_results():
     assert a.digest == _spec().digest
     assert a.digest != _spec(parameters={"scenario_seed": [1, 2, 4]}).digest
     assert a.digest != _spec(seed=1).digest
+
+
+CDPR = {"task": "cdpr_workspace", "base": "fastkit", "parameters": {"payload": [0.0]}}
+
+
+def _cdpr(**over):
+    return sweep_from_mapping({**CDPR, **over})
+
+
+@pytest.mark.parametrize("over,field", [
+    ({"seed": True}, "seed"), ({"chunk_size": False}, "chunk_size"),
+    ({"mode": "random", "samples": True, "parameters": {"payload": {"uniform": [0, 1]}}},
+     "samples"),
+    ({"parameters": {"payload": [0.0, True]}}, "parameters.payload[1]"),
+    ({"parameters": {"payload": {"range": [0, True], "num": 3}}}, "parameters.payload.range[1]"),
+    ({"parameters": {"payload": {"range": [0, 1], "num": True}}}, "parameters.payload.num"),
+    ({"parameters": {"payload": {"range": [0, 1], "step": True}}}, "parameters.payload.step"),
+    ({"parameters": {"payload": {"values": [False]}}}, "parameters.payload.values[0]"),
+    ({"mode": "random", "samples": 3, "parameters": {"payload": {"normal": [0, True]}}},
+     "parameters.payload.normal[1]"),
+    ({"options": {"grid": [2, True, 2]}}, "options.grid[1]"),
+    ({"options": {"box": [[0, 0, 0], [1, True, 1]]}}, "options.box[1][1]"),
+    ({"parameters": {"payload": "1.5"}}, "parameters.payload"),
+    ({"parameters": {"payload": {"range": [0, 1], "num": 2.0}}}, "parameters.payload.num"),
+    ({"parameters": {"payload": {"range": [0, 1], "nun": 2}}}, "parameters.payload.nun"),
+    ({"outputs": [3]}, "outputs[0]"),
+    ({"base": 3}, "base"),
+])
+def test_a_boolean_or_string_is_no_number_anywhere(over, field):
+    # Strict numbers in the file's model itself: no second walk over the data.
+    with pytest.raises(SweepError) as err:
+        _cdpr(**over)
+    assert err.value.field == field
+
+
+def test_integers_are_numbers_and_floats_keep_their_value():
+    spec = _cdpr(parameters={"payload": {"range": [0, 10], "num": 3},
+                             "base_separation": [5, 6.5]},
+                 options={"grid": [2, 1, 2], "box": [[-1, 0, 0], [1, 0, 1.5]]})
+    np.testing.assert_array_equal(spec.parameters[0].values, [0.0, 5.0, 10.0])
+    np.testing.assert_array_equal(spec.parameters[1].values, [5.0, 6.5])
+    assert spec.parameters[1].values.dtype == np.float64
+    assert spec.options == {"grid": [2, 1, 2], "box": [[-1.0, 0.0, 0.0], [1.0, 0.0, 1.5]]}

@@ -121,16 +121,17 @@ def plot_command(
     out: Optional[Path] = typer.Option(None, "--out", help="Figure file (.png, .pdf, .svg; "
                                        "default DIR/<value>.png)."),
 ) -> int:
-    from ..sweep import read_results
+    from ..sweep import read_results, results_columns
 
-    columns, meta = read_results(folder)
+    names, meta, _ = results_columns(folder)
     target = output_path(out if out is not None else folder / f"{value}.png", "--out",
                          FIGURE_SUFFIXES)
     assert target is not None
     for flag, name in (("--x", x), ("--y", y), ("--value", value)):
-        if name is not None and name not in columns:
+        if name is not None and name not in names:
             raise SweepError(flag, f"no column {name!r} in the results; columns: "
-                             f"{', '.join(columns)}")
+                             f"{', '.join(names)}")
+    columns, _ = read_results(folder, columns=[c for c in (x, y, value) if c is not None])
     from ..sweep import TASKS
     from ..viz.sweep import plot_sweep
     task = TASKS.get(meta.get("sweep_task", ""))

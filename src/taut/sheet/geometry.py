@@ -31,7 +31,6 @@ from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_finite_scalar, as_nonnegative
 from ..errors import InvalidInputError
-from ._tol import CIRCLE_RTOL, COLLINEAR_RTOL
 
 __all__ = ["FormationMetrics", "formation_metrics", "minimum_enclosing_circle",
            "formation_size", "max_obstacle_height", "min_robot_distance",
@@ -47,31 +46,9 @@ def _points(formation: object, field: str = "formation") -> np.ndarray:
     return r
 
 
-def _circle_two(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
-    c = (a + b) / 2
-    return c, float(np.linalg.norm(a - c))
-
-
-def _circle_three(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, float]:
-    """Circumcircle of a triangle; for (near-)collinear points the circle on the farthest
-    pair (which then contains the third point)."""
-    ab, ac = b - a, c - a
-    den = 2.0 * (ab[0] * ac[1] - ab[1] * ac[0])
-    scale = max(np.dot(ab, ab), np.dot(ac, ac), np.dot(c - b, c - b))
-    if abs(den) <= COLLINEAR_RTOL * scale:
-        pairs = [(a, b), (a, c), (b, c)]
-        p, q = max(pairs, key=lambda pq: float(np.dot(pq[0] - pq[1], pq[0] - pq[1])))
-        return _circle_two(p, q)
-    ab2, ac2 = np.dot(ab, ab), np.dot(ac, ac)
-    ux = (ac[1] * ab2 - ab[1] * ac2) / den
-    uy = (ab[0] * ac2 - ac[0] * ab2) / den
-    centre = a + np.array([ux, uy])
-    return centre, float(np.hypot(ux, uy))
-
-
 def minimum_enclosing_circle(formation: ArrayLike) -> tuple[np.ndarray, float]:
-    """Smallest circle containing every robot (Welzl's randomised incremental algorithm,
-    iterative form; expected O(N)).
+    """Smallest circle containing every robot (GEOS's minimum bounding circle through
+    shapely, as for the planner's obstacles in :mod:`taut.plan.world`).
 
     Parameters
     ----------
@@ -84,30 +61,17 @@ def minimum_enclosing_circle(formation: ArrayLike) -> tuple[np.ndarray, float]:
     radius : float
         Half of :math:`D_c` in the planning paper's eq. (1).
     """
+    import shapely
+
     pts = _points(formation)
-    # Work relative to the centroid, with a fixed shuffle (reproducible, expected O(N)).
+    # Relative to the centroid, so that far-off coordinates do not cost precision.
     origin = pts.mean(axis=0)
-    p = pts - origin
-    p = p[np.random.default_rng(0).permutation(len(p))]
-    scale = float(np.max(np.abs(p))) or 1.0
-    tol = CIRCLE_RTOL * scale
-
-    def inside(c: np.ndarray, r: float, q: np.ndarray) -> bool:
-        return float(np.linalg.norm(q - c)) <= r + tol
-
-    c, r = p[0].copy(), 0.0
-    for i in range(1, len(p)):
-        if inside(c, r, p[i]):
-            continue
-        c, r = p[i].copy(), 0.0
-        for j in range(i):
-            if inside(c, r, p[j]):
-                continue
-            c, r = _circle_two(p[i], p[j])
-            for k in range(j):
-                if not inside(c, r, p[k]):
-                    c, r = _circle_three(p[i], p[j], p[k])
-    return c + origin, r
+    cloud = shapely.multipoints(pts - origin)
+    radius = float(shapely.minimum_bounding_radius(cloud))
+    if radius == 0.0:                     # every robot at one place: GEOS gives no polygon
+        return pts[0].copy(), 0.0
+    centre = np.array(shapely.minimum_bounding_circle(cloud).centroid.coords[0])
+    return centre + origin, radius
 
 
 def formation_size(formation: ArrayLike, margin: float = 0.0) -> float:

@@ -17,7 +17,9 @@ Running
     :func:`run_sweep` writes ``results.parquet`` and returns a :class:`SweepResult`;
     :func:`evaluate_chunk` computes one chunk's rows, :func:`chunk_size_of` its size.
 Results
-    :func:`read_results` reads a results folder back as numpy columns and metadata.
+    :func:`read_results` reads a results folder back as numpy columns and metadata (only
+    the columns and rows asked for), :func:`iter_results` batch by batch,
+    :func:`results_columns` names its columns, metadata and row count.
 
 Examples
 --------
@@ -31,7 +33,7 @@ array([0., 1., 2.])
 
 from .file import load_sweep, sweep_from_mapping
 from .registry import TASKS
-from .results import read_results
+from .results import iter_results, read_results, results_columns
 from .runner import SweepResult, chunk_size_of, evaluate_chunk, run_sweep
 from .spec import Parameter, SweepSpec
 from .task import Task
@@ -44,5 +46,5 @@ __all__ = [
     # running
     "run_sweep", "SweepResult", "evaluate_chunk", "chunk_size_of",
     # results
-    "read_results",
+    "read_results", "iter_results", "results_columns",
 ]

@@ -21,34 +21,38 @@ options: {grid: [21, 1, 9]}         # task options that are not swept
 ``cdpr_deployment`` take ``box`` ([[xmin, ymin, zmin], [xmax, ymax, zmax]], m) and ``grid``
 (three integers nx ny nz >= 1, points per axis of the box); the other tasks take none.
 
-Every mistake is a :class:`~taut.errors.SweepError` naming the key (``parameters.scale``,
-``options.grid[0]``).
+The file's shape is a pydantic model like every other file kind's (strict numbers: a
+boolean or a string is not a number), validated by :func:`taut.io.files.validate_mapping`;
+what the shape cannot say (the task's parameter, output and option names, the mode's rules,
+ranges and sizes) is checked after it. Every mistake is a :class:`~taut.errors.SweepError`
+naming the key (``parameters.scale``, ``options.grid[0]``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Literal, cast
+from typing import Annotated, Any, Literal, Union, cast
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Strict, Tag
 
 from .._validate import MAX_CDPR_LENGTH_M, as_path
-from ..errors import SweepError
-from ..io.files import read_mapping, read_text
+from ..errors import ScenarioError, SweepError
+from ..io.files import read_mapping, read_text, validate_mapping
 from .registry import TASKS
 from .spec import DISTRIBUTIONS, Parameter, SweepSpec, _choice
 
 __all__ = ["load_sweep", "sweep_from_mapping", "base_model"]
 
-_KEYS = {"task", "base", "mode", "seed", "samples", "chunk_size", "parameters", "outputs",
-         "options", "name"}
 #: Most points one sweep may hold (a grid's product or random samples).
 MAX_POINTS = 10**9
 #: Most values one grid axis may hold.
 MAX_AXIS = 10**7
 #: Most points of a task's workspace grid (``options.grid``), per sweep point.
 MAX_GRID_POINTS = 10**6
+#: Largest ``chunk_size`` (points per task).
+MAX_CHUNK = 10**7
 
 #: Options each task accepts (name -> meaning with unit); tasks not listed take none.
 TASK_OPTIONS: dict[str, dict[str, str]] = {
@@ -57,85 +61,117 @@ TASK_OPTIONS: dict[str, dict[str, str]] = {
            "grid": "grid points per axis of the box [nx, ny, nz] (default [21, 1, 9])"}
     for task in ("cdpr_workspace", "cdpr_deployment")}
 
+# --- The file's shape, as pydantic models (strict: a boolean or a string is no number) ---
 
-def _number(value: Any, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SweepError(field, f"must be a number, got {value!r}")
-    if not np.isfinite(value):
-        raise SweepError(field, "must be finite")
-    return float(value)
+#: A finite number (an integer is accepted as a float; a boolean is not).
+_Number = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 
 
-def _count(value: Any, field: str, low: int, high: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise SweepError(field, f"must be an integer, got {value!r}")
-    if not low <= value <= high:
-        raise SweepError(field, f"must be in [{low}, {high}], got {value}")
-    return int(value)
+def _shape(value: Any) -> str:
+    """Which form a parameter's value takes; the tags are the ones
+    :func:`taut.io.files.validate_mapping` leaves out of an error's field."""
+    if isinstance(value, Mapping):
+        return "dict[law]" if set(value) & set(DISTRIBUTIONS) else "dict[axis]"
+    return "list[float]" if isinstance(value, list) else "float"
 
+
+class _Axis(BaseModel):
+    """A grid axis: ``{range: [lo, hi], num: n}``, ``{range, step}`` or ``{values: [...]}``."""
+
+    model_config = ConfigDict(extra="forbid")
+    range: list[_Number] | None = None
+    num: Annotated[int, Strict(), Field(ge=1, le=MAX_AXIS)] | None = None
+    step: _Number | None = None
+    values: Annotated[list[_Number], Field(min_length=1)] | None = None
+
+
+class _Law(BaseModel):
+    """A random distribution (random mode): one of its keys, with its numbers."""
+
+    model_config = ConfigDict(extra="forbid")
+    uniform: list[_Number] | None = None
+    normal: list[_Number] | None = None
+    integers: list[_Number] | None = None
+    choice: list[_Number] | None = None
+
+
+_Value = Annotated[Union[
+    Annotated[_Number, Tag("float")],
+    Annotated[Annotated[list[_Number], Field(min_length=1)], Tag("list[float]")],
+    Annotated[_Axis, Tag("dict[axis]")],
+    Annotated[_Law, Tag("dict[law]")]], Discriminator(_shape)]
+
+
+class _Options(BaseModel):
+    """Task options; which ones a task takes is checked against :data:`TASK_OPTIONS`."""
+
+    model_config = ConfigDict(extra="allow")
+    grid: list[Annotated[int, Strict(), Field(ge=1, le=MAX_GRID_POINTS)]] | None = None
+    box: list[list[_Number]] | None = None
+
+
+class _SweepFile(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    task: Annotated[str, Strict()]
+    base: Annotated[str, Strict()] | None = None
+    mode: Literal["grid", "random"] = "grid"
+    seed: Annotated[int, Strict(), Field(ge=0, le=2**63 - 1)] = 0
+    samples: Annotated[int, Strict(), Field(ge=1, le=MAX_POINTS)] | None = None
+    chunk_size: Annotated[int, Strict(), Field(ge=0, le=MAX_CHUNK)] = 0
+    parameters: dict[str, _Value]
+    outputs: list[Annotated[str, Strict()]] = []
+    options: _Options = _Options()
+    name: Annotated[str, Strict()] | None = None
+
+
+# --- What the shape cannot say: per-task names, mode rules, ranges ---
 
 def _grid_values(value: Any, field: str) -> np.ndarray:
-    if isinstance(value, Mapping):
-        extra = set(value) - {"range", "num", "step", "values"}
-        if extra:
-            raise SweepError(f"{field}.{sorted(extra)[0]}", "unknown key")
-        if "values" in value:
-            return _grid_values(value["values"], f"{field}.values")
-        if "range" not in value:
+    if isinstance(value, _Axis):
+        if value.values is not None:
+            return np.array(value.values)
+        if value.range is None:
             raise SweepError(field, "needs range: [low, high] with num or step, or values")
-        rng = value["range"]
-        if not isinstance(rng, list) or len(rng) != 2:
+        if len(value.range) != 2:
             raise SweepError(f"{field}.range", "must be [low, high]")
-        lo, hi = (_number(v, f"{field}.range") for v in rng)
+        lo, hi = value.range
         if hi < lo:
             raise SweepError(f"{field}.range", f"is empty: high {hi:g} < low {lo:g}")
-        if ("num" in value) == ("step" in value):
+        if (value.num is None) == (value.step is None):
             raise SweepError(field, "give exactly one of num and step with range")
-        if "num" in value:
-            num = _count(value["num"], f"{field}.num", 1, MAX_AXIS)
-            return np.linspace(lo, hi, num)
-        step = _number(value["step"], f"{field}.step")
+        if value.num is not None:
+            return np.linspace(lo, hi, value.num)
+        step = cast(float, value.step)
         if step <= 0:
             raise SweepError(f"{field}.step", "must be > 0")
         if (hi - lo) / step >= MAX_AXIS:
             raise SweepError(f"{field}.step", f"makes more than {MAX_AXIS} values")
         num = int(np.floor((hi - lo) / step * (1 + 1e-12))) + 1
         return lo + step * np.arange(num)
-    if isinstance(value, list):
-        if not value:
-            raise SweepError(field, "is an empty list")
-        return np.array([_number(v, f"{field}[{i}]") for i, v in enumerate(value)])
-    return np.array([_number(value, field)])
+    return np.array(value if isinstance(value, list) else [value], dtype=float)
 
 
-def _options(value: Any, task: str) -> dict[str, Any]:
-    """The ``options`` mapping checked against :data:`TASK_OPTIONS` (plain lists kept)."""
-    if not isinstance(value, Mapping):
-        raise SweepError("options", "must be a mapping")
+def _options(value: _Options, task: str) -> dict[str, Any]:
+    """The ``options`` checked against :data:`TASK_OPTIONS` (plain lists kept)."""
     known = TASK_OPTIONS.get(task, {})
-    for key in value:
+    for key in [*(k for k in ("grid", "box") if k in value.model_fields_set),
+                *(value.model_extra or {})]:
         if key not in known:
             expected = (f"expected one of {', '.join(known)}" if known else
                         f"task {task} takes no options")
             raise SweepError(f"options.{key}", f"unknown option; {expected}")
     out: dict[str, Any] = {}
-    if value.get("grid") is not None:
-        grid = value["grid"]
-        if not isinstance(grid, list) or len(grid) != 3:
+    if value.grid is not None:
+        if len(value.grid) != 3:
             raise SweepError("options.grid", "must be three integers [nx, ny, nz]")
-        counts = [_count(g, f"options.grid[{k}]", 1, MAX_GRID_POINTS)
-                  for k, g in enumerate(grid)]
-        if int(np.prod(counts)) > MAX_GRID_POINTS:
+        if int(np.prod(value.grid)) > MAX_GRID_POINTS:
             raise SweepError("options.grid", f"makes more than {MAX_GRID_POINTS} points")
-        out["grid"] = counts
-    if value.get("box") is not None:
-        box = value["box"]
-        if not (isinstance(box, list) and len(box) == 2
-                and all(isinstance(r, list) and len(r) == 3 for r in box)):
+        out["grid"] = list(value.grid)
+    if value.box is not None:
+        rows = value.box
+        if len(rows) != 2 or any(len(r) != 3 for r in rows):
             raise SweepError("options.box", "must be [[xmin, ymin, zmin], [xmax, ymax, "
                                             "zmax]], m")
-        rows = [[_number(v, f"options.box[{i}][{k}]") for k, v in enumerate(r)]
-                for i, r in enumerate(box)]
         for i, r in enumerate(rows):
             for k, v in enumerate(r):
                 if abs(v) > MAX_CDPR_LENGTH_M:
@@ -143,34 +179,31 @@ def _options(value: Any, task: str) -> dict[str, Any]:
                                      f"accepted range {MAX_CDPR_LENGTH_M:g} m")
         if any(lo > hi for lo, hi in zip(*rows)):
             raise SweepError("options.box", "min must be <= max on every axis")
-        out["box"] = rows
+        out["box"] = [list(r) for r in rows]
     return out
 
 
 def _parameter(name: str, value: Any, mode: str) -> Parameter:
     field = f"parameters.{name}"
-    if isinstance(value, Mapping) and set(value) & set(DISTRIBUTIONS):
+    if isinstance(value, _Law):
         if mode != "random":
             raise SweepError(field, "random distributions need mode: random")
-        if len(value) != 1:
+        laws = {k: v for k, v in value if v is not None}
+        if len(laws) != 1:
             raise SweepError(field, "give one distribution")
-        (law, args), = value.items()
-        if not isinstance(args, list):
-            raise SweepError(f"{field}.{law}", "must be a list of numbers")
-        nums = [_number(v, f"{field}.{law}[{i}]") for i, v in enumerate(args)]
-        return Parameter(name, distribution=law, arguments=np.array(nums))
+        (law, args), = laws.items()
+        return Parameter(name, distribution=law, arguments=np.array(args, dtype=float))
+    values = _grid_values(value, field)
     if mode == "random":
-        values = _grid_values(value, field)
         if values.size != 1:
             raise SweepError(field, "in random mode give a distribution or one value")
         return Parameter(name, distribution="choice", arguments=values)
-    return Parameter(name, values=_grid_values(value, field))
+    return Parameter(name, values=values)
 
 
-def _base(data: Mapping[str, Any], task: str, root: Path
+def _base(base: str | None, task: str, root: Path
           ) -> tuple[str | None, dict[str, Any] | None]:
     need = TASKS[task].needs_base
-    base = data.get("base")
     if not need:
         if base is not None:
             raise SweepError("base", f"task {task} takes no base file")
@@ -242,44 +275,34 @@ def sweep_from_mapping(data: Mapping[str, Any], root: str | Path = ".",
     folder = as_path(root, "root")
     if not isinstance(source, str):
         raise SweepError("source", f"must be the file's text (str), got {type(source).__name__}")
-    unknown = {str(k) for k in data} - _KEYS
-    if unknown:
-        raise SweepError(sorted(unknown)[0], "unknown key")
-    task = _choice(data.get("task"), sorted(TASKS), "task")
+    try:
+        raw = validate_mapping(_SweepFile, dict(data))
+    except ScenarioError as exc:
+        raise SweepError(exc.field, exc.problem) from None
+    task = _choice(raw.task, sorted(TASKS), "task")
     spec_task = TASKS[task]
-    mode = cast(Literal["grid", "random"],
-                _choice(data.get("mode", "grid"), ("grid", "random"), "mode"))
-    seed = _count(data.get("seed", 0), "seed", 0, 2**63 - 1)
-    samples = 0
-    if mode == "random":
-        samples = _count(data.get("samples"), "samples", 1, MAX_POINTS) \
-            if "samples" in data else 0
-        if not samples:
-            raise SweepError("samples", "required in random mode: the number of points")
-    elif "samples" in data:
+    if raw.mode == "random" and not raw.samples:
+        raise SweepError("samples", "required in random mode: the number of points")
+    if raw.mode == "grid" and raw.samples is not None:
         raise SweepError("samples", "only in random mode")
-    params_in = data.get("parameters")
-    if not isinstance(params_in, Mapping) or not params_in:
+    if not raw.parameters:
         raise SweepError("parameters", "required: a mapping of parameter names to values")
     params = []
-    for name, value in params_in.items():
+    for name, value in raw.parameters.items():
         if name not in spec_task.parameters:
             raise SweepError(f"parameters.{name}", f"unknown parameter of {task}; expected "
                              f"one of {', '.join(spec_task.parameters)}")
-        params.append(_parameter(str(name), value, mode))
-    outputs = data.get("outputs", [])
-    if not isinstance(outputs, list):
-        raise SweepError("outputs", "must be a list of output names")
-    for k, name in enumerate(outputs):
-        if not isinstance(name, str) or name not in spec_task.outputs:
-            raise SweepError(f"outputs[{k}]", f"unknown output {name!r} of {task}; expected "
+        params.append(_parameter(name, value, raw.mode))
+    for k, out in enumerate(raw.outputs):
+        if out not in spec_task.outputs:
+            raise SweepError(f"outputs[{k}]", f"unknown output {out!r} of {task}; expected "
                              f"one of {', '.join(spec_task.outputs)}")
-    chunk = _count(data.get("chunk_size", 0), "chunk_size", 0, 10**7)
-    options = _options(data.get("options", {}), task)
-    base, base_data = _base(data, task, folder)
+    options = _options(raw.options, task)
+    base, base_data = _base(raw.base, task, folder)
     spec = SweepSpec(task=task, parameters=tuple(params), base=base, base_data=base_data,
-                     mode=mode, samples=samples, seed=seed, chunk_size=chunk,
-                     outputs=tuple(outputs), options=dict(options), source=source)
+                     mode=raw.mode, samples=raw.samples or 0, seed=raw.seed,
+                     chunk_size=raw.chunk_size, outputs=tuple(raw.outputs),
+                     options=options, source=source)
     if spec.size > MAX_POINTS:
         raise SweepError("parameters", f"make {spec.size} points, more than {MAX_POINTS}")
     return spec

@@ -4,7 +4,9 @@ one, with the same chunks and so the same rows.
 Each chunk is evaluated by :func:`evaluate_chunk`, a pure function of the spec and the
 chunk's bounds; the client writes each finished chunk once (as its future completes), so a
 worker that dies mid-chunk only makes Dask recompute that chunk elsewhere: nothing is lost
-or duplicated.
+or duplicated. The client keeps at most :data:`IN_FLIGHT_PER_WORKER` chunks per worker
+thread submitted at a time and drops each result once written, so its memory does not grow
+with the number of points (measured in ``bench/bench_sweep.py --memory``).
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 import logging
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,7 +25,7 @@ from .. import __version__
 from .._validate import as_array, as_count, as_flag, as_path, require_instance
 from ..errors import SweepError
 from .file import base_model
-from .points import chunk_bounds, expand, point_seeds
+from .points import chunk_bounds, chunk_streams, expand, point_seeds
 from .registry import TASKS
 from .spec import SweepSpec
 from .store import Store
@@ -33,6 +35,9 @@ __all__ = ["SweepResult", "run_sweep", "evaluate_chunk", "chunk_size_of"]
 
 #: Seconds to wait for an existing scheduler to answer before giving up.
 CONNECT_TIMEOUT = 5.0
+#: Chunks submitted but not yet written, per worker thread of the cluster (one running,
+#: one queued so a worker never waits for the client).
+IN_FLIGHT_PER_WORKER = 2
 
 _CONTEXTS: dict[str, Any] = {}
 
@@ -133,13 +138,6 @@ def _connect(workers: int | None, scheduler: str | None) -> Any:
         return Client(cluster)
 
 
-def _params_for(spec: SweepSpec, bounds: list[tuple[int, int]]) -> Callable[[int, int], Columns]:
-    if spec.mode != "random":
-        return lambda lo, hi: expand(spec, lo, hi)
-    everything = expand(spec)            # random draws: one stream for the whole sweep
-    return lambda lo, hi: {k: v[lo:hi] for k, v in everything.items()}
-
-
 def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False, limit: int | None = None,
               progress: Callable[[int, int], None] | None = None) -> SweepResult:
@@ -205,13 +203,11 @@ def _run(spec: SweepSpec, store: Store, limit: int | None, total: int,
          workers: int | None, scheduler: str | None, progress: Any,
          t0: float) -> SweepResult:
     bounds = [b for b in chunk_bounds(spec.size, chunk_size_of(spec)) if b[0] < total]
-    todo = [k for k in range(len(bounds)) if not store.has(k)]
-    reused = len(bounds) - len(todo)
-    done = sum(min(bounds[k][1], total) - bounds[k][0] for k in range(len(bounds))
-               if k not in set(todo))
-    params = _params_for(spec, bounds)
+    todo = [not store.has(k) for k in range(len(bounds))]
+    n_todo = sum(todo)
+    done = sum(min(hi, total) - lo for (lo, hi), run in zip(bounds, todo) if not run)
     try:
-        for k, cols in _execute(spec, bounds, todo, params, workers, scheduler):
+        for k, cols in _execute(spec, bounds, todo, workers, scheduler):
             store.write_chunk(k, cols)
             done += min(bounds[k][1], total) - bounds[k][0]
             if progress is not None:
@@ -219,42 +215,63 @@ def _run(spec: SweepSpec, store: Store, limit: int | None, total: int,
     except (KeyboardInterrupt, _WorkerFailure) as exc:
         msg = "interrupted" if isinstance(exc, KeyboardInterrupt) else str(exc)
         return SweepResult(False, "interrupted", f"{msg}: {done} of {total} points done; run "
-                           "again with --resume to continue", None, 0, len(todo), reused,
-                           time.perf_counter() - t0)
+                           "again with --resume to continue", None, 0, n_todo,
+                           len(bounds) - n_todo, time.perf_counter() - t0)
     meta = {"taut_version": __version__, "sweep_digest": spec.digest,
             "sweep_task": spec.task, "sweep_source": spec.source}
-    path = store.assemble(list(range(len(bounds))), total, meta)
-    return SweepResult(True, "ok", f"{total} points", path, total, len(todo), reused,
-                       time.perf_counter() - t0)
+    path = store.assemble(len(bounds), total, meta)
+    return SweepResult(True, "ok", f"{total} points", path, total, n_todo,
+                       len(bounds) - n_todo, time.perf_counter() - t0)
 
 
 class _WorkerFailure(Exception):
     """A chunk failed on the cluster (e.g. its workers kept dying)."""
 
 
-def _execute(spec: SweepSpec, bounds: list[tuple[int, int]], todo: list[int],
-             params: Callable[[int, int], Columns], workers: int | None,
-             scheduler: str | None) -> Any:
-    """Yield ``(chunk index, columns)`` as chunks finish."""
-    if not todo:
+def _evaluate_part(spec: SweepSpec, start: int, stop: int,
+                   states: tuple[Mapping[str, Any], ...] | None) -> Columns:
+    """:func:`evaluate_chunk` of a chunk whose random columns are drawn from ``states``
+    (:func:`~taut.sweep.points.chunk_streams`): a task carries the spec and a few hundred
+    bytes, never the chunk's columns, so the scheduler holds no data per chunk."""
+    return evaluate_chunk(spec, start, stop, expand(spec, start, stop, states))
+
+
+def _execute(spec: SweepSpec, bounds: list[tuple[int, int]], todo: list[bool],
+             workers: int | None, scheduler: str | None) -> Any:
+    """Yield ``(chunk index, columns)`` as chunks finish (chunks ``k`` with ``todo[k]``)."""
+    if not any(todo):
         return
+    pending = ((k, lo, hi, states) for k, ((lo, hi), states)
+               in enumerate(zip(bounds, chunk_streams(spec, bounds))) if todo[k])
     if workers == 0 and scheduler is None:
-        for k in todo:
-            lo, hi = bounds[k]
-            yield k, evaluate_chunk(spec, lo, hi, params(lo, hi))
+        for k, lo, hi, states in pending:
+            yield k, _evaluate_part(spec, lo, hi, states)
         return
     from distributed import as_completed
 
     client = _connect(workers, scheduler)
     try:
-        futures, index = [], {}
-        for k in todo:
-            lo, hi = bounds[k]
-            fut = client.submit(evaluate_chunk, spec, lo, hi, params(lo, hi),
+        index: dict[str, int] = {}
+        # The spec goes to the workers once; a task names it. Sent with every task, a
+        # grid's value arrays (their size grows with the sweep) would pass through the
+        # scheduler, which keeps recent task graphs, once per chunk.
+        shared = client.scatter(spec, broadcast=True, hash=False)
+
+        def submit() -> Any:
+            item = next(pending, None)
+            if item is None:
+                return None
+            k, lo, hi, states = item
+            fut = client.submit(_evaluate_part, shared, lo, hi, states,
                                 key=f"taut-sweep-{spec.digest[:16]}-{k}", pure=False)
-            futures.append(fut)
             index[fut.key] = k
-        for fut in as_completed(futures):
+            return fut
+
+        window = IN_FLIGHT_PER_WORKER * max(sum(client.nthreads().values()), 1)
+        first = [f for f in (submit() for _ in range(window)) if f is not None]
+        running = as_completed(first)
+        del first
+        for fut in running:
             try:
                 cols = fut.result()
             except Exception as exc:   # a task error travels back from the worker
@@ -263,10 +280,14 @@ def _execute(spec: SweepSpec, bounds: list[tuple[int, int]], todo: list[int],
                     raise
                 raise _WorkerFailure(f"chunk {index[fut.key]} failed on the cluster "
                                      f"({type(exc).__name__}: {exc})") from None
-            yield index[fut.key], cols
+            k = index.pop(fut.key)
+            fut.release()                       # the cluster may forget it now
+            nxt = submit()
+            if nxt is not None:
+                running.add(nxt)
+            yield k, cols
     finally:
         cluster = getattr(client, "cluster", None)
         client.close()
         if cluster is not None and scheduler is None:
             cluster.close()
-

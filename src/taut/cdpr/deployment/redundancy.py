@@ -14,8 +14,9 @@ that rad/s and m/s mix on a common dimensionless scale):
   1e-6 weight on the cables to make the solution unique: the bases move only when the cables
   alone cannot produce the twist within their limits.
 
-Feasibility is decided by an LP (HiGHS); the QP is solved with SLSQP from that feasible
-point and its result is re-checked against the limits.
+Feasibility is decided by an LP (HiGHS); the QP is solved by DAQP (:mod:`taut._qp`), or
+SciPy's SLSQP from that feasible point where DAQP is not installed, and its result is
+re-checked against the limits.
 """
 
 from __future__ import annotations
@@ -25,8 +26,9 @@ from typing import Literal, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import linprog, minimize
+from scipy.optimize import linprog
 
+from ..._qp import solve_qp
 from ..._validate import as_array, as_choice
 from ...errors import InvalidInputError
 from .._tol import LEAST_BASE_CABLE_WEIGHT, RATE_FLOOR, REDUNDANCY_TOL, SCALE_ONE, SLSQP_FTOL
@@ -166,17 +168,11 @@ def resolve_redundancy(robot: CableRobot, pose: ArrayLike, twist: ArrayLike,
             c = (dd - C @ x) * wc
             return float(np.sum((x * wb) ** 2) + cable_w ** 2 * np.sum(c ** 2))
 
-        def g(x):
-            c = (dd - C @ x) * wc
-            return 2 * x * wb ** 2 - 2 * cable_w ** 2 * (C.T @ (c * wc))
-
-        cons = [{"type": "ineq", "fun": lambda x: hi[nb:] - (dd - C @ x),
-                 "jac": lambda x: C},
-                {"type": "ineq", "fun": lambda x: (dd - C @ x) - lo[nb:],
-                 "jac": lambda x: -C}]
-        res = minimize(f, x0, jac=g, bounds=list(zip(lo[:nb], hi[:nb])), constraints=cons,
-                       method="SLSQP", options={"ftol": SLSQP_FTOL, "maxiter": 200})
-        xq = np.clip(res.x, lo[:nb], hi[:nb])
+        Cw = C * (cable_w * wc)[:, None]                   # f(x) = |wb x|^2 + |Cw x - dw|^2
+        sol = solve_qp(2.0 * (np.diag(wb ** 2) + Cw.T @ Cw), -2.0 * Cw.T @ (cable_w * wc * dd),
+                       A_ub=np.vstack([C, -C]), b_ub=np.concatenate([dd - lo[nb:], hi[nb:] - dd]),
+                       lb=lo[:nb], ub=hi[:nb], x0=x0, ftol=SLSQP_FTOL, unconverged=True)
+        xq = np.clip(x0 if sol is None else sol, lo[:nb], hi[:nb])
         lq = dd - C @ xq
         if np.all(lq <= hi[nb:] + tol) and np.all(lq >= lo[nb:] - tol) and f(xq) <= f(x0):
             x = xq

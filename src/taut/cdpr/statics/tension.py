@@ -19,8 +19,9 @@ mobile bases (eqs. 21-23), for a batch of poses. One entry point,
     <= 2`` redundant cables it is solved exactly and batched: writing ``t = W+ w + N z``
     the problem is the projection of the origin onto a polygon (or interval) in ``z``,
     whose minimiser is the interior point, the foot on an edge line, or a vertex (KKT
-    active-set enumeration). Otherwise (or with ``qp_solver="scipy"``) SciPy's SLSQP
-    solves it pose by pose.
+    active-set enumeration). Otherwise (or with ``qp_solver="daqp"``) the QP solver DAQP
+    solves it pose by pose (:mod:`taut._qp`; a core dependency), or SciPy's SLSQP where DAQP
+    is not installed (or with ``qp_solver="scipy"``).
 
 Returned tensions are polished so that ``W t + w_e = 0`` holds to rounding error.
 """
@@ -33,8 +34,9 @@ from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import linprog, minimize
+from scipy.optimize import linprog
 
+from ..._qp import qp_backend, solve_qp
 from ...errors import InvalidInputError
 from ..._validate import as_choice, as_flag
 from .._batching import is_single, unbatch
@@ -47,7 +49,7 @@ from ..model.robot import CableRobot
 __all__ = ["TensionResult", "distribute_tensions", "METHODS"]
 
 TensionMethod = Literal["closed_form", "lp_min_sum", "lp_min_max", "qp_min_norm"]
-QPSolver = Literal["auto", "enumeration", "scipy"]
+QPSolver = Literal["auto", "enumeration", "daqp", "scipy"]
 #: The methods of :func:`distribute_tensions`.
 METHODS: tuple[str, ...] = get_args(TensionMethod)
 
@@ -151,8 +153,10 @@ def distribute_tensions(robot: CableRobot, poses: ArrayLike,
         Impose the friction condition of the mobile bases that have a friction
         coefficient (:mod:`taut.cdpr.statics.sliding`); no effect on a model without one.
         ``closed_form`` only checks it, like tipping.
-    qp_solver : {"auto", "enumeration", "scipy"}
-        For ``qp_min_norm``: exact batched enumeration (needs m - n <= 2) or SciPy SLSQP.
+    qp_solver : {"auto", "enumeration", "daqp", "scipy"}
+        For ``qp_min_norm``: exact batched enumeration (needs m - n <= 2), the QP solver
+        DAQP, or SciPy SLSQP. ``"auto"``: the enumeration for m - n <= 2, else DAQP when
+        installed, else SLSQP.
 
     Returns
     -------
@@ -216,11 +220,12 @@ def _solve(robot: CableRobot, st: CableState, w: np.ndarray, method: str, qp_sol
         r = robot.m - robot.dof
         if method.startswith("lp_"):
             t = _lp(st.W, w, A, b, robot, minmax=(method == "lp_min_max"))
-        elif qp_solver == "scipy" or (qp_solver == "auto" and r > 2):
-            t = _qp_scipy(st.W, w, A, b, robot)
+        elif qp_solver in ("scipy", "daqp") or (qp_solver == "auto" and r > 2):
+            t = _qp_per_pose(st.W, w, A, b, robot, qp_backend(
+                "auto" if qp_solver == "auto" else qp_solver))
         elif r > 2:
             raise InvalidInputError("qp_solver", "enumeration needs at most 2 redundant "
-                                                 "cables; use qp_solver='scipy'")
+                                                 "cables; use qp_solver='daqp' or 'scipy'")
         else:
             t = np.concatenate([_qp_enum(pinv[c], N[c], w[c], A[c], b[c], ok[c], robot)
                                 for c in _chunks(B, 512)]) if B else np.zeros((0, robot.m))
@@ -426,20 +431,18 @@ def _qp_enum(pinv: np.ndarray, N: np.ndarray, w: np.ndarray, A: np.ndarray, b: n
     return np.where(found[:, None], t, np.nan)
 
 
-def _qp_scipy(W: np.ndarray, w: np.ndarray, A: np.ndarray, b: np.ndarray,
-              robot: CableRobot) -> np.ndarray:
-    """Per-pose min-norm QP with SciPy SLSQP (reference and fallback for r > 2)."""
+def _qp_per_pose(W: np.ndarray, w: np.ndarray, A: np.ndarray, b: np.ndarray,
+                 robot: CableRobot, backend: str) -> np.ndarray:
+    """Per-pose min-norm QP by :func:`taut._qp.solve_qp` (DAQP, or SLSQP from the mean
+    tension), each answer checked against the constraint rows."""
     B, n, m = W.shape
     out = np.full((B, m), np.nan)
     tm = 0.5 * (robot.t_min + robot.t_max)
-    tol = feas_tol(robot)
+    slack = SLSQP_REL * float(np.max(robot.t_max))
+    eye = np.eye(m)
     for k in range(B):
-        cons = [{"type": "eq", "fun": lambda t, k=k: W[k] @ t - w[k],
-                 "jac": lambda t, k=k: W[k]},
-                {"type": "ineq", "fun": lambda t, k=k: b[k] - A[k] @ t,
-                 "jac": lambda t, k=k: -A[k]}]
-        sol = minimize(lambda t: 0.5 * t @ t, tm, jac=lambda t: t, constraints=cons,
-                       method="SLSQP", options={"ftol": SLSQP_FTOL, "maxiter": 200})
-        if sol.success and np.all(A[k] @ sol.x <= b[k] + SLSQP_REL * float(np.max(robot.t_max))):
-            out[k] = sol.x
+        x = solve_qp(eye, A_eq=W[k], b_eq=w[k], A_ub=A[k], b_ub=b[k], x0=tm,
+                     ftol=SLSQP_FTOL, backend=backend)
+        if x is not None and np.all(A[k] @ x <= b[k] + slack):
+            out[k] = x
     return out

@@ -265,8 +265,7 @@ def _rigid(checker: PoseChecker, f: Formation, run: list[np.ndarray],
     merged into one straight motion while they turn by at most pi/2 in all (the shortcut
     needs edges that turn by less than pi), then shortcut."""
     w = np.array(run)
-    for k in range(1, len(w)):
-        w[k, 2] = w[k - 1, 2] + float(np.angle(np.exp(1j * (w[k, 2] - w[k - 1, 2]))))
+    w[:, 2] = np.unwrap(w[:, 2])
     if len(w) > 2:
         keep = [0]
         for k in range(1, len(w) - 1):

@@ -102,12 +102,7 @@ def unwrap_shortest(path: np.ndarray) -> np.ndarray:
     [3.0, 3.2832]
     """
     out = np.array(path, dtype=float)
-    for k in range(1, len(out)):
-        d = float(out[k, 2] - out[k - 1, 2])
-        d = d - 2 * np.pi * np.round(d / (2 * np.pi))
-        if abs(d) > np.pi:                     # rounding put it on the far side of pi
-            d -= np.copysign(2 * np.pi, d)
-        out[k, 2] = out[k - 1, 2] + d
+    out[:, 2] = np.unwrap(out[:, 2])
     return out
 
 

@@ -190,8 +190,7 @@ def rrt_connect(checker: PoseChecker, starts: np.ndarray, goals: np.ndarray, *,
 
 def _unwrap(path: np.ndarray) -> np.ndarray:
     out = path.copy()
-    for k in range(1, len(out)):
-        out[k, 2] = out[k - 1, 2] + float(np.angle(np.exp(1j * (out[k, 2] - out[k - 1, 2]))))
+    out[:, 2] = np.unwrap(out[:, 2])
     return out
 
 
