@@ -25,21 +25,37 @@ def cdpr():
     return api, api.load({"example": "fastkit"})["model"]
 
 
-def test_planner_job_reports_progress_and_the_library_plan(tmp_path):
-    api = PlanAPI(Catalog(ROOT / "examples"))
-    try:
-        sc = api.load({"example": CORRIDOR.name})["scenario"]
-        jid = api.run({"scenario": sc})["job"]
-        seen = set()
-        deadline = time.monotonic() + 600             # the machine may be shared
-        while time.monotonic() < deadline:
-            s = api.job(jid)
-            seen.add(s["stage"])
-            if s["state"] != "running":
-                break
-            time.sleep(0.05)
-    finally:
-        api.close()
+def run_job(client, sc, timeout=600.0):
+    """Queue a planning job through the app and poll it to the end; returns the last
+    reply and every stage seen."""
+    r = client.post("/api/plan/run", json={"scenario": sc})
+    assert r.status_code == 200, r.text
+    jid, seen = r.json()["job"], set()
+    deadline = time.monotonic() + timeout              # the machine may be shared
+    while time.monotonic() < deadline:
+        s = client.get(f"/api/plan/job/{jid}").json()
+        seen.add(s["stage"])
+        if s["state"] != "running":
+            break
+        time.sleep(0.05)
+    # fetched once: the id is spent
+    gone = client.get(f"/api/plan/job/{jid}")
+    assert gone.status_code == 422 and gone.json()["error"].startswith("job: ")
+    return s, seen
+
+
+def test_planner_job_reports_progress_and_the_library_plan():
+    pytest.importorskip("starlette.testclient", reason="needs the app-test extra")
+    from starlette.testclient import TestClient
+
+    from taut.app.server import create_app
+
+    app = create_app(catalog=Catalog(ROOT / "examples"), workers=1)
+    with TestClient(app, base_url="http://127.0.0.1:8765",
+                    headers={"X-Taut-Token": app.state.token}) as client:
+        sc = client.post("/api/plan/load", json={"example": CORRIDOR.name}).json()["scenario"]
+        s, seen = run_job(client, sc)
+        yaml_text = client.post("/api/plan/yaml", json={"scenario": sc}).json()["yaml"]
     assert s["state"] == "done" and s["steps"] == 2
     assert "planner with obstacle crossing" in seen or "SE(2) bypass baseline" in seen
     want = plan(load_plan_scenario(CORRIDOR))
@@ -49,6 +65,7 @@ def test_planner_job_reports_progress_and_the_library_plan(tmp_path):
     np.testing.assert_allclose(got["object"], want.object, atol=1e-12)
     # The baseline is the SE(2) bypass (the disc model finds no route here).
     assert s["baseline"]["success"] is True and s["baseline"]["planner"] == "se2-bypass"
+    assert s["world"]["start"] == [float(x) for x in load_plan_scenario(CORRIDOR).start]
     # Plots (taut.plan.plan_profile): the object clears every obstacle beneath by the
     # height safety; the sheet never tears (slack >= 0) and the least slack is the pair
     # slack of the first sample.
@@ -61,21 +78,17 @@ def test_planner_job_reports_progress_and_the_library_plan(tmp_path):
     assert got["sheet_slack_m"][0] == pytest.approx(slack, abs=1e-12)
     assert min(got["sheet_slack_m"]) >= -1e-9
     # The YAML download is a scenario `taut plan` reads back as the same problem.
-    back = plan_scenario_from_mapping(yaml.safe_load(api.yaml({"scenario": sc})["yaml"]))
+    back = plan_scenario_from_mapping(yaml.safe_load(yaml_text))
     assert back.team.hold_height == 0.5 and len(back.world.obstacles) == 2
 
 
-def test_unknown_job_and_bad_scenario_are_one_line_errors():
+def test_bad_scenario_is_one_line_error():
     api = PlanAPI(Catalog(ROOT / "examples"))
-    try:
-        with pytest.raises(TautError, match="^job: "):
-            api.job("999")
+    bad = yaml.safe_load(CORRIDOR.read_text())
+    bad["team"]["hold_height"] = -1
+    for call in (api.load, api.check, api.baseline, api.crossing):
         with pytest.raises(TautError, match=r"^team\.hold_height: "):
-            bad = yaml.safe_load(CORRIDOR.read_text())
-            bad["team"]["hold_height"] = -1
-            api.load({"scenario": bad})
-    finally:
-        api.close()
+            call({"scenario": bad})
 
 
 def test_feasible_pose_tensions_and_margins_are_the_library_s(cdpr):

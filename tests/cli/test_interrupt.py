@@ -54,3 +54,17 @@ def test_serial_sweep_interrupted_keeps_its_chunks(tmp_path):
     assert sum("interrupted" in x for x in lines) == 1
     assert not any("Traceback" in x for x in lines), lines
     assert list((out / "chunks").glob("*.parquet")), "the finished chunks were lost"
+
+
+@pytest.mark.parametrize("args", [
+    ["cdpr", "workspace", "fastkit", "--grid", "301", "1", "301"],
+    ["cdpr", "simulate", "fastkit", "--waypoints",
+     "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 20)],
+], ids=lambda a: " ".join(a[:2]))
+def test_cable_robot_commands_interrupted(args):
+    """A workspace grid (a loop of solver calls) and a control simulation (a compiled
+    kernel), stopped once they report progress: one line, exit 130."""
+    code, lines = interrupt(args, ": working")
+    assert code == 130
+    assert lines[-1] == "taut: interrupted"
+    assert not any("Traceback" in x or "SystemError" in x for x in lines), lines

@@ -17,6 +17,10 @@ from taut.io import MAX_YAML_VALUES, load_cdpr_model, parse_mapping, read_mappin
 
 ROOT = Path(__file__).parents[2]
 CORRIDOR = ROOT / "examples" / "plan" / "paper_corridor.yaml"
+#: Options some commands require (a platform pose, waypoints, a workspace box).
+POSE = ["--pose", "0", "0", "1"]
+WAYPOINTS = ["--waypoints", "-0.5,0,1.0; 0.5,0,1.0"]
+BOX = ["--workspace", "-0.5", "0.5", "-0.1", "0.1", "0.5", "1.0"]
 
 
 def bomb(levels=9, width=9, top="lol"):
@@ -62,6 +66,60 @@ def test_cdpr_simulate_output_over_its_model_is_refused(tmp_path, monkeypatch, c
                  "--out", "m.json"]) == 2
     assert "is also an input" in capsys.readouterr().err
     assert model.read_bytes() == before
+
+
+def _command_id(words):
+    """``["cdpr", "simulate", "{model}", ..., "--plot", "{out}.png"]`` -> ``"cdpr simulate
+    --plot"``."""
+    head = words[:next(k for k, w in enumerate(words) if w.startswith("{"))]
+    return " ".join(head + [words[words.index(next(w for w in words
+                                                   if w.startswith("{out}"))) - 1]])
+
+
+@pytest.mark.parametrize("command, source", [
+    (["fk", "{sheet}", "--plot", "{out}.png"], "sheet"),
+    (["simulate", "{sheet}", "--trajectory", "{csv}", "--plot", "{out}.png"], "sheet"),
+    (["simulate", "{sheet}", "--trajectory", "{csv}", "--plot", "{out}.png"], "csv"),
+    (["plan", "{plan}", "--out", "{out}.json"], "plan"),
+    (["plan", "{plan}", "--plot", "{out}.png"], "plan"),
+    (["plan", "{plan}", "--animate", "{out}.gif"], "plan"),
+    (["physics", "{sheet}", "--plot", "{out}.png"], "sheet"),
+    (["physics", "{sheet}", "--video", "{out}.gif"], "sheet"),
+    (["cdpr", "wrench-set", "{model}", *POSE, "--plot", "{out}.png"], "model"),
+    (["cdpr", "workspace", "{model}", "--plot", "{out}.png"], "model"),
+    (["cdpr", "twist-set", "{model}", *POSE, "--plot", "{out}.png"], "model"),
+    (["cdpr", "deploy", "{model}", *BOX, "--plot", "{out}.png"], "model"),
+    (["cdpr", "simulate", "{model}", *WAYPOINTS, "--out", "{out}.json"], "model"),
+    (["cdpr", "simulate", "{model}", *WAYPOINTS, "--plot", "{out}.png"], "model"),
+    (["cdpr", "simulate", "{model}", *WAYPOINTS, "--animate", "{out}.gif"], "model"),
+    (["cdpr", "simulate", "{model}", "--reference", "{ref}", "--out", "{out}.json"], "ref"),
+], ids=lambda v: _command_id(v) if isinstance(v, list) else v)
+def test_no_command_writes_over_one_of_its_inputs(tmp_path, monkeypatch, capsys, command,
+                                                  source):
+    """Every file a command writes (--out, --plot, --animate, --video), given as another
+    name (a hard link) of one of the command's inputs, is refused in one line and the
+    input is left as it was."""
+    monkeypatch.chdir(tmp_path)
+    files = {"sheet": tmp_path / "sheet.yaml", "plan": tmp_path / "plan.yaml",
+             "model": tmp_path / "model.yaml", "csv": tmp_path / "traj.csv",
+             "ref": tmp_path / "ref.csv"}
+    files["sheet"].write_text((ROOT / "examples" / "sheet" / "example1.yaml").read_text())
+    files["plan"].write_text(CORRIDOR.read_text())
+    files["model"].write_text(yaml.safe_dump(_preset("fastkit")))
+    files["csv"].write_text("time,x1,y1,x2,y2,x3,y3,x4,y4\n"
+                            "0,210,120,800,40,900,550,440,720\n"
+                            "1,215,120,800,40,900,550,440,720\n")
+    files["ref"].write_text("time,x,y,z,roll,pitch,yaw\n0,0,0,1,0,0,0\n1,0,0,1,0,0,0\n"
+                            "2,0,0,1,0,0,0\n")
+    suffix = next(w for w in command if w.startswith("{out}"))[len("{out}"):]
+    out = tmp_path / f"out{suffix}"
+    os.link(files[source], out)
+    before = files[source].read_bytes()
+    args = [w.format(out="out", **files) for w in command]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"'{out.name}' is also an input" in err, err
+    assert files[source].read_bytes() == before
 
 
 def _preset(name):
@@ -130,14 +188,20 @@ def test_recursive_alias_is_refused():
 
 
 @pytest.mark.parametrize("command", [
-    ["fk", "{f}"], ["plan", "{f}"], ["cdpr", "tensions", "{f}", "--pose", "0", "0", "1"],
+    ["fk", "{f}"], ["ik", "{f}", "--object", "0", "0", "1"],
+    ["simulate", "{f}", "--trajectory", "{csv}"], ["plan", "{f}"], ["physics", "{f}"],
+    ["cdpr", "tensions", "{f}", *POSE], ["cdpr", "wrench-set", "{f}", *POSE],
+    ["cdpr", "workspace", "{f}"], ["cdpr", "twist-set", "{f}", *POSE],
+    ["cdpr", "deploy", "{f}", *BOX], ["cdpr", "simulate", "{f}", *WAYPOINTS],
     ["app", "{f}", "--port", "0"],
-])
+], ids=lambda c: " ".join(c[:2]))
 def test_every_command_refuses_a_bomb_in_one_line(tmp_path, capsys, command):
     path = tmp_path / "bomb.yaml"
     path.write_text("name: x\n" + bomb())
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,x1,y1\n0,0,0\n")
     t0 = time.perf_counter()
-    assert main([c.format(f=path) for c in command]) == 2
+    assert main([c.format(f=path, csv=csv) for c in command]) == 2
     assert time.perf_counter() - t0 < 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "YAML aliases add more than" in err
@@ -162,18 +226,110 @@ def test_too_large_file_is_refused(tmp_path, monkeypatch):
         read_mapping(path)
 
 
-def test_a_missing_extra_is_named_in_one_line(monkeypatch, capsys, scenario_json):
-    """An optional dependency missing deep inside a command: one line naming the extra."""
+@pytest.mark.parametrize("module, extra", [
+    ("mujoco", "physics"), ("dask", "sweep"), ("starlette", "app"), ("ompl", "plan-ompl")])
+def test_a_missing_extra_is_named_in_one_line(monkeypatch, capsys, scenario_json, module,
+                                              extra):
+    """An optional dependency (the four of the issue) missing deep inside a command: one
+    line naming the extra, not a ModuleNotFoundError traceback."""
+    import importlib
     import sys
 
     from taut.cli import plan as plan_cli
 
-    def needs_mujoco(*args, **kwargs):
-        import mujoco  # noqa: F401
-    monkeypatch.setitem(sys.modules, "mujoco", None)
-    monkeypatch.setattr("taut.plan.planner.run_plan", needs_mujoco)
+    def needs_extra(*args, **kwargs):
+        importlib.import_module(module + ".sub")
+    monkeypatch.setitem(sys.modules, module, None)
+    monkeypatch.setattr("taut.plan.planner.run_plan", needs_extra)
     assert plan_cli is not None
     assert main(["plan", "sc.json"]) == 2
     err = capsys.readouterr().err
-    assert err == ("taut: error: mujoco: not installed; install taut[physics] "
-                   "(pip install 'taut[physics]')\n")
+    assert err == (f"taut: error: {module}: not installed; install taut[{extra}] "
+                   f"(pip install 'taut[{extra}]')\n")
+
+
+# --- figures and animations ---------------------------------------------------------------
+
+@pytest.mark.parametrize("spell", ["same", "hardlink", "symlink"])
+def test_a_figure_over_an_input_is_refused(tmp_path, monkeypatch, capsys, spell):
+    """`--plot` goes through the same check as `--out`: a scenario that happens to carry
+    a figure's extension (or a link to it) is not overwritten by the figure."""
+    monkeypatch.chdir(tmp_path)
+    Path("sc.png").write_text((ROOT / "examples" / "sheet" / "example1.yaml").read_text())
+    before = Path("sc.png").read_bytes()
+    out = "sc.png"
+    if spell == "hardlink":
+        os.link("sc.png", out := "fig.png")
+    if spell == "symlink":
+        os.symlink("sc.png", out := "fig.svg")
+    assert main(["fk", "sc.png", "--plot", out]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("taut: error: --plot: ") and "is also an input" in err
+    assert Path("sc.png").read_bytes() == before
+
+
+def test_an_animation_over_an_input_is_refused(scenario_json, capsys):
+    os.link("sc.json", "replay.gif")
+    before = scenario_json.read_bytes()
+    t0 = time.perf_counter()
+    assert main(["plan", "sc.json", "--animate", "replay.gif"]) == 2
+    assert time.perf_counter() - t0 < 5                # refused before planning
+    assert "--animate: 'replay.gif' is also an input" in capsys.readouterr().err
+    assert scenario_json.read_bytes() == before
+
+
+def test_figures_and_animations_are_written_atomically(tmp_path):
+    """A save that fails midway leaves the old file and no temporary; one that succeeds
+    replaces the file with a complete PNG / GIF."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation
+
+    from taut.viz._save import save_animation, save_figure
+
+    png, gif = tmp_path / "f.png", tmp_path / "a.gif"
+    png.write_bytes(b"old png")
+    gif.write_bytes(b"old gif")
+    fig, ax = plt.subplots()
+    line, = ax.plot([0, 1], [0, 1])
+    real = fig.savefig
+
+    def half_then_fail(path, **kw):
+        Path(path).write_bytes(b"\x89PNG half")
+        raise OSError(28, "No space left on device")
+
+    fig.savefig = half_then_fail
+    with pytest.raises(OSError):
+        save_figure(fig, png, dpi=50)
+    assert png.read_bytes() == b"old png"
+    fig.savefig = real
+
+    def broken(k):
+        if k == 2:
+            raise RuntimeError("frame 2 cannot be drawn")
+        line.set_ydata([0, k])
+        return (line,)
+
+    with pytest.raises(RuntimeError):
+        save_animation(FuncAnimation(fig, broken, frames=4), gif, fps=5)
+    assert gif.read_bytes() == b"old gif"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.gif", "f.png"]
+
+    save_figure(fig, png, dpi=50)
+    save_animation(FuncAnimation(fig, lambda k: broken(1), frames=3), gif, fps=5)
+    plt.close(fig)
+    assert png.read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+    assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.gif", "f.png"]
+
+
+def test_every_figure_is_saved_through_the_atomic_writer():
+    """No module of taut.viz writes a figure or an animation itself."""
+    import re
+
+    viz = ROOT / "src" / "taut" / "viz"
+    direct = [f"{p.name}:{n}" for p in sorted(viz.glob("*.py")) if p.name != "_save.py"
+              for n, line in enumerate(p.read_text().splitlines(), 1)
+              if re.search(r"\.savefig\(|\banim\w*\.save\(|PillowWriter", line)]
+    assert direct == []

@@ -114,3 +114,30 @@ def test_model_dynamics_section_is_numbers_only(fastkit):
     with pytest.raises(ScenarioError) as err:
         cdpr_model_from_mapping(m)
     assert err.value.field == "dynamics.cable_stiffness"
+
+
+def test_model_file_with_a_bomb_in_its_dynamics_is_refused_fast(fastkit, tmp_path):
+    """The issue's 5.8 KB model file: a real model whose `dynamics:` section holds an
+    alias bomb (9 levels of 9 aliases: 387 million values). Refused by the parser's alias
+    budget in well under a second, with the file named, by the loader and the CLI."""
+    import time
+
+    from taut.cli import main
+    from taut.io import load_cdpr_model
+
+    levels = "\n".join(f"  l{k}: &l{k} [" + ", ".join([f"*l{k - 1}"] * 9) + "]"
+                       for k in range(1, 10))
+    import yaml
+
+    model = {k: v for k, v in fastkit.items() if k != "dynamics"}
+    text = (yaml.safe_dump(model) + "dynamics:\n  l0: &l0 [" + ", ".join(["1.0"] * 9)
+            + "]\n" + levels + "\n")
+    path = tmp_path / "model.yaml"
+    path.write_text(text)
+    assert path.stat().st_size < 10_000
+    t0 = time.perf_counter()
+    with pytest.raises(ScenarioError, match="YAML aliases add more than") as err:
+        load_cdpr_model(path)
+    assert time.perf_counter() - t0 < 1.0
+    assert err.value.field == str(path)
+    assert main(["cdpr", "tensions", str(path), "--pose", "0", "0", "1"]) == 2

@@ -16,13 +16,19 @@ Only its user can drive it (the model of JupyterLab's and the Dask dashboard's s
   ``text/plain`` fetch cannot), else HTTP 415; no CORS headers are ever sent;
 * a body is counted while it streams in: past :data:`MAX_BODY` bytes HTTP 413 (before the
   rest is read), slower than :data:`BODY_TIMEOUT_S` HTTP 408;
-* the views' handlers run in a worker pool (one thread per core), never on the event
-  loop, so the page, its scripts, the catalog and job polls answer while a heavy request
-  runs; a request past its time budget (``budget_s``) gets HTTP 503 (its thread finishes
-  in the background; numerical code cannot be stopped midway).
+* the views' requests are computed by worker processes (:mod:`.pool`, one per core, at
+  most :data:`taut.app.pool.MAX_WORKERS`):
+  the raw body goes to a worker, which parses it, computes and renders the reply, so the
+  event loop only moves bytes and the page, its scripts, the catalog and job polls
+  answer while heavy requests run; a request is cancelled by killing its worker when the
+  client disconnects, when it overruns its time budget (``budget_s``, HTTP 503) and on
+  Ctrl-C; a worker's address space is capped (:data:`taut.app.worker.MEMORY_LIMIT`; a
+  request needing more gets HTTP 507);
+* planning jobs are queued (:mod:`.jobs`: at most ``max_jobs``, HTTP 503 "busy" past
+  that; an id stays valid until its finished result has been fetched).
 
 Every reply is JSON, errors included: ``{"error": "<field>: <problem>"}`` (the line the
-CLI prints) with HTTP 422 for bad input, 403/404/405/408/413/415/503 as above, and HTTP 500
+CLI prints) with HTTP 422 for bad input, 403/404/405/408/413/415/503/507 as above, and HTTP 500
 with a one-line ``error`` for a bug, logged with its traceback on the server's stderr
 only, never sent to the page.
 """
@@ -31,19 +37,15 @@ from __future__ import annotations
 
 import contextlib
 import hmac
-import json
-import logging
-import os
 import secrets
 import socket
-from collections.abc import AsyncIterator, Callable
+from collections.abc import AsyncIterator, Awaitable, Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs
 
 import anyio
-import anyio.to_thread
 from starlette.applications import Starlette
 from starlette.exceptions import HTTPException
 from starlette.requests import Request
@@ -52,17 +54,14 @@ from starlette.routing import BaseRoute, Mount, Route
 from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
 
-from ..errors import InvalidInputError, TautError
-from ..io.serialize import json_ready
+from ..errors import InvalidInputError
 from .catalog import Catalog
-from .cdpr_api import CdprAPI
-from .payload import check_json, kind_of_mapping
-from .plan_api import BusyError, PlanAPI
-from .sheet_api import SheetAPI
+from .jobs import PlanJobs
+from .payload import kind_of_mapping
+from .pool import WorkerPool, default_size
+from .worker import render
 
 __all__ = ["create_app", "bind", "serve", "static_dir", "new_token", "LOOPBACK_HOSTS"]
-
-log = logging.getLogger("taut.app")
 
 #: Largest request body accepted (an uploaded scenario or a long drag path), bytes.
 MAX_BODY = 8 * 1024 * 1024
@@ -70,6 +69,9 @@ MAX_BODY = 8 * 1024 * 1024
 BODY_TIMEOUT_S = 10.0
 #: Default time budget of one request's work, s.
 BUDGET_S = 60.0
+#: Longest wait after Ctrl-C for replies in progress before the app stops, s (uvicorn
+#: takes whole seconds).
+SHUTDOWN_S = 1
 #: Header that carries the token.
 TOKEN_HEADER = "x-taut-token"
 #: Host names that always mean this machine.
@@ -86,16 +88,11 @@ def new_token() -> str:
     return secrets.token_urlsafe(32)
 
 
-def _render(content: Any) -> bytes:
-    return json.dumps(json_ready(content), allow_nan=False,
-                      separators=(",", ":")).encode("utf-8")
-
-
 class _JSON(JSONResponse):
     """JSON without NaN (the page's JSON.parse rejects it): NaN/inf become null."""
 
     def render(self, content: Any) -> bytes:
-        return _render(content)
+        return render(content)
 
 
 def _error(status: int, line: str) -> Response:
@@ -182,50 +179,24 @@ async def _read_body(request: Request, limit: int, timeout: float) -> bytes:
     return b"".join(chunks)
 
 
-def _run(handler: Callable[[dict[str, Any]], dict[str, Any]], raw: bytes | None,
-         path: str) -> tuple[int, bytes]:
-    """Parse, handle and render one request (in a worker thread)."""
-    try:
-        body = {} if raw is None else check_json(raw)
-        return 200, _render(handler(body))
-    except BusyError as exc:
-        return 503, _render({"error": str(exc)})
-    except TautError as exc:
-        return 422, _render({"error": str(exc)})
-    except Exception as exc:               # a bug: log it here, one line to the page
-        log.exception("internal error in %s", path)
-        return 500, _render({"error": f"internal error ({exc.__class__.__name__}); the "
-                                      "server log has the details"})
+def _endpoint(pool: WorkerPool, name: str) -> Callable[[Request], Awaitable[Response]]:
+    """The route of a view's POST endpoint: the JSON body, as it arrived, to a worker."""
+    async def route(request: Request) -> Response:
+        try:
+            raw = await _json_body(request)
+        except _Refused as exc:
+            return _error(exc.status, exc.line)
+        status, data = await pool.call(name, raw, receive=request.receive)
+        return Response(data, status_code=status, media_type="application/json")
+    return route
 
 
-class _Worker:
-    """Runs handlers in a thread pool of ``workers`` threads, each within ``budget_s``."""
-
-    def __init__(self, workers: int, budget_s: float) -> None:
-        self.limiter = anyio.CapacityLimiter(workers)
-        self.budget_s = budget_s
-
-    def endpoint(self, handler: Callable[[dict[str, Any]], dict[str, Any]], *,
-                 post: bool = True) -> Callable[[Request], Any]:
-        async def route(request: Request) -> Response:
-            try:
-                raw = None
-                if post:
-                    kind = request.headers.get("content-type", "").split(";")[0]
-                    if kind.strip().lower() != "application/json":
-                        raise _Refused(415, "Content-Type: must be application/json")
-                    raw = await _read_body(request, MAX_BODY, BODY_TIMEOUT_S)
-                with anyio.fail_after(self.budget_s):
-                    status, data = await anyio.to_thread.run_sync(
-                        _run, handler, raw, request.url.path, abandon_on_cancel=True,
-                        limiter=self.limiter)
-                return Response(data, status_code=status, media_type="application/json")
-            except _Refused as exc:
-                return _error(exc.status, exc.line)
-            except TimeoutError:
-                return _error(503, f"request: took longer than its {self.budget_s:g} s "
-                                   "budget; try a smaller input")
-        return route
+async def _json_body(request: Request) -> bytes:
+    """A POST's body, refused unless it says it is JSON (checked by the worker)."""
+    kind = request.headers.get("content-type", "").split(";")[0]
+    if kind.strip().lower() != "application/json":
+        raise _Refused(415, "Content-Type: must be application/json")
+    return await _read_body(request, MAX_BODY, BODY_TIMEOUT_S)
 
 
 def create_app(initial: dict[str, Any] | None = None, *,
@@ -243,24 +214,25 @@ def create_app(initial: dict[str, Any] | None = None, *,
         Where bundled examples come from (default: the source checkout's ``examples/``).
     token : str, optional
         The secret every ``/api/`` request must carry; default :func:`new_token`. The app
-        keeps it in ``app.state.token``.
+        keeps it in ``app.state.token`` (and its :class:`~taut.app.pool.WorkerPool` in
+        ``app.state.pool``).
     hosts : tuple of str
         Host names accepted besides :data:`LOOPBACK_HOSTS` (the ``--host`` served on).
     workers : int, optional
-        Threads running requests at once (default: the machine's cores, at least 2).
+        Worker processes computing requests at once (default
+        :func:`taut.app.pool.default_size`: one per core, at most two).
     budget_s : float
         Time budget of one request, s.
     max_jobs : int, optional
-        Planning jobs queued or running at once (default
-        :data:`taut.app.plan_api.MAX_JOBS`); more get HTTP 503 "busy".
+        Planning jobs queued or running at once (default :data:`taut.app.jobs.MAX_JOBS`);
+        more get HTTP 503 "busy".
     """
     catalog = catalog or Catalog()
     token = token or new_token()
-    sheet, cdpr = SheetAPI(catalog), CdprAPI(catalog)
-    planner = PlanAPI(catalog) if max_jobs is None else PlanAPI(catalog, max_jobs=max_jobs)
     start = None if initial is None else {"kind": kind_of_mapping(initial), "mapping": initial}
     page = static_dir() / "index.html"
-    worker = _Worker(workers or max(2, os.cpu_count() or 2), float(budget_s))
+    pool = WorkerPool(workers or default_size(), float(budget_s), catalog.root)
+    jobs = PlanJobs(pool) if max_jobs is None else PlanJobs(pool, max_jobs)
 
     async def index(request: Request) -> Response:
         return FileResponse(page, headers={"Cache-Control": "no-store"})
@@ -272,18 +244,27 @@ def create_app(initial: dict[str, Any] | None = None, *,
         return _JSON({"initial": start})
 
     async def get_job(request: Request) -> Response:
-        jid = request.path_params["jid"]
-        return await worker.endpoint(lambda _: planner.job(jid), post=False)(request)
+        status, data = jobs.job(request.path_params["jid"])
+        return Response(data, status_code=status, media_type="application/json")
+
+    async def run_plan(request: Request) -> Response:
+        try:
+            raw = await _json_body(request)
+        except _Refused as exc:
+            return _error(exc.status, exc.line)
+        status, data = await jobs.run(raw)
+        return Response(data, status_code=status, media_type="application/json")
 
     routes: list[BaseRoute] = [Route("/", index), Route("/api/catalog", get_catalog),
-              Route("/api/initial", get_initial),
-              Route("/api/plan/job/{jid}", get_job)]
-    for view, api, actions in (("sheet", sheet, ("load", "fk", "ik", "simulate", "yaml")),
-                               ("plan", planner, ("load", "run", "yaml")),
-                               ("cdpr", cdpr, ("load", "state", "workspace", "yaml"))):
+                               Route("/api/initial", get_initial),
+                               Route("/api/plan/job/{jid}", get_job),
+                               Route("/api/plan/run", run_plan, methods=["POST"])]
+    for view, actions in (("sheet", ("load", "fk", "ik", "simulate", "yaml")),
+                          ("plan", ("load", "yaml")),
+                          ("cdpr", ("load", "state", "workspace", "yaml"))):
         for action in actions:
-            routes.append(Route(f"/api/{view}/{action}",
-                                worker.endpoint(getattr(api, action)), methods=["POST"]))
+            routes.append(Route(f"/api/{view}/{action}", _endpoint(pool, f"{view}.{action}"),
+                                methods=["POST"]))
     routes.append(Mount("/static", StaticFiles(directory=str(static_dir())), name="static"))
 
     async def http_error(request: Request, exc: Exception) -> Response:
@@ -298,12 +279,13 @@ def create_app(initial: dict[str, Any] | None = None, *,
 
     @contextlib.asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
-        yield
-        planner.close()
+        async with pool.running():
+            yield
 
     app = Starlette(routes=routes, lifespan=lifespan,
                     exception_handlers={HTTPException: http_error})
     app.state.token = token
+    app.state.pool = pool
     allowed = tuple(dict.fromkeys(LOOPBACK_HOSTS + tuple(h.lower() for h in hosts)))
     app.add_middleware(_Guard, token=token, hosts=allowed)
     return app
@@ -339,12 +321,13 @@ def bind(host: str, port: int) -> socket.socket:
 
 
 def serve(sock: socket.socket, app: Starlette, *, log_level: str = "critical") -> None:
-    """Serve ``app`` on an already bound socket until interrupted (uvicorn; at most 2 s
-    of graceful shutdown after Ctrl-C). uvicorn's own log is off by default: the app
-    logs its errors itself (logger ``taut.app``), and a request cut short by Ctrl-C is
-    not one."""
+    """Serve ``app`` on an already bound socket until interrupted (uvicorn; after Ctrl-C
+    replies being sent get :data:`SHUTDOWN_S`, then every request still computing is
+    cancelled and its worker killed). uvicorn's own log is off by default: the app logs
+    its errors itself (logger ``taut.app``), and a request cut short by Ctrl-C is not
+    one."""
     import uvicorn
 
     config = uvicorn.Config(app, log_level=log_level, access_log=False, lifespan="on",
-                            timeout_graceful_shutdown=2, server_header=False)
+                            timeout_graceful_shutdown=SHUTDOWN_S, server_header=False)
     uvicorn.Server(config).run(sockets=[sock])

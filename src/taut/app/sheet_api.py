@@ -25,8 +25,10 @@ from ..sheet import simulate
 from .catalog import Catalog, regular_team
 from .payload import ModelCache, field, mapping_from_upload, numbers
 
-__all__ = ["SheetAPI"]
+__all__ = ["SheetAPI", "MAX_SIM_STEPS"]
 
+#: Most steps of one simulation request (a drag path), which keeps it within its budget.
+MAX_SIM_STEPS = 20000
 #: Keys of a sheet scenario file, in the order they are written.
 _KEYS = ("name", "units", "hold_height", "mass", "sheet", "formation")
 
@@ -125,8 +127,8 @@ class SheetAPI:
         """Quasi-static simulation along ``formations`` (T x N x 2, one row per step)."""
         team = self._team(body)
         formations = field(body, "formations", list)
-        if len(formations) > 20000:
-            raise InvalidInputError("formations", "at most 20000 steps")
+        if len(formations) > MAX_SIM_STEPS:
+            raise InvalidInputError("formations", f"at most {MAX_SIM_STEPS} steps")
         start = field(body, "start", list, default=None)
         res = simulate(team, numbers(formations, "formations", 3),
                        start=None if start is None else numbers(start, "start", 1))

@@ -5,8 +5,9 @@ Files
     (:func:`parse_mapping` the same from text; files over :data:`MAX_FILE_BYTES` and
     alias bombs over :data:`MAX_YAML_VALUES` values refused), :func:`read_text` reads
     one, :func:`validate_mapping` checks a parsed mapping against a pydantic model
-    (errors naming the dotted key), :func:`write_json` writes JSON and
-    :func:`write_text_atomic` any text (temporary file, then rename).
+    (errors naming the dotted key), :func:`write_json` writes JSON,
+    :func:`write_text_atomic` any text and :func:`atomic_path` gives a temporary file to
+    write that replaces the target once complete (figures, animations).
 Sheet scenarios
     :func:`load_sheet_scenario` and :func:`sheet_scenario_from_mapping` build a
     :class:`SheetScenario` (the team, its formation, the length unit).
@@ -36,7 +37,8 @@ from .._lazy import lazy_names
 if TYPE_CHECKING:                   # the real names, for type checkers
     from .cdpr_model import cdpr_model_from_mapping, load_cdpr_model
     from .files import (MAX_FILE_BYTES, MAX_YAML_VALUES, parse_mapping, read_mapping,
-                        read_text, validate_mapping, write_json, write_text_atomic)
+                        read_text, validate_mapping, write_json, write_text_atomic,
+                        atomic_path)
     from .plan_scenario import (load_plan_scenario, plan_scenario_from_mapping,
                                 plan_scenario_to_mapping)
     from .sheet_scenario import SheetScenario, load_sheet_scenario, sheet_scenario_from_mapping
@@ -45,6 +47,7 @@ _HOME = {
     "cdpr_model_from_mapping": "cdpr_model", "load_cdpr_model": "cdpr_model",
     "read_mapping": "files", "read_text": "files", "validate_mapping": "files",
     "write_json": "files", "parse_mapping": "files", "write_text_atomic": "files",
+    "atomic_path": "files",
     "MAX_FILE_BYTES": "files", "MAX_YAML_VALUES": "files",
     "load_plan_scenario": "plan_scenario", "plan_scenario_from_mapping": "plan_scenario",
     "plan_scenario_to_mapping": "plan_scenario",
@@ -55,7 +58,7 @@ _HOME = {
 __all__ = [
     # files
     "read_mapping", "read_text", "parse_mapping", "validate_mapping", "write_json",
-    "write_text_atomic", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
+    "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
     # sheet scenarios
     "load_sheet_scenario", "sheet_scenario_from_mapping", "SheetScenario",
     # plan scenarios

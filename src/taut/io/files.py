@@ -12,15 +12,18 @@ add more than :data:`MAX_YAML_VALUES` values to it (an "alias bomb": a few kB th
 expand to billions of values). The expansion is counted on the parsed node graph (each
 anchored node once), so a bomb is refused in milliseconds.
 
-:func:`write_text_atomic` is how every command writes a file: a temporary file in the
-same folder, renamed over the target, so an interrupted command never leaves half a file.
+:func:`write_text_atomic` is how every command writes a file, and :func:`atomic_path`
+how figures and animations are saved: a temporary file in the same folder, renamed over
+the target, so an interrupted command never leaves half a file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -31,7 +34,7 @@ from ..errors import InvalidInputError, ScenarioError
 from .._validate import as_path, require_instance
 
 __all__ = ["read_text", "read_mapping", "parse_mapping", "validate_mapping", "write_json",
-           "write_text_atomic", "MAX_FILE_BYTES", "MAX_YAML_VALUES"]
+           "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES"]
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -245,6 +248,23 @@ def _at(obj: Any, loc: tuple[Any, ...]) -> Any:
 
 
 _NOT_FOUND = object()
+#: Steps pydantic adds to an error's location to say which branch of a union failed.
+_UNION_TAGS = frozenset({"float", "int", "str", "bool", "none"})
+
+
+def _data_loc(data: Any, loc: tuple[Any, ...]) -> tuple[Any, ...]:
+    """An error location without pydantic's union-branch steps (``list[float]``,
+    ``float``, ...) that are not keys of the file."""
+    out: list[Any] = []
+    for part in loc:
+        inside = isinstance(data, dict) and part in data
+        if isinstance(part, str) and not inside and ("[" in part or part in _UNION_TAGS):
+            continue
+        out.append(part)
+        data = data[part] if inside else (
+            data[part] if isinstance(data, list) and isinstance(part, int)
+            and -len(data) <= part < len(data) else None)
+    return tuple(out)
 
 
 def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
@@ -260,7 +280,7 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
         validated = model.model_validate(data)
     except ValidationError as exc:
         err = exc.errors()[0]
-        loc = _location(tuple(p for p in err["loc"] if not (isinstance(p, str) and "[" in p)))
+        loc = _location(_data_loc(data, err["loc"]))
         msg = err["msg"]
         if err["type"] == "extra_forbidden":
             msg = "unknown key"
@@ -288,26 +308,54 @@ def write_json(obj: Any, path: str | Path) -> None:
 
 
 def write_text_atomic(path: str | Path, text: str | bytes) -> None:
-    """Write a file all at once: a temporary file next to ``path``, flushed, then renamed
-    over it (:func:`os.replace` is atomic on POSIX and Windows), so a reader sees the old
-    file or the new one, never half of one, and an interrupt leaves no partial file.
+    """Write a file all at once (:func:`atomic_path`), so a reader sees the old file or
+    the new one, never half of one, and an interrupt leaves no partial file.
 
     Raises
     ------
     InvalidInputError
         ``path``: the folder cannot be written; ``text`` neither ``str`` nor ``bytes``.
     """
-    path = Path(as_path(path))
     require_instance(text, (str, bytes), "text")
     data = text.encode("utf-8") if isinstance(text, str) else text
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """A temporary file next to ``path`` to write, renamed over ``path`` when the block
+    ends without an error (:func:`os.replace` is atomic on POSIX and Windows) and removed
+    when it fails or is interrupted. Its name ends like ``path`` (``.png``, ``.gif``), so
+    writers that choose the format by the suffix (matplotlib) write the right one. A new
+    file gets the usual permissions (0666 less the umask), a replaced one keeps its own.
+
+    Raises
+    ------
+    InvalidInputError
+        ``path``: the folder cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> target = Path(tempfile.mkdtemp()) / "out.txt"
+    >>> with atomic_path(target) as tmp:
+    ...     _ = tmp.write_text("done")
+    ...     target.exists()
+    False
+    >>> target.read_text(), sorted(p.name for p in target.parent.iterdir())
+    ('done', ['out.txt'])
+    """
+    path = Path(as_path(path))
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
-                                   dir=path.parent if str(path.parent) else ".")
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
+                                    dir=path.parent if str(path.parent) else ".")
     except OSError as exc:
         raise InvalidInputError(str(path), f"cannot write ({exc.strerror or exc})") from None
+    os.close(fd)
+    tmp = Path(name)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+        yield tmp
         if path.exists():
             try:
                 os.chmod(tmp, path.stat().st_mode & 0o7777)
@@ -317,5 +365,5 @@ def write_text_atomic(path: str | Path, text: str | bytes) -> None:
             os.chmod(tmp, 0o666 & ~_UMASK)
         os.replace(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise

@@ -324,6 +324,10 @@ def equilibria_check_to_dict(check: Any) -> dict[str, Any]:
                     "agrees": s.agrees, "predicted": f(s.predicted), "tied": f(s.tied),
                     "settled": f(s.settled), "difference": f(s.difference),
                     "tied_difference": f(s.tied_difference), "sliding": float(s.sliding),
+                    "predicted_sliding": float(s.predicted_sliding),
+                    "resolved": bool(s.resolved),
+                    "reached": None if s.reached is None else list(s.reached),
+                    "basin": float(s.basin),
                     "moved": float(s.moved), "time_s": float(s.time)}
                    for s in check.states],
     }

@@ -2,7 +2,9 @@
 
 Keys: ``hold_height`` (required, > 0), ``sheet`` (required, list of [x, y] vertices in robot
 order), ``formation`` (list of [x, y] robot positions; required by ``taut fk``), and the
-optional ``units`` (a label only), ``mass`` (kg, > 0) and ``name``. Unknown keys, keys given
+optional ``units`` (a label only), ``mass`` (the object's mass, kg, > 0), ``object``
+(the object's shape: ``radius``, > 0, in ``units``; used by ``taut physics``) and ``name``.
+Unknown keys, keys given
 twice, booleans in place of numbers and values outside the accepted range
 (:data:`taut._validate.MAX_SHEET_LENGTH`, :data:`taut._validate.MAX_MASS_KG`) are errors.
 """
@@ -26,6 +28,12 @@ __all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"
 Point = tuple[float, float]
 
 
+class _ObjectFile(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=False)
+
+    radius: float = Field(gt=0, allow_inf_nan=False)
+
+
 class _SheetScenarioFile(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=False)
 
@@ -35,6 +43,7 @@ class _SheetScenarioFile(BaseModel):
     mass: float | None = Field(default=None, allow_inf_nan=False)
     sheet: list[Point]
     formation: list[Point] | None = None
+    object: _ObjectFile | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,12 +60,15 @@ class SheetScenario:
     units : str or None
         Length unit label (not interpreted).
     name : str or None
+    object_radius : float or None
+        The object's radius, in ``units`` (the physics check's ball), or None.
     """
 
     team: SheetTeam
     formation: np.ndarray | None
     units: str | None
     name: str | None
+    object_radius: float | None = None
 
 
 def _rename(exc: TautError, field: str) -> ScenarioError:
@@ -70,7 +82,9 @@ def sheet_scenario_from_mapping(data: dict) -> SheetScenario:
     try:
         for field, value, limit, unit in (
                 ("sheet", raw.sheet, MAX_SHEET_LENGTH, "scenario units"),
-                ("formation", raw.formation, MAX_SHEET_LENGTH, "scenario units")):
+                ("formation", raw.formation, MAX_SHEET_LENGTH, "scenario units"),
+                ("object.radius", None if raw.object is None else raw.object.radius,
+                 MAX_SHEET_LENGTH, "scenario units")):
             if value is not None:
                 check_range(value, field, limit, unit)
     except TautError as exc:
@@ -92,7 +106,8 @@ def sheet_scenario_from_mapping(data: dict) -> SheetScenario:
             formation = check_formation(sheet, np.array(raw.formation, dtype=float))
         except TautError as exc:
             raise ScenarioError("formation", exc.problem) from None
-    return SheetScenario(team, formation, raw.units, raw.name)
+    return SheetScenario(team, formation, raw.units, raw.name,
+                         None if raw.object is None else raw.object.radius)
 
 
 def load_sheet_scenario(path: str | Path) -> SheetScenario:

@@ -15,6 +15,7 @@ import numpy as np  # noqa: E402
 from ..cdpr.model.robot import CableRobot  # noqa: E402
 from ..cdpr.workspace.wrench_feasible import WorkspaceResult  # noqa: E402
 from ..cdpr.sets.wrench import AxisCapacities  # noqa: E402
+from ._save import save_figure  # noqa: E402
 
 __all__ = ["draw_robot_outline", "plot_workspace", "plot_axis_capacities"]
 
@@ -96,7 +97,7 @@ def plot_workspace(result: WorkspaceResult, robot: CableRobot,
         fig.suptitle(label, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, dpi=150)
     return fig
 
 
@@ -129,5 +130,5 @@ def plot_axis_capacities(without: AxisCapacities, with_tipping: AxisCapacities |
     fig.suptitle(title or "wrench capability (min of + and - directions)", fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, dpi=150)
     return fig

@@ -15,6 +15,7 @@ import numpy as np  # noqa: E402
 
 from ..cdpr.model.robot import CableRobot  # noqa: E402
 from ..cdpr.workspace.wrench_feasible import WorkspaceResult  # noqa: E402
+from ._save import save_figure  # noqa: E402
 
 __all__ = ["plot_binding"]
 
@@ -93,5 +94,5 @@ def plot_binding(result: WorkspaceResult, robot: CableRobot, path: str | Path | 
               bbox_to_anchor=(0.5, -0.08 if three_d else -0.14))
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, dpi=150)
     return fig

@@ -19,6 +19,7 @@ from ..errors import InvalidInputError  # noqa: E402
 from ..cdpr.workspace.wrench_feasible import WorkspaceResult  # noqa: E402
 from .cdpr import draw_robot_outline  # noqa: E402
 from .cdpr_binding import _STYLE  # noqa: E402
+from ._save import save_figure  # noqa: E402
 
 __all__ = ["plot_workspace_comparison"]
 
@@ -87,5 +88,5 @@ def plot_workspace_comparison(results: Sequence[WorkspaceResult],
         ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, dpi=150)
     return fig

@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..cdpr.deployment.deploy import DeploymentResult  # noqa: E402
+from ._save import save_figure  # noqa: E402
 
 __all__ = ["plot_capacity_bars", "plot_deployment"]
 
@@ -40,7 +41,7 @@ def plot_capacity_bars(series: dict[str, np.ndarray], labels: Sequence[str],
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save_figure(fig, path, dpi=130)
         plt.close(fig)
     return fig
 
@@ -86,6 +87,6 @@ def plot_deployment(result: DeploymentResult, path: str | Path | None = None,
                            + ("" if result.success else " (not feasible)")), fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save_figure(fig, path, dpi=130)
         plt.close(fig)
     return fig

@@ -12,12 +12,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
+from matplotlib.animation import FuncAnimation  # noqa: E402
 
 from ..cdpr.kinematics._bases import moved_exits  # noqa: E402
 from ..cdpr.kinematics.cables import rotation_matrices  # noqa: E402
 from ..cdpr.model.robot import CableRobot  # noqa: E402
 from ..cdpr.control.simulate import ControlResult  # noqa: E402
+from ._save import save_figure, save_animation  # noqa: E402
 
 __all__ = ["plot_control", "plot_comparison", "animate_control"]
 
@@ -57,7 +58,7 @@ def plot_control(r: ControlResult, path: str | Path | None = None, title: str | 
     fig.suptitle(title or f"{r.controller.get('name', '')} control: {r.message}", fontsize=9)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save_figure(fig, path, dpi=130)
         plt.close(fig)
     return fig
 
@@ -80,7 +81,7 @@ def plot_comparison(results: Mapping[str, ControlResult], path: str | Path | Non
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save_figure(fig, path, dpi=130)
         plt.close(fig)
     return fig
 
@@ -122,5 +123,5 @@ def animate_control(robot: CableRobot, r: ControlResult, path: str | Path, *,
         return (*lines, plat, exits, title)
 
     anim = FuncAnimation(fig, update, frames=len(idx), blit=False)
-    anim.save(str(path), writer=PillowWriter(fps=fps))
+    save_animation(anim, path, fps=fps)
     plt.close(fig)

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..sheet.sim.simulate import SimulationResult  # noqa: E402
+from ._save import save_figure  # noqa: E402
 
 __all__ = ["plot_simulation"]
 
@@ -98,7 +99,7 @@ def plot_simulation(result: SimulationResult, path: str | Path | None = None, *,
         fig.suptitle(title)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
         plt.close(fig)
         return None
     return fig

@@ -13,13 +13,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import shapely  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
+from matplotlib.animation import FuncAnimation  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 from matplotlib.patches import Polygon as PolygonPatch  # noqa: E402
 
 from ..plan.checks.profile import plan_profile  # noqa: E402
 from ..plan.result import PlanResult  # noqa: E402
 from ..plan.world import Scenario  # noqa: E402
+from ._save import save_figure, save_animation  # noqa: E402
 
 __all__ = ["plot_plan", "animate_plan", "draw_world"]
 
@@ -158,7 +159,7 @@ def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
         _clearances(axs[1, 0], scenario, r)
     _distances(axs[1, 1], scenario, r)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -189,5 +190,5 @@ def animate_plan(scenario: Scenario, result: PlanResult, path: str | Path, *,
         return (sheet, *bots, obj, title)
 
     anim = FuncAnimation(fig, update, frames=len(idx), blit=False)
-    anim.save(str(path), writer=PillowWriter(fps=fps))
+    save_animation(anim, path, fps=fps)
     plt.close(fig)

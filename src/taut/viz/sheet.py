@@ -16,6 +16,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 from ..sheet.fk.results import Equilibrium, FKResult  # noqa: E402
+from ._save import save_figure  # noqa: E402
 
 __all__ = ["draw_equilibrium", "plot_fk", "KIND_COLOURS"]
 
@@ -108,6 +109,6 @@ def plot_fk(result: FKResult, path: str | Path | None = None, *, units: str | No
     fig.tight_layout(rect=(0, 0.08 if rows == 1 else 0.05, 1, 1))
     if path is not None:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, dpi=150)
         plt.close(fig)
     return fig

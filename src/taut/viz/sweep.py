@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from ._save import save_figure
+
 __all__ = ["plot_sweep"]
 
 
@@ -110,6 +112,6 @@ def plot_sweep(columns: dict[str, np.ndarray], x: str, value: str, path: str | P
     ax.set_xlabel(labels.get(x, x))
     ax.set_title(title or f"{value} over {x}" + (f" and {y}" if y else ""))
     out = Path(path)
-    fig.savefig(out, dpi=150)
+    save_figure(fig, out, dpi=150)
     plt.close(fig)
     return out
