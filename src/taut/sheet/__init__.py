@@ -86,30 +86,60 @@ Method, METHODS
 Backend
     Compute backend (``"auto"``, ``"numba"``, ``"numpy"``).
 HAVE_NUMBA
-    Whether the compiled kernels are available.
+    Whether this process runs the compiled kernels (``TAUT_NUMBA``; docs/compiled_kernels.md).
 COMPILED_MAX_N
     Largest team for which the compiled solver tries every small subset.
 EquilibriumKind
     What a rest state is: ``"stable"``, ``"saddle"``, ``"not_equilibrium"``.
+
+The names above are imported on first use (PEP 562): ``from taut.sheet import
+forward_kinematics`` loads neither the inverse kinematics nor the simulation.
 """
 
-from ._options import METHODS, Backend, Method
-from .fk.forward import forward_kinematics, forward_kinematics_batch
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
 from .._units import GRAVITY
-from .fk.results import BatchFKResult, Equilibrium, EquilibriumKind, FKResult, Funnel
-from .fk.solver import COMPILED_MAX_N, HAVE_NUMBA, FKSolver
-from .geometry import (FormationMetrics, formation_metrics, formation_size,
-                       max_obstacle_diameter, max_obstacle_height, min_robot_distance,
-                       minimum_enclosing_circle)
-from .ik.inverse import (IKCertificate, IKConstraints, IKResult, contact_weights,
-                         formation_from_angles, ik_constraints, inverse_kinematics)
-from .model import Sheet, check_formation, check_formations, check_hold_height
-from .random import (random_convex_polygon, random_hanging_team, random_scattered_team,
-                     random_team)
-from .sim.results import EventKind, SimulationEvent, SimulationResult, SimulatorState
-from .sim.simulate import simulate
-from .sim.simulator import Simulator
-from .team import SheetTeam
+from ._options import METHODS, Backend, Method
+
+if TYPE_CHECKING:                   # the real names, for type checkers
+    from .fk.forward import forward_kinematics, forward_kinematics_batch
+    from .fk.results import BatchFKResult, Equilibrium, EquilibriumKind, FKResult, Funnel
+    from .fk.solver import COMPILED_MAX_N, HAVE_NUMBA, FKSolver
+    from .geometry import (FormationMetrics, formation_metrics, formation_size,
+                           max_obstacle_diameter, max_obstacle_height, min_robot_distance,
+                           minimum_enclosing_circle)
+    from .ik.inverse import (IKCertificate, IKConstraints, IKResult, contact_weights,
+                             formation_from_angles, ik_constraints, inverse_kinematics)
+    from .model import Sheet, check_formation, check_formations, check_hold_height
+    from .random import (random_convex_polygon, random_hanging_team, random_scattered_team,
+                         random_team)
+    from .sim.results import EventKind, SimulationEvent, SimulationResult, SimulatorState
+    from .sim.simulate import simulate
+    from .sim.simulator import Simulator
+    from .team import SheetTeam
+
+_HOME = {
+    "forward_kinematics": "fk.forward", "forward_kinematics_batch": "fk.forward",
+    "BatchFKResult": "fk.results", "Equilibrium": "fk.results",
+    "EquilibriumKind": "fk.results", "FKResult": "fk.results", "Funnel": "fk.results",
+    "COMPILED_MAX_N": "fk.solver", "HAVE_NUMBA": "fk.solver", "FKSolver": "fk.solver",
+    "FormationMetrics": "geometry", "formation_metrics": "geometry",
+    "formation_size": "geometry", "max_obstacle_diameter": "geometry",
+    "max_obstacle_height": "geometry", "min_robot_distance": "geometry",
+    "minimum_enclosing_circle": "geometry", "IKCertificate": "ik.inverse",
+    "IKConstraints": "ik.inverse", "IKResult": "ik.inverse",
+    "contact_weights": "ik.inverse", "formation_from_angles": "ik.inverse",
+    "ik_constraints": "ik.inverse", "inverse_kinematics": "ik.inverse", "Sheet": "model",
+    "check_formation": "model", "check_formations": "model", "check_hold_height": "model",
+    "random_convex_polygon": "random", "random_hanging_team": "random",
+    "random_scattered_team": "random", "random_team": "random", "EventKind": "sim.results",
+    "SimulationEvent": "sim.results", "SimulationResult": "sim.results",
+    "SimulatorState": "sim.results", "simulate": "sim.simulate",
+    "Simulator": "sim.simulator", "SheetTeam": "team",
+}
 
 __all__ = [
     # Model
@@ -132,3 +162,6 @@ __all__ = [
     "GRAVITY", "Method", "METHODS", "Backend", "HAVE_NUMBA", "COMPILED_MAX_N",
     "EquilibriumKind",
 ]
+
+
+__getattr__, __dir__ = lazy_names(__name__, _HOME, globals())

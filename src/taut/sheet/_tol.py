@@ -92,14 +92,26 @@ TINY = 1e-300
 #: a regular hexagon at 0.9x written to 6 decimals), and 500x below a robot's 5 mm error on
 #: a 1 m sheet (the planner's robustness check), so no two states a team can tell apart merge.
 MERGE_RTOL = 1e-5
-#: Formations within this distance (relative to the sheet size) of a similar copy of the
-#: sheet whose enumeration reports no stable state get the direct minimisation of the
-#: object's height (fk._lowest): 10x the largest noise of the issue-25 property test (1e-4),
-#: far outside SNAP_TOL, where the taut-set enumeration can lose the lowest state.
+#: The direct minimisation of the object's height (fk._lowest) can supply a *stable* state
+#: the enumeration missed only within this distance (relative to the sheet size) of a similar
+#: copy of the sheet, where float64 cannot tell a cable slack by 1e-9 from a taut one; 10x
+#: the largest noise of the issue-25 property test (1e-4), far outside SNAP_TOL. Elsewhere
+#: the enumeration's stable states are complete, so ``FKResult.stable``/``success`` skip the
+#: descent there (it still runs, on first access, for ``lowest``, ``status``, ``message``).
 DIRECT_RTOL = 1e-3
-#: Iterations of each of those descents (next to a similar copy the descent from the
-#: centroids arrives within a few dozen; one still running drifts towards the floor).
+#: Iterations of each descent of the direct minimisation of the object's height (fk._lowest;
+#: run where the enumeration reports no stable state): from the centroids it arrives within
+#: a few dozen; one still running drifts towards the floor.
 DIRECT_MAXIT = 400
+#: Pieces of F within this (normalised: squared lengths over the squared sheet size) of the
+#: maximum where the descent stops are re-solved exactly, every subset of 3..5 of them
+#: (fk._lowest): next to a similar copy the descent can stop on a flat-looking face whose
+#: neighbours carry the true minimiser (seed 34152 of the issue-25 property test: it stops
+#: on a 2-cable face, the strict minimum's third cable 1.6e-6 below the maximum there);
+#: 60x that, and far below the gaps between distinct states of a generic team.
+DIRECT_NEAR_TOL = 1e-4
+#: At most this many of those pieces (the highest) are re-solved: C(10, <=5) = 637 systems.
+DIRECT_NEAR_MAX = 10
 #: Relative tolerance (times the sheet size) for geometric equalities on input data:
 #: robot pairs may exceed their sheet distance by this much (rounding of given data).
 GEOMETRY_RTOL = 1e-9

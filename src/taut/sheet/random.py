@@ -86,12 +86,15 @@ def random_hanging_team(rng: np.random.Generator, *, robots: tuple[int, int] = (
                         width: tuple[float, float] = (500.0, 1000.0),
                         hold: tuple[float, float] = (0.8, 1.5)
                         ) -> tuple[SheetTeam, np.ndarray]:
-    """A random team whose object has a rest state: the sample of the physics checks.
+    """A random team for which forward kinematics finds an equilibrium: the sample of the
+    physics checks.
 
     Draws ``n`` in ``robots`` (inclusive) and :func:`random_team`, scales it so that the
     sheet's longest side is uniform in ``width`` (sheet units), holds it at a height
     uniform in ``hold`` times the sheet radius (largest vertex distance from the vertices'
-    centroid), and draws again until forward kinematics finds a rest state.
+    centroid), and draws again until forward kinematics finds an equilibrium. The
+    equilibrium may be unstable (about 1 % of draws have no stable one: the physics checks
+    then verify that nothing is held).
 
     Returns
     -------
@@ -101,7 +104,7 @@ def random_hanging_team(rng: np.random.Generator, *, robots: tuple[int, int] = (
     Raises
     ------
     InvalidInputError
-        A bad range, or no team with a rest state in :data:`HANGING_DRAWS` draws.
+        A bad range, or no team with an equilibrium in :data:`HANGING_DRAWS` draws.
     """
     from .fk.forward import forward_kinematics
 
@@ -123,7 +126,7 @@ def random_hanging_team(rng: np.random.Generator, *, robots: tuple[int, int] = (
         team = SheetTeam(sheet, rng.uniform(*h) * radius)
         if forward_kinematics(team, R).equilibria:
             return team, R
-    raise InvalidInputError("hold", f"no team with a rest state in {HANGING_DRAWS} draws")
+    raise InvalidInputError("hold", f"no team with an equilibrium in {HANGING_DRAWS} draws")
 
 
 def _range(value: object, field: str, limit: float) -> tuple[float, float]:

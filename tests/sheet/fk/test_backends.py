@@ -1,13 +1,12 @@
 """The compiled small-team kernel (numba) and the numpy path give the same equilibria.
 
 Two independent implementations of the same decisions (Lagrange systems by hand-written
-LU vs LAPACK, the reduced Hessian by Gram-Schmidt vs SVD, ...), compared on generic,
+LU vs LAPACK, the reduced Hessian by closed forms vs SVD, ...), compared on generic,
 scattered and degenerate teams: formations that are (nearly) similar copies of the sheet
 (the FK paper's Lemma 2), robot pairs exactly at their sheet distance, sheets with
 collinear vertices, low hold heights.
 """
 
-import tempfile
 
 import numpy as np
 import pytest
@@ -259,27 +258,17 @@ def test_similar_fit_equals_similar_copy(kind, seed, n, mirror):
         assert scale == pytest.approx(scales[0], rel=1e-12)
 
 
-def test_kernel_is_cached_on_disk_and_cache_dir_falls_back(monkeypatch, tmp_path):
-    """numba's on-disk cache holds the kernel (index files next to it or in
-    NUMBA_CACHE_DIR), and with no writable location a per-user temp dir is chosen."""
+def test_kernel_is_cached_on_disk():
+    """numba's on-disk cache holds the per-call kernel (index files next to it or in
+    NUMBA_CACHE_DIR); where the cache goes on a read-only install is tests/test_jit.py's."""
     import os
 
-    import numba
-
-    from taut import _jit as sk
+    from taut._jit import cache_dir
     from taut.sheet._kernels import small as _small_kernel
 
     sheet = Sheet.regular(4, 1.0)
     FKSolver(SheetTeam(sheet, 1.0)).solve(0.8 * sheet.vertices)
-    where = (os.environ.get("NUMBA_CACHE_DIR")
-             or os.path.join(os.path.dirname(_small_kernel.__file__), "__pycache__"))
-    index = [f for _, _, files in os.walk(where) for f in files
-             if f.startswith("small.solve_formation") and f.endswith(".nbi")]
+    places = (cache_dir()[0], os.path.join(os.path.dirname(_small_kernel.__file__), "__pycache__"))
+    index = [f for where in places for _, _, files in os.walk(where) for f in files
+             if f.startswith("batch.solve_one") and f.endswith(".nbi")]
     assert index
-    writable = sk._writable
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
-    monkeypatch.setattr(numba.config, "CACHE_DIR", "")
-    monkeypatch.setattr(sk, "_writable", lambda d: False)
-    sk._ensure_cache_dir()
-    assert numba.config.CACHE_DIR.startswith(os.path.join(tempfile.gettempdir(), "taut-numba"))
-    assert writable(str(tmp_path / "x"))

@@ -5,6 +5,8 @@ lowest rest state."""
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
@@ -12,6 +14,8 @@ import taut.sheet as ts
 from taut.errors import InvalidInputError
 from taut.sheet import FKSolver, HAVE_NUMBA, Sheet, SheetTeam
 from taut.sheet._tol import MERGE_RTOL
+
+from fk_exact import brute_lowest, exact_states, sharp_minimum
 
 BACKENDS = ["numba", "numpy"] if HAVE_NUMBA else ["numpy"]
 
@@ -154,7 +158,65 @@ def test_lowest_by_direct_minimisation_says_so():
     res = ts.forward_kinematics(team, R)
     assert res.success and res.status == "ok"
     assert res.direct and "direct minimisation" in res.message
-    assert len(res.lowest.taut) == 16
+    # In exact rational arithmetic (fk_exact) the lowest rest point is the centre, with
+    # every other cable at full length (the 6-digit data keep that 8-fold symmetry) and
+    # the rest slack by ~1e-6: the taut set is those 8. Weights 1/8 on each balance the
+    # object there and their gradients span R^4, so it is a strict (sharp) minimum; float64
+    # places it within 1.2e-6 of the sheet size (one state: MERGE_RTOL).
+    low = res.lowest
+    assert low.taut == tuple(range(1, 16, 2))
+    exact = exact_states(team.sheet.vertices, R, team.hold_height, cables=low.taut)
+    assert [float(c) for c in exact[0].x] == [0.0, 0.0, 0.0, 0.0]
+    assert all(exact[0].slack[i] == 0 for i in low.taut)
+    assert min(exact[0].slack[i] for i in range(0, 16, 2)) > 0
+    assert sharp_minimum(team.sheet.vertices, R, exact[0], {i: Fraction(1, 8) for i in low.taut})
+    assert np.abs(exact[0].object(team.hold_height) - low.object).max() < MERGE_RTOL
+
+
+def test_a_flat_lowest_state_is_reported_as_not_strict():
+    """A square sheet squeezed along y only (robots at (+-1, +-(1 - c))): every cable's
+    condition |r_o - r_i|^2 + d^2 <= |v_o - v_i|^2 has the same x-terms on both sides when
+    the object and the contact point move together along x, so the depth does not depend
+    on that shift: the lowest states form a segment (d^2 = 1 - (1 - c)^2, all four cables
+    taut), a minimum that is not strict. The enumeration finds no isolated state; the
+    direct minimisation reports it, kind "saddle", status "not_strict" (not dropped)."""
+    V = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]], float)
+    for c, th in ((0.2, 0.0), (0.5, 0.7)):
+        Q = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+        R = np.array([[1, 1 - c], [-1, 1 - c], [-1, -1 + c], [1, -1 + c]]) @ Q.T + [3.0, -2.0]
+        team = SheetTeam(Sheet(V), 3.0)
+        for method in ("fast", "subsets", "exhaustive"):
+            res = ts.forward_kinematics(team, R, method=method)
+            low = res.lowest
+            assert res.status == "not_strict" and not res.success and res.direct, method
+            assert low.kind == "saddle" and low.taut == (0, 1, 2, 3), method
+            assert "not strict" in res.message
+            assert low.height == pytest.approx(3.0 - np.sqrt(2 * c - c * c), abs=1e-12)
+            np.testing.assert_allclose(low.weights.sum(), 1.0, atol=1e-12)
+            # The flatness itself: the same depth after sliding along the trough.
+            d2 = [np.min(np.sum((low.contact + s * np.array([1.0, 0]) - V) ** 2, axis=1)
+                         - np.sum((low.object[:2] + s * Q[:, 0] - R) ** 2, axis=1))
+                  for s in (0.0, 0.3, -0.4)]
+            np.testing.assert_allclose(d2, (3.0 - low.height) ** 2, atol=1e-12)
+        b = ts.forward_kinematics_batch(team, R[None])
+        assert b.status.tolist() == ["not_strict"] and b.count.tolist() == [1]
+
+
+def test_an_object_that_slides_off_the_sheet_has_no_rest_state():
+    """A copy of an obtuse triangle (circumcentre outside it) at 0.8x, far above the
+    floor: no rest state exists (the independent constrained minimisation ends with the
+    contact point on the sheet's edge); the result says so in one line, lowest is None."""
+    V = np.array([[0, 0], [4, 0], [2, 0.6]], float)
+    team = SheetTeam(Sheet(V), 10.0)
+    _, rest = brute_lowest(V, 0.8 * V, 10.0)
+    assert not rest
+    for method in ("fast", "exhaustive"):
+        res = ts.forward_kinematics(team, 0.8 * V, method=method)
+        assert res.lowest is None and res.status == "infeasible" and not res.success
+        assert not res.direct and res.equilibria == ()
+        assert res.message.endswith("the object slides off the sheet (descending its "
+                                    "height carries the contact point over the sheet's "
+                                    "edge: no rest state)")
 
 
 def test_clear_cases_are_unchanged():

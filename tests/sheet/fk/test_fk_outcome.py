@@ -46,14 +46,16 @@ def test_no_stable_state_is_not_success():
 
     from taut.sheet import FKResult
 
-    # Away from a similar copy of the sheet (next to one, the direct minimisation of the
-    # height would supply the stable state, issue 25).
-    R = INNER + [[0.0, 0.0], [0.05, 0.0], [0.0, 0.0], [0.0, 0.0]]
-    res = forward_kinematics(SheetTeam(SQUARE, 1.0), R)
-    saddle = FKResult((replace(res.lowest, kind="saddle"),), None, "fast", SQUARE, R,
-                      1.0, None)
+    # A team without a rest state (a copy of an obtuse triangle: the object slides off the
+    # sheet), so that the direct minimisation of the height supplies none (issue 25).
+    sheet = Sheet([[0, 0], [4, 0], [2, 0.6]])
+    R = 0.8 * sheet.vertices
+    state = forward_kinematics(SheetTeam(SQUARE, 1.0), INNER).lowest
+    saddle = FKResult((replace(state, kind="saddle"),), None, "fast", sheet, R, 10.0, None)
     assert (saddle.success, saddle.status) == (False, "infeasible")
-    assert saddle.message == "no stable state: 1 solution(s), 1 saddle, 0 not an equilibrium"
+    assert saddle.message.startswith(
+        "no stable state: 1 solution(s), 1 saddle, 0 not an equilibrium; the object slides "
+        "off the sheet")
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -92,13 +92,18 @@ def test_bad_solver_arguments():
 
 
 def test_without_numba_auto_falls_back_and_numba_is_refused(monkeypatch):
+    """Without the compiled kernels ``auto`` answers with numpy and ``numba`` is refused,
+    naming the field and saying why (taut._jit.not_compiled_reason)."""
+    from taut._jit import not_compiled_reason
+
     monkeypatch.setattr(solver, "HAVE_NUMBA", False)
     sheet = Sheet.regular(4, 1.0)
     s = FKSolver(SheetTeam(sheet, 1.0))
     assert s.backend == "numpy"
     assert s.solve(0.8 * sheet.vertices).stable
-    with pytest.raises(InvalidInputError, match="numba"):
+    with pytest.raises(InvalidInputError, match="backend") as err:
         FKSolver(SheetTeam(sheet, 1.0), backend="numba")
+    assert str(err.value) == "backend: " + not_compiled_reason()
 
 
 def test_closest_stable_picks_the_nearest_state():

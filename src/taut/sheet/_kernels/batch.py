@@ -1,58 +1,20 @@
-"""Compiled forward kinematics of many formations of one small team in one numba call,
-with one workspace for the whole batch (``_small_kernel.solve_formations`` allocates
-its per-formation arrays and sorts with ``np.argsort`` for every formation; at N = 4 that
-is a third of the cost). The per-formation decisions are those of
-``_small_kernel.solve_formation`` (the same helper functions, in the same order), so the
-rows are identical (tested in tests/sheet/fk/test_solver_batch.py)."""
+"""Compiled forward kinematics of one small team: many formations in one numba call with
+one workspace for the whole batch, and the per-call path of ``FKSolver.solve`` (one call
+on a packed solver, nothing allocated but the work arrays). The per-formation decisions
+are those of ``_small_kernel.solve_formation`` (the same function, ``solve_into``), so the
+rows are identical (tested in tests/sheet/fk/test_solver_batch.py and
+tests/sheet/fk/test_solver_fastpath.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..._jit import jit
-from .small import (INFEASIBLE, _candidates, _frame, append_rows, classify_survivors, feasible,
-    similar_fit, solve_formation)
+from .small import (INFEASIBLE, append_rows, similar_fit, solve_carved, solve_into, work_floats,
+    work_views)
 
-__all__ = ["solve_formations_ws", "solve_packed", "pack"]
-
-
-@jit
-def _sorted_survivors(key, C, order):
-    """Indices of the candidates with ``key >= 0`` into ``order``, by increasing key (the
-    keys are distinct: they end in the table position); returns their count."""
-    m = 0
-    for c in range(C):
-        k = key[c]
-        if k < 0:
-            continue
-        i = m - 1
-        while i >= 0 and key[order[i]] > k:            # insertion sort: C is small
-            order[i + 1] = order[i]
-            i -= 1
-        order[i + 1] = c
-        m += 1
-    return m
-
-
-@jit
-def _one(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out, Rn, P, G, bvec, sol,
-         taut, key, order, ang):
-    """``_small_kernel.solve_formation`` on preallocated work arrays; returns the number
-    of rows written to ``out`` (or ``INFEASIBLE``). ``taut`` needs no reset: only rows of
-    surviving candidates are read, and ``_candidates`` writes those in full."""
-    if not feasible(R, lim2):
-        return INFEASIBLE
-    C = table.shape[0]
-    cx, cy = _frame(R, Vn, scale, Rn, P, G, bvec)
-    z = hold / scale
-    found = _candidates(Rn, P, G, bvec, table, sizes, z * z, sol, taut, key)
-    if found == 0:
-        return 0
-    m = _sorted_survivors(key, C, order)
-    k, _stable, _pending = classify_survivors(order, 0, m, key, C, Rn, P, table, sizes, sol,
-                                              taut, ang, out, Vn, scale, cx, cy, vcx, vcy,
-                                              hold)
-    return k
+__all__ = ["solve_formations_ws", "solve_one", "pack", "out_rows", "decode", "snap_screen_batch",
+           "HEADER", "FLAGS_SHIFT", "HAS_STABLE", "HAS_PENDING", "NEAR_COPY", "TORN"]
 
 
 @jit
@@ -64,22 +26,16 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     C = table.shape[0]
     W = 12 + 3 * N
     buf = np.empty((C, W))
-    Rn = np.empty((N, 2))
-    P = np.empty((N, 5))
-    G = np.empty((N, N))
-    bvec = np.empty(N)
-    sol = np.empty((C, 11))
-    taut = np.zeros((C, N), dtype=np.bool_)
-    key = np.empty(C, dtype=np.int64)
-    order = np.empty(C, dtype=np.int64)
-    ang = np.empty(N)
+    Rn, P, G, bvec, ang, sol, lin, eig, key, order = work_views(
+        np.empty(work_floats(N, C)), np.empty(2 * C, dtype=np.int64), N, C)
+    taut = np.empty((C, N), dtype=np.bool_)
     cap = max(16, 2 * B)
     rows = np.empty((cap, W))
     form = np.empty(cap, dtype=np.int64)
     M = 0
     for b in range(B):
-        k = _one(Rb[b], Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf, Rn, P, G, bvec,
-                 sol, taut, key, order, ang)
+        k, _, _ = solve_carved(Rb[b], Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf, Rn,
+                               P, G, bvec, ang, sol, lin, eig, key, order, taut)
         if k < 0:
             return rows[:M], form[:M], b
         rows, form = append_rows(rows, form, M, buf, k, b)
@@ -87,45 +43,96 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     return rows[:M], form[:M], -1
 
 
+#: Leading floats of a pack (:func:`pack`): N, C, scale, vcx, vcy, hold, three snap bounds.
+HEADER = 9
+#: :func:`solve_one`'s return code when the caller has work left: ``-1 - (rows | flags <<
+#: FLAGS_SHIFT)`` (rows < 2**20: the candidates of at most ``COMPILED_MAX_N`` robots).
+FLAGS_SHIFT = 20
+#: Flags: a stable row; a row with a weight family to resolve; next to a similar copy;
+#: the formation is torn or not finite (no rows).
+HAS_STABLE, HAS_PENDING, NEAR_COPY, TORN = 1, 2, 4, 8
+
+
 def pack(Vn, A, lim2, table, sizes, scale, vcx, vcy, hold, snap):
-    """The arguments of :func:`solve_packed` for one solver: a flat float64 array (``Vn``
-    and ``A`` (N, 2) each, ``lim2`` (N, N), then ``scale, vcx, vcy, hold`` and the three
-    snap-screen bounds ``snap``) and a flat int64 array (``table`` (C, 5) then ``sizes``
-    (C,)). Two arguments instead of nine: numba's dispatch costs ~0.3 us per array."""
-    f = np.concatenate([np.ravel(Vn), np.ravel(A), np.ravel(lim2),
-                        [scale, vcx, vcy, hold], np.asarray(snap, dtype=np.float64)])
-    i = np.concatenate([np.ravel(table), np.ravel(sizes)]).astype(np.int64)
-    return np.ascontiguousarray(f, dtype=np.float64), np.ascontiguousarray(i)
+    """The solver argument of :func:`solve_one`: one flat float64 array holding ``N, C,
+    scale, vcx, vcy, hold`` and the three snap-screen bounds ``snap``, then ``Vn`` and
+    ``A`` (N, 2) each and ``lim2`` (N, N), then the int64 ``table`` (C, 5) and ``sizes``
+    (C,) as raw 8-byte words (read back with ``view``, never converted). One argument
+    instead of nine: numba's dispatch costs ~0.1-0.3 us per array."""
+    N, C = len(Vn), len(table)
+    head = np.array([N, C, scale, vcx, vcy, hold, *snap], dtype=np.float64)
+    floats = np.concatenate([head, np.ravel(Vn), np.ravel(A), np.ravel(lim2)])
+    ints = np.concatenate([np.ravel(table), np.ravel(sizes)]).astype(np.int64)
+    out = np.empty(len(floats) + len(ints), dtype=np.float64)
+    out[:len(floats)] = floats
+    out[len(floats):].view(np.int64)[:] = ints
+    return out
+
+
+def out_rows(N: int, C: int) -> int:
+    """Rows of :func:`solve_one`'s ``out`` for ``N`` robots and ``C`` candidates: ``C``
+    result rows, then the float, int64 and bool work arrays of ``solve_into``."""
+    work = work_floats(N, C) + 2 * C + (C * N + 7) // 8
+    return C + -(-work // (12 + 3 * N))
+
+
+def decode(code: int) -> tuple[int, int]:
+    """``(rows, flags)`` of a :func:`solve_one` return code (``rows`` is ``INFEASIBLE``
+    for a torn or non-finite formation)."""
+    if code >= 0:
+        return code, 0
+    v = -1 - code
+    if v >> FLAGS_SHIFT & TORN:
+        return INFEASIBLE, TORN
+    return v & ((1 << FLAGS_SHIFT) - 1), v >> FLAGS_SHIFT
 
 
 @jit
-def solve_packed(R, fpack, ipack, out):
-    """``_small_kernel.solve_formation`` of formation ``R`` (N, 2) on the packed solver
-    arguments (:func:`pack`), and the screen of ``FKSolver._snap`` (next to a similar copy
-    the formation is answered as the copy, stable states or not: docs/sheet_fk_solver.md)
-    (``_small_kernel.similar_fit``: the formation is within the snap distance of a
-    similar copy of the sheet, not larger than it). Returns ``(rows, stable_rows,
-    pending_rows, near_copy)``; rows is ``INFEASIBLE`` for a torn or non-finite ``R``."""
+def solve_one(R, solver, out):
+    """``_small_kernel.solve_formation`` of formation ``R`` (N, 2) on a packed solver
+    (:func:`pack`), and the screen of ``FKSolver._snap`` (``_small_kernel.similar_fit``:
+    within the snap distance of a similar copy of the sheet, not larger than it; next to
+    one the formation is answered as the copy, stable states or not:
+    docs/sheet_fk_solver.md). ``out`` (C + extra, width): rows in ``out[:C]``, the work
+    arrays after them (:func:`out_rows` rows in all).
+
+    Returns one int (the cheapest value to return to Python): the number of rows when
+    they are the answer (no state, or a stable one and no weight family, and not next to
+    a similar copy), else ``-1 - (rows | flags << FLAGS_SHIFT)`` (:func:`decode`; the
+    flag ``TORN`` for a torn or non-finite ``R``)."""
     N = R.shape[0]
-    C = ipack.shape[0] // 6
-    Vn = fpack[0:2 * N].reshape(N, 2)
-    A = fpack[2 * N:4 * N].reshape(N, 2)
-    lim2 = fpack[4 * N:4 * N + N * N].reshape(N, N)
-    g = 4 * N + N * N
-    table = ipack[0:5 * C].reshape(C, 5)
-    sizes = ipack[5 * C:6 * C]
-    k, stable, pending = solve_formation(R, Vn, table, sizes, fpack[g], fpack[g + 1],
-                                         fpack[g + 2], fpack[g + 3], lim2, out)
-    near = False
-    if k >= 0:
-        scale, dist = similar_fit(R, A)
-        near = fpack[g + 4] < dist <= fpack[g + 5] and scale <= fpack[g + 6]
-    return k, stable, pending, near
+    C = int(solver[1])
+    g = HEADER
+    Vn = solver[g:g + 2 * N].reshape(N, 2)
+    A = solver[g + 2 * N:g + 4 * N].reshape(N, 2)
+    lim2 = solver[g + 4 * N:g + 4 * N + N * N].reshape(N, N)
+    h = g + 4 * N + N * N
+    ints = solver[h:h + 6 * C].view(np.int64)
+    table = ints[0:5 * C].reshape(C, 5)
+    sizes = ints[5 * C:6 * C]
+    flat = out.reshape(out.size)
+    o = C * out.shape[1]
+    fw = flat[o:o + work_floats(N, C)]
+    o += work_floats(N, C)
+    iw = flat[o:o + 2 * C].view(np.int64)
+    o += 2 * C
+    taut = flat[o:o + (C * N + 7) // 8].view(np.bool_)[:C * N].reshape(C, N)
+    k, stable, pending = solve_into(R, Vn, table, sizes, solver[2], solver[3], solver[4],
+                                    solver[5], lim2, out, fw, iw, taut)
+    if k < 0:
+        return -1 - (TORN << FLAGS_SHIFT)
+    flags = (HAS_STABLE if stable else 0) | (HAS_PENDING if pending else 0)
+    scale, dist = similar_fit(R, A)
+    if solver[6] < dist <= solver[7] and scale <= solver[8]:
+        flags |= NEAR_COPY
+    if k == 0 and flags == 0 or flags == HAS_STABLE:
+        return k
+    return -1 - (k | flags << FLAGS_SHIFT)
 
 
 @jit
 def snap_screen_batch(Rb, A, low, high, top):
-    """The snap screen of ``solve_packed`` on every formation of ``Rb`` (B, N, 2): within
+    """The snap screen of ``solve_one`` on every formation of ``Rb`` (B, N, 2): within
     ``(low, high]`` of a similar copy of the sheet (centred vertices ``A``), scale at most
     ``top`` -> (B,) bool (``FKSolver._snap`` makes the exact test on those)."""
     B = Rb.shape[0]

@@ -129,53 +129,22 @@ def _in_hull(Rn, taut, N, px, py, ang):
     return gap <= math.pi + ANGLE_TOL
 
 
-@jit
-def _project_out(v, Q, q):
-    """Remove from ``v`` (4,) its components along the first ``q`` rows of ``Q`` (twice:
-    "twice is enough" for Gram-Schmidt); returns the residual norm."""
-    for _ in range(2):
-        for k in range(q):
-            dot = v[0] * Q[k, 0] + v[1] * Q[k, 1] + v[2] * Q[k, 2] + v[3] * Q[k, 3]
-            for c in range(4):
-                v[c] -= dot * Q[k, c]
-    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3])
-
-
-@jit
-def _orthonormal_complement(D, nrows, Q):
-    """Orthonormal rows ``Q[nrows:4]`` spanning the null space of the ``nrows`` (affinely
-    independent, so linearly independent) rows of ``D`` (4 columns), which are first
-    orthonormalised into ``Q[:nrows]``; each further row is the coordinate axis with the
-    largest residual (no threshold needed)."""
-    v = np.empty(4)
-    for r in range(nrows):
-        for c in range(4):
-            v[c] = D[r, c]
-        nv = _project_out(v, Q, r)
-        for c in range(4):
-            Q[r, c] = v[c] / nv
-    best = np.empty(4)
-    for q in range(nrows, 4):
-        top = -1.0
-        for axis in range(4):
-            for c in range(4):
-                v[c] = 0.0
-            v[axis] = 1.0
-            nv = _project_out(v, Q, q)
-            if nv > top:
-                top = nv
-                for c in range(4):
-                    best[c] = v[c] / nv
-        for c in range(4):
-            Q[q, c] = best[c]
+#: Rows of the work array of :func:`_reduced_min_eig_ws` (4 columns).
+EIG_WORK_ROWS = 3
 
 
 @jit
 def _reduced_min_eig(P, members, s):
     """Smallest eigenvalue of diag(1, 1, -1, -1) on the face's tangent space
     (``_kernel.reduced_hessian_min_eig``): +inf for 5 members, the generalised cross
-    product for 4, a 2 x 2 closed form for 3, a 3 x 3 one for 2 (docs/sheet_kinematics.md
-    §5)."""
+    product for 4, a 2 x 2 closed form for 3, -1 for 2 (docs/sheet_kinematics.md §5)."""
+    return _reduced_min_eig_ws(P, members, s, np.empty((EIG_WORK_ROWS, 4)))
+
+
+@jit
+def _reduced_min_eig_ws(P, members, s, work):
+    """:func:`_reduced_min_eig` on a caller's work array ``work`` (``EIG_WORK_ROWS``, 4):
+    no allocation (the per-call path of the small-team kernel)."""
     if s >= 5:
         return np.inf
     if s <= 2:
@@ -183,32 +152,53 @@ def _reduced_min_eig(P, members, s):
         # eigenvalue is exactly -1 (such rows never get here: a 2-cable taut set fails
         # the paper's test, larger ones are weight families).
         return -1.0
-    D = np.empty((4, 4))
+    if s == 3:
+        return _min_eig_three(P, members[0], members[1], members[2])
+    D = work[0:3]
     for a in range(1, s):
         for c in range(4):
             D[a - 1, c] = P[members[a], c] - P[members[0], c]
-    if s == 4:
-        num = 0.0
-        den = 0.0
-        for k in range(4):
-            c0, c1, c2 = _MINOR_COLS[k, 0], _MINOR_COLS[k, 1], _MINOR_COLS[k, 2]
-            m3 = (D[0, c0] * (D[1, c1] * D[2, c2] - D[1, c2] * D[2, c1])
-                  - D[0, c1] * (D[1, c0] * D[2, c2] - D[1, c2] * D[2, c0])
-                  + D[0, c2] * (D[1, c0] * D[2, c1] - D[1, c1] * D[2, c0]))
-            nk2 = m3 * m3
-            num += nk2 if k < 2 else -nk2
-            den += nk2
-        return num / den
-    Q = np.zeros((4, 4))
-    _orthonormal_complement(D, s - 1, Q)
-    nz = 5 - s
-    H = np.zeros((3, 3))
-    for i in range(nz):
-        for j in range(nz):
-            zi, zj = s - 1 + i, s - 1 + j
-            H[i, j] = (Q[zi, 0] * Q[zj, 0] + Q[zi, 1] * Q[zj, 1]
-                       - Q[zi, 2] * Q[zj, 2] - Q[zi, 3] * Q[zj, 3])
-    if nz == 2:
-        half = 0.5 * (H[0, 0] - H[1, 1])
-        return 0.5 * (H[0, 0] + H[1, 1]) - math.sqrt(half * half + H[0, 1] * H[0, 1])
-    return H[0, 0]                                 # not reached: nz is 1 or 2
+    num = 0.0
+    den = 0.0
+    for k in range(4):
+        c0, c1, c2 = _MINOR_COLS[k, 0], _MINOR_COLS[k, 1], _MINOR_COLS[k, 2]
+        m3 = (D[0, c0] * (D[1, c1] * D[2, c2] - D[1, c2] * D[2, c1])
+              - D[0, c1] * (D[1, c0] * D[2, c2] - D[1, c2] * D[2, c0])
+              + D[0, c2] * (D[1, c0] * D[2, c1] - D[1, c1] * D[2, c0]))
+        nk2 = m3 * m3
+        num += nk2 if k < 2 else -nk2
+        den += nk2
+    return num / den
+
+
+@jit
+def _min_eig_three(P, i, j, k):
+    """The 3-member case of :func:`_reduced_min_eig_ws`: the face's tangent space is the
+    orthogonal complement of the plane spanned by ``d1 = P_j - P_i`` and ``d2 = P_k - P_i``
+    (first 4 coordinates). J = diag(1, 1, -1, -1) is symmetric and orthogonal, so in an
+    orthonormal basis (plane, complement) its blocks A (plane) and C (complement) satisfy
+    A^2 + B B' = I, C^2 + B' B = I and trace A + trace C = trace J = 0 (CS decomposition):
+    with both blocks 2 x 2 the spectrum of C is minus that of A, and the smallest
+    eigenvalue on the tangent space is minus the largest of A, a symmetric 2 x 2 from one
+    Gram-Schmidt step on d1, d2 (re-orthogonalised once). No work array, no loop over
+    axes."""
+    a0 = P[j, 0] - P[i, 0]
+    a1 = P[j, 1] - P[i, 1]
+    a2 = P[j, 2] - P[i, 2]
+    a3 = P[j, 3] - P[i, 3]
+    n = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2 + a3 * a3)
+    a0, a1, a2, a3 = a0 / n, a1 / n, a2 / n, a3 / n
+    b0 = P[k, 0] - P[i, 0]
+    b1 = P[k, 1] - P[i, 1]
+    b2 = P[k, 2] - P[i, 2]
+    b3 = P[k, 3] - P[i, 3]
+    for _ in range(2):                             # "twice is enough"
+        d = a0 * b0 + a1 * b1 + a2 * b2 + a3 * b3
+        b0, b1, b2, b3 = b0 - d * a0, b1 - d * a1, b2 - d * a2, b3 - d * a3
+    n = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3)
+    b0, b1, b2, b3 = b0 / n, b1 / n, b2 / n, b3 / n
+    h00 = a0 * a0 + a1 * a1 - a2 * a2 - a3 * a3
+    h11 = b0 * b0 + b1 * b1 - b2 * b2 - b3 * b3
+    h01 = a0 * b0 + a1 * b1 - a2 * b2 - a3 * b3
+    half = 0.5 * (h00 - h11)
+    return -(0.5 * (h00 + h11) + math.sqrt(half * half + h01 * h01))

@@ -32,11 +32,12 @@ import math
 import numpy as np
 
 from ..._jit import HAVE_NUMBA, jit
-from .linalg import _in_hull, _lu_solve, _reduced_min_eig, _singular_extremes
+from .linalg import EIG_WORK_ROWS, _in_hull, _lu_solve, _reduced_min_eig_ws, _singular_extremes
 from .._tol import CURVATURE_TOL, INSIDE_WEIGHT, MAX_CONDITION, SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL
 
-__all__ = ["HAVE_NUMBA", "solve_formation", "solve_formations", "append_rows",
-           "lifted_points", "similar_fit", "feasible", "row_width"]
+__all__ = ["HAVE_NUMBA", "solve_formation", "solve_into", "solve_carved", "work_views",
+           "solve_formations", "append_rows",
+           "lifted_points", "similar_fit", "feasible", "row_width", "work_floats"]
 
 #: Row kind codes (the first three as ``_lifted.KIND_*``; ``PENDING``: weights to resolve).
 STABLE, SADDLE, NOT_EQUILIBRIUM, PENDING = 0, 1, 2, 3
@@ -49,6 +50,19 @@ COL_KIND, COL_TSIZE, COL_OBJECT, COL_CONTACT, COL_DEPTH, COL_TAUT = 0, 1, 2, 5, 
 def row_width(N: int) -> int:
     """Width of an output row for ``N`` robots."""
     return 12 + 3 * N
+
+
+#: Floats of :func:`solve_into`'s work array besides the per-robot and per-candidate
+#: parts: the bordered system (13 x 6) and the reduced Hessian's work (``EIG_WORK_ROWS``
+#: x 4).
+_FIXED_WORK = 13 * 6 + EIG_WORK_ROWS * 4
+
+
+@jit
+def work_floats(N, C):
+    """Length of :func:`solve_into`'s float work array for ``N`` robots and ``C``
+    candidates."""
+    return 2 * N + 5 * N + N * N + N + N + 11 * C + _FIXED_WORK
 
 
 @jit
@@ -140,16 +154,16 @@ def feasible(R, lim2):
 
 
 @jit
-def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key):
+def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key, lin):
     """Steps 2-3 for every candidate of ``table`` (C, 5): ``sol[c]`` = (w (5), x (4), mu,
     depth2), ``taut[c]`` the exact taut set and ``key[c]`` its sort key (taut-set size,
     then taut set, then the own-set preference, then table order), or -1 where the
-    candidate fails. Returns the number of survivors."""
+    candidate fails. Returns the number of survivors. ``lin`` (13, 6): work array."""
     N = Rn.shape[0]
     C = table.shape[0]
-    K = np.empty((6, 6))
-    work = np.empty((6, 6))
-    rhs = np.empty(6)
+    K = lin[0:6]
+    work = lin[6:12]
+    rhs = lin[12]
     found = 0
     for c in range(C):
         key[c] = -1
@@ -199,9 +213,10 @@ def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key):
 
 
 @jit
-def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang):
+def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang, eig):
     """Step 4 for candidate ``c`` whose exact taut set is ``taut_c``: -1 when the paper's
-    projection test fails, else the status (``PENDING`` for weight families)."""
+    projection test fails, else the status (``PENDING`` for weight families). ``ang``
+    (N,) and ``eig`` (``EIG_WORK_ROWS``, 4): work arrays."""
     N = Rn.shape[0]
     s = sizes[c]
     min_w = np.inf
@@ -217,7 +232,7 @@ def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang):
         return PENDING
     if min_w < -WEIGHT_TOL:
         return NOT_EQUILIBRIUM
-    if _reduced_min_eig(P, table[c], s) > CURVATURE_TOL:
+    if _reduced_min_eig_ws(P, table[c], s, eig) > CURVATURE_TOL:
         return STABLE
     return SADDLE
 
@@ -259,29 +274,91 @@ def solve_formation(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out):
     Returns ``(rows, stable_rows, pending_rows)``, or ``(INFEASIBLE, 0, 0)`` for a
     non-finite or torn formation (nothing solved)."""
     N = R.shape[0]
-    if not feasible(R, lim2):
-        return INFEASIBLE, 0, 0
     C = table.shape[0]
-    Rn = np.empty((N, 2))
-    P = np.empty((N, 5))
-    G = np.empty((N, N))
-    bvec = np.empty(N)
-    cx, cy = _frame(R, Vn, scale, Rn, P, G, bvec)
-    z = hold / scale
-    sol = np.empty((C, 11))
-    taut = np.zeros((C, N), dtype=np.bool_)
-    key = np.empty(C, dtype=np.int64)
-    found = _candidates(Rn, P, G, bvec, table, sizes, z * z, sol, taut, key)
-    if found == 0:
-        return 0, 0, 0
-    order = np.argsort(key)
-    return classify_survivors(order, C - found, C, key, C, Rn, P, table, sizes, sol, taut,
-                              np.empty(N), out, Vn, scale, cx, cy, vcx, vcy, hold)
+    return solve_into(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out,
+                      np.empty(work_floats(N, C)), np.empty(2 * C, dtype=np.int64),
+                      np.empty((C, N), dtype=np.bool_))
 
 
 @jit
-def classify_survivors(order, r0, r1, key, C, Rn, P, table, sizes, sol, taut, ang, out, Vn,
-                       scale, cx, cy, vcx, vcy, hold):
+def solve_into(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out, fw, iw, taut):
+    """:func:`solve_formation` on the caller's work arrays: ``fw`` float64
+    (``work_floats(N, C)``,), ``iw`` int64 (2 C,), ``taut`` bool (C, N); nothing is
+    allocated (the per-call path). ``taut`` needs no reset: only rows of surviving
+    candidates are read, and ``_candidates`` writes those in full."""
+    N = R.shape[0]
+    Rn, P, G, bvec, ang, sol, lin, eig, key, order = work_views(fw, iw, N, table.shape[0])
+    return solve_carved(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out, Rn, P, G, bvec,
+                        ang, sol, lin, eig, key, order, taut)
+
+
+@jit
+def work_views(fw, iw, N, C):
+    """The work arrays of :func:`solve_carved` as views of ``fw`` (``work_floats(N, C)``,)
+    and ``iw`` (2 C,): Rn (N, 2), P (N, 5), G (N, N), bvec (N,), ang (N,), sol (C, 11),
+    lin (13, 6), eig (``EIG_WORK_ROWS``, 4), key (C,), order (C,). Made once per batch:
+    each view costs reference counting."""
+    Rn = fw[0:2 * N].reshape(N, 2)
+    o = 2 * N
+    P = fw[o:o + 5 * N].reshape(N, 5)
+    o += 5 * N
+    G = fw[o:o + N * N].reshape(N, N)
+    o += N * N
+    bvec = fw[o:o + N]
+    ang = fw[o + N:o + 2 * N]
+    o += 2 * N
+    sol = fw[o:o + 11 * C].reshape(C, 11)
+    o += 11 * C
+    lin = fw[o:o + 78].reshape(13, 6)
+    eig = fw[o + 78:o + 78 + 4 * EIG_WORK_ROWS].reshape(EIG_WORK_ROWS, 4)
+    return Rn, P, G, bvec, ang, sol, lin, eig, iw[0:C], iw[C:2 * C]
+
+
+@jit
+def solve_carved(R, Vn, table, sizes, scale, vcx, vcy, hold, lim2, out, Rn, P, G, bvec, ang,
+                 sol, lin, eig, key, order, taut):
+    """:func:`solve_formation` on the work arrays of :func:`work_views` and ``taut``."""
+    if not feasible(R, lim2):
+        return INFEASIBLE, 0, 0
+    C = table.shape[0]
+    cx, cy = _frame(R, Vn, scale, Rn, P, G, bvec)
+    z = hold / scale
+    found = _candidates(Rn, P, G, bvec, table, sizes, z * z, sol, taut, key, lin)
+    if found == 0:
+        return 0, 0, 0
+    m = sorted_survivors(key, C, found, order)
+    return classify_survivors(order, 0, m, key, C, Rn, P, table, sizes, sol, taut, ang, eig,
+                              out, Vn, scale, cx, cy, vcx, vcy, hold)
+
+
+#: Up to this many survivors :func:`sorted_survivors` sorts by insertion (no allocation).
+_INSERTION_MAX = 32
+
+
+@jit
+def sorted_survivors(key, C, found, order):
+    """Indices of the ``found`` candidates with ``key >= 0`` into ``order``, by increasing
+    key (the keys are distinct: they end in the table position); returns ``found``."""
+    if found > _INSERTION_MAX:
+        order[:found] = np.argsort(key)[C - found:]
+        return found
+    m = 0
+    for c in range(C):
+        k = key[c]
+        if k < 0:
+            continue
+        i = m - 1
+        while i >= 0 and key[order[i]] > k:
+            order[i + 1] = order[i]
+            i -= 1
+        order[i + 1] = c
+        m += 1
+    return m
+
+
+@jit
+def classify_survivors(order, r0, r1, key, C, Rn, P, table, sizes, sol, taut, ang, eig, out,
+                       Vn, scale, cx, cy, vcx, vcy, hold):
     """Classify the surviving candidates ``order[r0:r1]`` (sorted by ``key``; one per
     distinct stationary point, ``key // (2 C)``) and write their rows into ``out``.
     Returns ``(rows, stable_rows, pending_rows)``."""
@@ -300,7 +377,7 @@ def classify_survivors(order, r0, r1, key, C, Rn, P, table, sizes, sol, taut, an
         for j in range(N):
             if taut[c, j]:
                 tsize += 1
-        status = _classify_row(Rn, P, table, sizes, c, sol, taut[c], tsize, ang)
+        status = _classify_row(Rn, P, table, sizes, c, sol, taut[c], tsize, ang, eig)
         if status < 0:
             continue
         _write_row(out, k, status, c, sol, taut[c], tsize, table, sizes, Vn, scale, cx, cy,

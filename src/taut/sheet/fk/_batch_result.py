@@ -8,7 +8,6 @@ from ..._units import GRAVITY
 from ...errors import InfeasibleFormationError
 from .._lifted import KIND_NAMES, KIND_NOT_EQUILIBRIUM, KIND_STABLE
 from .._tol import MERGE_RTOL
-from ._lowest import near_copy
 from ..model import Sheet, check_formation
 from .results import (BatchFKResult, Equilibrium, _equilibrium, _merge_equilibria,
                       _with_lowest)
@@ -119,9 +118,7 @@ def _lowest_batch(sheet: Sheet, formations: np.ndarray, hold_height: float,
     the (possibly widened) arrays."""
     found = {}
     for b in missing:
-        if not near_copy(sheet.vertices, formations[b], sheet.size):
-            continue                             # no direct minimisation out here
-        eqs, supplied = _with_lowest(_row_states(sheet, taut, obj, contact, weights, kind,
+        eqs, supplied, _ = _with_lowest(_row_states(sheet, taut, obj, contact, weights, kind,
                                                  int(b), int(count[b])),
                                      sheet, formations[b], hold_height, mass)
         if supplied:

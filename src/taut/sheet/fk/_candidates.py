@@ -17,10 +17,12 @@ paper's Algorithm 1 without visiting its :math:`\\sum_k \\binom{N}{k}` subsets.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.linalg import qr
-from scipy.spatial import ConvexHull, QhullError
+
+if TYPE_CHECKING:
+    from scipy.spatial import ConvexHull
 
 from .._tol import (CLOSED_FORM_RTOL, EXACT_FLAT, FALLBACK_SIN, GRAM_SCHMIDT_RTOL2, NEAR_FLAT,
     RANK_TOL, TINY, UP_IN_HULL_TOL, UPPER_NORMAL_TOL)
@@ -353,6 +355,7 @@ def hull_candidates(P: np.ndarray, pairs: bool, *, shortcut: bool = True,
         if N <= NEAR_FLAT_SUBSETS:
             return _every_subset(N, pairs)
         flat = _hull_faces(P, Pc, vt, d, pairs, shortcut=False)
+        from scipy.spatial import ConvexHull, QhullError
         try:
             joggled = ConvexHull(Pc, qhull_options="QJ").simplices
         except QhullError:                             # pragma: no cover - last resort
@@ -369,6 +372,10 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
     """Candidates from the upper faces of the hull of the lifted points ``P`` (N, 5) in
     their ``d``-dimensional affine hull (``Pc`` centred, ``vt`` its right singular vectors);
     ``shortcut``: stationary points straight from the facet normals where it applies."""
+    # Qhull (scipy.spatial, ~0.2 s to import) only where a hull is built: small teams on
+    # the compiled path never need it.
+    from scipy.spatial import ConvexHull, QhullError
+
     N = len(P)
     basis = vt[:d].T                                   # (5, d)
     Y = Pc @ basis
@@ -395,6 +402,8 @@ def _hull_faces(P: np.ndarray, Pc: np.ndarray, vt: np.ndarray, d: int, pairs: bo
         # The whole point set is a face (exposed by a direction orthogonal to its hull):
         # add one affinely independent spanning subset of it.
         i0 = int(np.argmax(np.einsum("ij,ij->i", Pc, Pc)))
+        from scipy.linalg import qr
+
         _, _, piv = qr((P - P[i0]).T, pivoting=True, mode="economic")
         whole = np.sort(np.concatenate([[i0], piv[:d]]).astype(np.intp))
         _add_rows(out, len(whole), whole[None, :].astype(np.intp), N)

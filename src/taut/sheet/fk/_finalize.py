@@ -6,7 +6,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog, minimize
 
 from .._lifted import (KIND_NOT_EQUILIBRIUM, KIND_SADDLE, KIND_STABLE, Frame, Solved,
     in_hull_2d, reduced_hessian_min_eig)
@@ -67,6 +66,10 @@ def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: n
     achievable minimum weight ``t*`` (an LP solved with HiGHS): ``t* >= 0`` iff some
     non-negative weights balance the object (docs/sheet_kinematics.md §3).
     """
+    from scipy.optimize import linprog               # rare: imported here, not with FK
+
+    from ..._qp import solve_qp
+
     k = len(idx)
     E = np.vstack([frame.R[f, idx].T, frame.V[idx].T, np.ones(k)])
     rhs = np.concatenate([ro, vo, [1.0]])
@@ -87,11 +90,10 @@ def _weights_family(frame: Frame, f: int, idx: np.ndarray, ro: np.ndarray, vo: n
     t_star = float(lp.x[-1])
     if t_star < -WEIGHT_TOL or w_min_norm.min() >= -WEIGHT_TOL:
         return w_min_norm, t_star
-    res = minimize(lambda w: 0.5 * w @ w, np.maximum(lp.x[:k], 0.0), jac=lambda w: w,
-                   method="SLSQP", bounds=[(0.0, None)] * k,
-                   constraints=[{"type": "eq", "fun": lambda w: E @ w - rhs, "jac": lambda w: E}],
-                   options={"ftol": FAMILY_FTOL, "maxiter": 200})
-    w = res.x if res.success and np.abs(E @ res.x - rhs).max() < FAMILY_RESIDUAL else lp.x[:k]
+    # min |w|^2 / 2 s.t. E w = rhs, w >= 0: DAQP (taut._qp), or SLSQP from the LP's point.
+    x = solve_qp(np.eye(k), A_eq=E, b_eq=rhs, lb=np.zeros(k), x0=np.maximum(lp.x[:k], 0.0),
+                 ftol=FAMILY_FTOL)
+    w = x if x is not None and np.abs(E @ x - rhs).max() < FAMILY_RESIDUAL else lp.x[:k]
     return w, t_star
 
 

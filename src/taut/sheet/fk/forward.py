@@ -25,12 +25,20 @@ Methods (one interface, chosen by ``method``):
 ``"subsets"``
     Every set of at most 5 cables as a candidate (complete, O(N^5)); a cross-check of
     ``"fast"`` that needs no convex hull.
+
+One formation at a time, a process answers with the numpy engine until its FK calls have
+taken as long as loading the compiled kernels would (:func:`taut._jit.prefer_compiled`:
+a one-shot ``taut fk`` never loads numba), then with the compiled solver; both give the
+same equilibria.
 """
 
 from __future__ import annotations
 
+import time
+
 from numpy.typing import ArrayLike
 
+from ..._jit import charge_numpy, prefer_compiled
 from ..._validate import as_choice
 from ...errors import InvalidInputError
 from ._numpy import forward_numpy
@@ -64,9 +72,9 @@ def forward_kinematics(team: SheetTeam, formation: ArrayLike, *, method: Method 
         every method solves the copy (docs/sheet_fk_solver.md). Every method
         reports one physical state once: states whose object and contact points
         coincide within ``MERGE_RTOL`` (1e-5 of the sheet size) are merged into one on
-        the union of their taut cables; and where, next to a copy (within
-        ``DIRECT_RTOL``, 1e-3 of the sheet size), no stable state was enumerated, a
-        direct minimisation of the height supplies the lowest one (``.direct``).
+        the union of their taut cables; and where no stable state was enumerated, a
+        direct minimisation of the height supplies the lowest rest state (``.direct``)
+        or says why there is none (the floor, or the object slides off the sheet).
 
     Returns
     -------
@@ -115,7 +123,13 @@ def forward_kinematics(team: SheetTeam, formation: ArrayLike, *, method: Method 
     method = as_choice(method, METHODS, "method")  # type: ignore[assignment]
     if method == "exhaustive":
         return forward_numpy(team.sheet, formation, team.hold_height, team.mass, method)
-    return cached_solver(team, method).solve(formation)
+    if prefer_compiled():
+        return cached_solver(team, method).solve(formation)
+    t0 = time.perf_counter()
+    try:
+        return cached_solver(team, method, "numpy").solve(formation)
+    finally:
+        charge_numpy(time.perf_counter() - t0)
 
 
 def forward_kinematics_batch(team: SheetTeam, formations: ArrayLike, *,

@@ -10,7 +10,7 @@ is reported once (:mod:`taut.sheet.fk._merge`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Callable, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -21,7 +21,7 @@ from ...errors import InvalidInputError
 from .._lifted import KIND_NAMES, KIND_NOT_EQUILIBRIUM, KIND_STABLE
 from .._tol import MERGE_RTOL
 from ..model import Sheet, check_formation
-from ._lowest import lowest_by_descent, near_copy
+from ._lowest import OFF_SHEET, lowest_by_descent, may_find_stable
 from ._merge import coincident_groups, merged_weights
 from ._solve import explain_no_equilibrium
 
@@ -161,16 +161,18 @@ def _merge_equilibria(eqs: tuple[Equilibrium, ...], sheet: Sheet, formation: np.
 
 
 def _with_lowest(eqs: tuple[Equilibrium, ...], sheet: Sheet, formation: np.ndarray,
-                 hold_height: float, mass: float | None) -> tuple[tuple[Equilibrium, ...], bool]:
+                 hold_height: float, mass: float | None
+                 ) -> tuple[tuple[Equilibrium, ...], bool, str | None]:
     """``eqs`` and, when none of them is stable, the lowest rest state found by direct
     minimisation (:mod:`taut.sheet.fk._lowest`) in place of a state at the same point;
-    the flag says whether the minimisation supplied it."""
+    whether the minimisation supplied it, and if it found none, why (``_lowest.FLOOR``,
+    ``OFF_SHEET`` or ``NO_REST``)."""
     if any(e.kind == "stable" for e in eqs):
-        return eqs, False
+        return eqs, False, None
     found = lowest_by_descent(sheet.vertices, formation, hold_height, sheet.size,
                               [(e.object, e.contact) for e in eqs])
-    if found is None:
-        return eqs, False
+    if isinstance(found, str):
+        return eqs, False, found
     idx, obj, contact, w, strict = found
     lengths = np.linalg.norm(sheet.vertices[idx] - contact, axis=1)
     tensions = (None if mass is None
@@ -181,7 +183,7 @@ def _with_lowest(eqs: tuple[Equilibrium, ...], sheet: Sheet, formation: np.ndarr
     keep = [e for e in eqs if max(np.abs(e.object - obj).max(),
                                   np.abs(e.contact - contact).max()) > tol]
     out = sorted(keep + [new], key=lambda e: (len(e.taut), e.taut))
-    return tuple(out), True
+    return tuple(out), True, None
 
 
 class FKResult:
@@ -216,8 +218,10 @@ class FKResult:
 
     _equilibria: tuple[Equilibrium, ...] | None
     _rows: np.ndarray | None
+    _enum: tuple[Equilibrium, ...]
     _message: str | None
     _direct: bool
+    _why: str | None
     funnel: Funnel | None
     method: str
     sheet: Sheet
@@ -229,10 +233,10 @@ class FKResult:
                  method: str, sheet: Sheet, formation: np.ndarray, hold_height: float,
                  mass: float | None) -> None:
         eqs = _merge_equilibria(tuple(equilibria), sheet, formation, hold_height, mass)
-        eqs, direct = _with_lowest(eqs, sheet, formation, hold_height, mass)
-        self.__dict__.update(_equilibria=eqs, _rows=None, _message=None, _direct=direct,
-                             funnel=funnel, method=method, sheet=sheet, formation=formation,
-                             hold_height=hold_height, mass=mass)
+        self.__dict__.update(_equilibria=None, _rows=None, _enum=eqs, _message=None,
+                             _direct=False, _why=None, funnel=funnel, method=method,
+                             sheet=sheet, formation=formation, hold_height=hold_height,
+                             mass=mass)
 
     @classmethod
     def _from_rows(cls, rows: np.ndarray, method: str, sheet: Sheet, formation: np.ndarray,
@@ -241,11 +245,31 @@ class FKResult:
         ``_kernels.small``: kind, taut-set size, object, contact, depth, taut mask,
         weights, lengths, ...)."""
         self = object.__new__(cls)
-        self.__dict__.update(_equilibria=None, _rows=rows, _message=None, _direct=False,
-                             funnel=None,
+        self.__dict__.update(_equilibria=None, _rows=rows, _enum=(), _message=None,
+                             _direct=False, _why=None, funnel=None,
                              method=method, sheet=sheet, formation=formation,
                              hold_height=hold_height, mass=mass)
         return self
+
+    @classmethod
+    def _rows_maker(cls, method: str, sheet: Sheet, hold_height: float, mass: float | None
+                    ) -> Callable[[np.ndarray, np.ndarray], "FKResult"]:
+        """``make(rows, formation)``, the same as ``_from_rows(rows, method, sheet,
+        formation, hold_height, mass)`` for one solver: the fields fixed per solver are set
+        once and ``make`` copies one dict (the per-call path of ``FKSolver.solve``; a
+        keyword update costs ~0.3 us more)."""
+        template = cls._from_rows(np.zeros((0, 0)), method, sheet, np.zeros((0, 2)),
+                                  hold_height, mass).__dict__
+        new, set_dict = object.__new__, object.__setattr__
+
+        def make(rows: np.ndarray, formation: np.ndarray) -> "FKResult":
+            fields = template.copy()
+            fields["_rows"] = rows
+            fields["formation"] = formation
+            self = new(cls)
+            set_dict(self, "__dict__", fields)
+            return self
+        return make
 
     def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError(f"FKResult is frozen: cannot assign to {name!r}")
@@ -257,16 +281,23 @@ class FKResult:
     def equilibria(self) -> tuple[Equilibrium, ...]:
         eqs = self._equilibria
         if eqs is None:
+            # Built once, on first access; the rows stay (a thread that read
+            # ``_equilibria`` as None before another set it builds the same tuple again).
             eqs = self._build(self._rows)
-            self.__dict__.update(_equilibria=eqs, _rows=None)
+            self.__dict__["_equilibria"] = eqs
         return eqs
 
     def _build(self, rows: np.ndarray | None) -> tuple[Equilibrium, ...]:
-        if rows is None or len(rows) == 0:
-            eqs, direct = _with_lowest((), self.sheet, self.formation, self.hold_height,
-                                       self.mass)
-            self.__dict__["_direct"] = direct
-            return eqs
+        """The states: the enumeration's (from the kernel ``rows`` when given) and, when
+        none is stable, the direct minimisation's lowest (:func:`_with_lowest`)."""
+        eqs = self._enum if rows is None or len(rows) == 0 else self._row_states(rows)
+        eqs, direct, why = _with_lowest(eqs, self.sheet, self.formation, self.hold_height,
+                                        self.mass)
+        self.__dict__.update(_direct=direct, _why=why)
+        return eqs
+
+    def _row_states(self, rows: np.ndarray) -> tuple[Equilibrium, ...]:
+        """The enumeration's states from kernel rows, states at one point merged."""
         N = self.sheet.n
         scale = self.sheet.size
         force = None if self.mass is None else self.mass * GRAVITY
@@ -282,28 +313,37 @@ class FKResult:
             out.append(_equilibrium(tuple(idx.tolist()), row[2:5].copy(), row[5:7].copy(),
                                     w, tensions, lengths, KIND_NAMES[kind]))
         eqs = tuple(out)
-        kinds = rows[:, 0].tolist()
-        if len(kinds) > 1:                       # the merge's height screen, on the rows
+        if len(rows) > 1:                        # the merge's height screen, on the rows
             z = sorted(rows[:, 4].tolist())
             tol = MERGE_RTOL * scale
             if not all(b - a > tol for a, b in zip(z, z[1:])):
                 eqs = _merge_equilibria(eqs, self.sheet, self.formation, self.hold_height,
                                         self.mass)
-        if KIND_STABLE not in kinds:
-            eqs, direct = _with_lowest(eqs, self.sheet, self.formation, self.hold_height,
-                                       self.mass)
-            self.__dict__["_direct"] = direct
         return eqs
+
+    def _no_stable_state(self) -> bool:
+        """True when, before the states are built, no stable state can exist: the
+        enumeration found none and the direct minimisation cannot supply one here
+        (``_lowest.may_find_stable``; away from a similar copy it is not run for this)."""
+        if self._equilibria is not None:
+            return False
+        rows = self._rows
+        if rows is not None and len(rows):
+            if np.any(rows[:, 0] == KIND_STABLE):
+                return False
+        elif any(e.stable for e in self._enum):
+            return False
+        return not may_find_stable(self.sheet.vertices, self.formation, self.sheet.size)
 
     @property
     def success(self) -> bool:
         """At least one stable state (the formation holds the object)."""
         rows = self._rows
-        if self._equilibria is None and rows is not None:
+        if self._equilibria is None and rows is not None and len(rows):
             if np.any(rows[:, 0] == KIND_STABLE):
                 return True
-            if not near_copy(self.sheet.vertices, self.formation, self.sheet.size):
-                return False                     # no direct minimisation out here
+        if self._no_stable_state():
+            return False
         return any(e.stable for e in self.equilibria)
 
     @property
@@ -320,9 +360,6 @@ class FKResult:
         else ``"infeasible"`` (no rest state above the floor)."""
         if self.success:
             return "ok"
-        if (self._equilibria is None and self._rows is not None
-                and not near_copy(self.sheet.vertices, self.formation, self.sheet.size)):
-            return "infeasible"                  # no direct minimisation out here
         return "not_strict" if self.lowest is not None else "infeasible"
 
     @property
@@ -337,9 +374,12 @@ class FKResult:
 
     def _describe(self) -> str:
         eqs = self.equilibria
+        off = ("; the object slides off the sheet (descending its height carries the "
+               "contact point over the sheet's edge: no rest state)"
+               if self._why == OFF_SHEET else "")
         if not eqs:
             return "no equilibrium: " + explain_no_equilibrium(
-                self.sheet, self.formation, self.hold_height)
+                self.sheet, self.formation, self.hold_height) + off
         stable = sum(e.stable for e in eqs)
         how = (" (the lowest found by direct minimisation of the height: the enumeration "
                "missed it)" if self._direct else "")
@@ -350,11 +390,14 @@ class FKResult:
                     f"{how}")
         saddle = sum(e.kind == "saddle" for e in eqs)
         return (f"no stable state: {len(eqs)} solution(s), {saddle} saddle, "
-                f"{len(eqs) - saddle} not an equilibrium")
+                f"{len(eqs) - saddle} not an equilibrium{off}")
 
     @property
     def stable(self) -> tuple[Equilibrium, ...]:
-        """The stable equilibria."""
+        """The stable equilibria (without building the other states where the enumeration
+        found no stable one away from a similar copy of the sheet: there are none)."""
+        if self._no_stable_state():
+            return ()
         return tuple(e for e in self.equilibria if e.stable)
 
     @property
@@ -363,10 +406,11 @@ class FKResult:
         without one, the non-strict minimum found by direct minimisation (kind
         ``"saddle"``, :attr:`status` ``"not_strict"``). None only when the object would
         rest on the ground (no state with :math:`z_o > 0`)."""
-        st = self.stable
+        eqs = self.equilibria                    # sets _direct
+        st = [e for e in eqs if e.stable]
         if st:
             return min(st, key=lambda e: e.height)
-        if self._direct:                         # set when the states were built
+        if self._direct:
             return min((e for e in self.equilibria if e.kind == "saddle"),
                        key=lambda e: e.height, default=None)
         return None

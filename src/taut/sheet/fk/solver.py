@@ -13,14 +13,13 @@ against each other; docs/sheet_fk_solver.md). An engine: it never imports the fr
 
 from __future__ import annotations
 
-import importlib.util
-import os
 import weakref
 from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._jit import HAVE_NUMBA, not_compiled_reason
 from ..._validate import as_array, as_choice, require_nonempty
 from ...errors import InvalidInputError
 from ._candidates import hull_candidates, padded_small_subsets
@@ -37,11 +36,9 @@ from ..team import SheetTeam, require_team
 
 __all__ = ["FKSolver", "COMPILED_MAX_N", "HAVE_NUMBA"]
 
-#: numba importable (and not disabled by the environment variable TAUT_DISABLE_NUMBA).
-#: The kernel module (and numba) is imported on the first solver that uses it, so that
-#: ``import taut`` stays fast.
-HAVE_NUMBA = (importlib.util.find_spec("numba") is not None
-              and not os.environ.get("TAUT_DISABLE_NUMBA"))
+# HAVE_NUMBA (taut._jit): this process runs the compiled kernels. The kernel module (and
+# numba) is imported on the first solver that uses it, so that ``import taut`` stays fast.
+
 sk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._kernels.small, once loaded
 bk: ModuleType = None  # type: ignore[assignment]   # taut.sheet._kernels.batch, once loaded
 
@@ -116,7 +113,7 @@ class FKSolver:
 
     __slots__ = ("team", "sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
                  "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
-                 "_fpack", "_ipack", "_out_shape",
+                 "_fast", "_shape", "_mass", "_pack", "_out_shape", "_make",
                  "__weakref__")
 
     def __init__(self, team: SheetTeam, *, method: Method = "fast",
@@ -130,7 +127,7 @@ class FKSolver:
         fits = method != "exhaustive" and N <= KERNEL_MAX_N
         if backend == "numba":
             if not HAVE_NUMBA:
-                raise InvalidInputError("backend", "numba is not installed (pip install numba)")
+                raise InvalidInputError("backend", not_compiled_reason())
             if not fits:
                 raise InvalidInputError("backend", f"the compiled kernel takes methods 'fast' "
                                                    f"and 'subsets' with N <= {KERNEL_MAX_N}")
@@ -154,12 +151,19 @@ class FKSolver:
         self._width = 12 + 3 * N                   # _small_kernel.row_width(N)
         self._args = (self._Vn, self._table, self._sizes, self._scale, self._vcx, self._vcy,
                       self.hold_height, self._lim2)
-        self._out_shape = (len(table), self._width)
+        # The per-call path (solve): one compiled call on one packed array.
+        self._fast = self.backend == "numba" and not self._hull
+        self._shape = (N, 2)
+        self._mass = team.mass
+        self._make = FKResult._rows_maker(self.method, sheet, self.hold_height, team.mass)
+        self._pack = np.zeros(0)
+        self._out_shape = (0, self._width)
         if self.backend == "numba":
             _load_kernel()
-            self._fpack, self._ipack = _batch_kernel().pack(
+            self._pack = _batch_kernel().pack(
                 self._Vn, self._A, self._lim2, self._table, self._sizes, self._scale,
                 self._vcx, self._vcy, self.hold_height, _snap_screen(self._scale))
+            self._out_shape = (bk.out_rows(N, len(table)), self._width)
 
     def __repr__(self) -> str:
         return (f"FKSolver(N={self.sheet.n}, hold_height={self.hold_height:g}, "
@@ -177,34 +181,58 @@ class FKSolver:
         check : bool
             Validate ``formation`` (shape, finite, no pair farther apart than
             its sheet vertices). ``False`` skips the Python-side checks for trusted loops
-            (pass a C-contiguous float64 (N, 2) array); a torn or non-finite formation
-            still raises.
+            (a float64 (N, 2) array is checked in nanoseconds either way); a torn or
+            non-finite formation still raises.
 
         Raises
         ------
         InvalidInputError, InfeasibleFormationError
             As :func:`~taut.sheet.forward_kinematics`.
         """
-        mass = self.team.mass
-        if self.backend != "numba":
-            return forward_numpy(self.sheet, formation, self.hold_height, mass, self.method)
-        if check:
-            R = _formation_array(formation, self.sheet)
-        else:
-            R = np.array(formation, dtype=np.float64, order="C")
-        if self._hull:
-            rows = self._rows(R)
-        else:                                       # the hot path, one compiled call
-            out = np.empty(self._out_shape)
-            k, stable, pending, near = bk.solve_packed(R, self._fpack, self._ipack, out)
-            if not near and ((stable and not pending) or k == 0):
-                rows = out[:k]
+        if self._fast:                              # the hot path: one compiled call
+            if (type(formation) is np.ndarray and formation.dtype is _FLOAT64
+                    and formation.shape == self._shape):
+                R = formation.copy()                # C-contiguous; the result keeps it
             else:
-                rows = None if k < 0 else self._finish(R, out[:k], stable, pending, near=near)
+                R = self._formation(formation, check)
+            out = np.empty(self._out_shape)
+            code = bk.solve_one(R, self._pack, out)
+            if code >= 0:                           # the rows are the answer
+                return self._make(out[:code], R)
+            return self._flagged(R, out, code)
+        if self.backend != "numba":
+            return forward_numpy(self.sheet, formation, self.hold_height, self._mass,
+                                 self.method)
+        R = self._formation(formation, check)
+        return self._result(R, self._rows(R))
+
+    def _formation(self, formation: ArrayLike, check: bool) -> np.ndarray:
+        """``formation`` as a fresh C-contiguous float64 (N, 2) array (validated when
+        ``check``; the kernel checks finiteness and the pair limits)."""
+        if check:
+            return _formation_array(formation, self.sheet)
+        R = np.array(formation, dtype=np.float64, order="C")
+        if R.shape != self._shape:
+            check_formation(self.sheet, R)          # raises the shape error
+        return R
+
+    def _flagged(self, R: np.ndarray, out: np.ndarray, code: int) -> FKResult:
+        """The result of a :func:`~taut.sheet._kernels.batch.solve_one` call whose rows need
+        more than the kernel did (an infeasible formation, weight families, a formation
+        next to a similar copy of the sheet)."""
+        k, flags = bk.decode(code)
+        rows = None if k < 0 else self._finish(R, out[:k], flags & bk.HAS_PENDING,
+                                               near=bool(flags & bk.NEAR_COPY))
+        return self._result(R, rows)
+
+    def _result(self, R: np.ndarray, rows: np.ndarray | None) -> FKResult:
+        """The result for ``R`` from its kernel rows; None (the kernel found ``R``
+        infeasible) raises the model's error or, where the model's check accepts ``R``
+        (borderline), lets the numpy engine decide."""
         if rows is None:
             check_formation(self.sheet, R)          # raises with the usual message
-            return forward_numpy(self.sheet, R, self.hold_height, mass, self.method)
-        return FKResult._from_rows(rows, self.method, self.sheet, R, self.hold_height, mass)
+            return forward_numpy(self.sheet, R, self.hold_height, self._mass, self.method)
+        return self._make(rows, R)
 
     def _rows(self, R: np.ndarray) -> np.ndarray | None:
         """Kernel rows of formation ``R`` (snapped and with weight families resolved);
@@ -212,9 +240,9 @@ class FKSolver:
         found = self._kernel(R)
         if found is None:
             return None
-        return self._finish(R, *found, 0)
+        return self._finish(R, found[0], 0)
 
-    def _finish(self, R: np.ndarray, rows: np.ndarray, stable: int, pending: int, *,
+    def _finish(self, R: np.ndarray, rows: np.ndarray, pending: int, *,
                 near: bool | None = None) -> np.ndarray:
         """Rows of ``R`` after the kernel: weight families resolved (``pending`` rows),
         snapped to a similar copy of the sheet next to one, whether or not a state is stable
@@ -401,6 +429,9 @@ class FKSolver:
         return rows[order], form[order]
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _snap_screen(size: float) -> tuple[float, float, float]:
     """Bounds of the snap screen on ``similar_fit``'s distance (low, high) and scale
     (high): ``SNAP_MIN``/``SNAP_TOL`` of the sheet size widened by ``SCREEN_SLACK``."""
@@ -425,22 +456,22 @@ def _formation_array(formation: ArrayLike, sheet: Sheet) -> np.ndarray:
 
 # -- cached solvers for the functional front end ------------------------------------------
 
-_SOLVERS: ("weakref.WeakKeyDictionary[Sheet, dict[tuple[float, float | None, str], "
+_SOLVERS: ("weakref.WeakKeyDictionary[Sheet, dict[tuple[float, float | None, str, str], "
             "FKSolver]]") = weakref.WeakKeyDictionary()
-#: Solvers kept per sheet (distinct hold heights, masses and methods) by ``cached_solver``.
+#: Solvers kept per sheet (distinct hold heights, masses, methods, backends) by ``cached_solver``.
 _PER_SHEET = 16
 
 
-def cached_solver(team: SheetTeam, method: Method) -> FKSolver:
-    """The :class:`FKSolver` for ``team`` (a validated :class:`SheetTeam`) and ``method``,
-    built once per sheet, hold height, mass and method, and reused."""
+def cached_solver(team: SheetTeam, method: Method, backend: Backend = "auto") -> FKSolver:
+    """The :class:`FKSolver` for ``team`` (a validated :class:`SheetTeam`), ``method`` and
+    ``backend``, built once per sheet, hold height, mass, method and backend, and reused."""
     per = _SOLVERS.get(team.sheet)
     if per is None:
         per = _SOLVERS[team.sheet] = {}
-    key = (team.hold_height, team.mass, method)
+    key = (team.hold_height, team.mass, method, backend)
     solver = per.get(key)
     if solver is None:
         if len(per) >= _PER_SHEET:
             per.clear()
-        solver = per[key] = FKSolver(team, method=method)
+        solver = per[key] = FKSolver(team, method=method, backend=backend)
     return solver

@@ -12,7 +12,6 @@ from __future__ import annotations
 from typing import Callable, TypeVar
 
 import numpy as np
-from scipy.optimize import nnls
 
 from .._tol import (ARMIJO_C1, ARRIVAL_ACTIVE_TOL, DESCENT_EPS0, DESCENT_GRAD2_TOL,
     DESCENT_MIN_EPS, DESCENT_MIN_STEP)
@@ -27,6 +26,8 @@ def min_norm_combination(G: np.ndarray) -> np.ndarray:
     """Point of minimum norm in the convex hull of the rows of ``G`` (k, 4)."""
     if len(G) == 1:
         return G[0]
+    from scipy.optimize import nnls     # not at import: FK imports this module, rarely calls it
+
     M = 1e3 * max(1.0, float(np.abs(G).max()))
     A = np.vstack([G.T, M * np.ones(len(G))])
     b = np.zeros(A.shape[0])

@@ -52,7 +52,7 @@ from ..._validate import as_array, as_choice
 from ...errors import InvalidInputError, InvalidTrajectoryError
 from ._branch import (State, Tracker, fk_result, fk_stable_batch, from_equilibrium, make_event,
     members, nearest, resolve_step)
-from ..._jit import HAVE_NUMBA
+from ..._jit import HAVE_NUMBA, not_compiled_reason
 from .results import EventKind, SimulationEvent, SimulationResult, SimulatorState
 from .._options import BACKENDS, Backend
 from ..model import Sheet, check_formations
@@ -67,7 +67,7 @@ def _compiled(backend: object) -> bool:
     ``backend``: ``"numba"`` without numba installed is an error)."""
     backend = as_choice(backend, BACKENDS, "backend")
     if backend == "numba" and not HAVE_NUMBA:
-        raise InvalidInputError("backend", "numba is not installed (pip install numba)")
+        raise InvalidInputError("backend", not_compiled_reason())
     return backend != "numpy" and HAVE_NUMBA
 
 
