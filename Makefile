@@ -1,5 +1,6 @@
 # Quick start: `make demo` runs the main demo, `make test` runs the whole test suite.
-# Both create their own virtual environment in .venv on first use (needs only python3).
+# Both create their own virtual environment in .venv on first use (needs only python3) and
+# compile the numba kernels into their cache once (`taut compile`, docs/compiled_kernels.md).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -11,12 +12,16 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/taut compile
 	touch $(STAMP)
 
 demo: $(STAMP)
 	$(BIN)/taut fk examples/sheet/example2_r2_r4_353mm.yaml --mass 1.0 --plot out/example2.png
 
+# `taut compile` returns at once when the kernels are cached; after a kernel edit it
+# compiles them once here, not in the middle of the tests.
 test: $(STAMP)
+	$(BIN)/taut compile
 	$(BIN)/python -m mypy
 	$(BIN)/python -m pytest -m "not slow"
 	$(BIN)/python -m pytest --doctest-modules src/taut -p no:cacheprovider
@@ -32,7 +37,7 @@ bench: $(STAMP)
 # numba's cache notices edits to a kernel's own file only, not to kernels it calls from
 # other files (src/taut/_jit.py): after editing a kernel, drop the cached code.
 clean-cache:
-	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
+	find src -name '*.nbi' -delete -o -name '*.nbc' -delete -o -name 'taut-jit-*.stamp*' -delete
 
 clean: clean-cache
 	rm -rf $(VENV) out .pytest_cache .hypothesis

@@ -2,6 +2,11 @@ import json
 import os
 from pathlib import Path
 
+# The suite runs the compiled kernels, compiling what numba's cache lacks (`make test`
+# warms the cache first), and compares them with the numpy engines; the default "auto"
+# would pick numpy on a cold cache and skip those comparisons (src/taut/_jit.py).
+os.environ.setdefault("TAUT_NUMBA", "always")
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings

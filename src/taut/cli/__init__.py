@@ -13,7 +13,9 @@ Exit codes (the same in every command):
 2     invalid input: one line ``taut: error: <field>: <problem>`` on stderr
 ====  =====================================================================================
 
-Commands import their solvers when they run, so ``taut --help`` loads no scipy.
+``taut <command>`` imports only that command's module (:data:`COMMANDS`), and commands
+import their solvers when they run, so ``taut --help`` loads no scipy and ``taut fk`` no
+planner, cable-robot model or matplotlib (tests/cli/test_startup.py).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ import signal
 import sys
 import threading
 import warnings
+from collections.abc import Iterable
+from importlib import import_module
 from typing import Any
 
 import typer
@@ -30,9 +34,9 @@ from typer.exceptions import TyperException
 
 from .. import __version__
 from ..errors import TautError
-from . import cdpr, fk, motion, physics, plan, sweep
 
-app = typer.Typer(
+#: The root command's settings.
+_APP_OPTIONS: dict[str, Any] = dict(
     name="taut",
     help="Carrying loads with cables and mobile robots. Exit codes: 0 answered yes; 1 a "
          "valid question answered no (no equilibrium, infeasible tensions, unreachable "
@@ -44,6 +48,38 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 
+#: Each top-level command -> the module of this package that registers it. ``taut <command>``
+#: imports only that module (and what the command itself needs); help and an unknown
+#: command load them all.
+COMMANDS = {"fk": "fk", "ik": "motion", "simulate": "motion", "plan": "plan",
+            "cdpr": "cdpr", "physics": "physics", "sweep": "sweep", "app": "webapp",
+            "compile": "warmup"}
+
+
+def build_app(commands: Iterable[str] = tuple(COMMANDS)) -> typer.Typer:
+    """The ``taut`` Typer app with the given top-level ``commands`` (keys of
+    :data:`COMMANDS`); ``app``, this module's attribute, is the app with all of them."""
+    app = typer.Typer(**_APP_OPTIONS)
+    app.callback()(_root)
+    for name in dict.fromkeys(COMMANDS[c] for c in commands):
+        import_module(f"{__name__}.{name}").register(app)
+    return app
+
+
+def __getattr__(name: str) -> Any:
+    if name == "app":
+        return build_app()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _needed(args: list[str]) -> tuple[str, ...]:
+    """The commands a command line needs registered: the one it names (its first word
+    that is not an option), none for ``--version``, all for help or an unknown name."""
+    command = next((a for a in args if not a.startswith("-")), None)
+    if command in COMMANDS:
+        return (command,)
+    return () if command is None and "--version" in args else tuple(COMMANDS)
+
 
 def _print_version(value: bool) -> None:
     if value:
@@ -51,7 +87,6 @@ def _print_version(value: bool) -> None:
         raise typer.Exit()
 
 
-@app.callback()
 def _root(version: bool = typer.Option(False, "--version", callback=_print_version,
                                        is_eager=True, help="Print the version and exit.")
           ) -> None:
@@ -62,14 +97,6 @@ def _root(version: bool = typer.Option(False, "--version", callback=_print_versi
     infeasible tensions, unreachable target, no plan or placement); 2 invalid input, with
     one line ``taut: error: <field>: <problem>`` on stderr."""
 
-
-for _module in (fk, motion, plan, cdpr, physics, sweep):
-    _module.register(app)
-
-# `taut app` (module webapp: a submodule named `app` would shadow the Typer object above).
-from . import webapp  # noqa: E402
-
-webapp.register(app)
 
 EXIT_NO = 1
 EXIT_USAGE = 2
@@ -116,7 +143,7 @@ def _interrupted(exc: BaseException | None) -> bool:
 #: Top-level modules of the optional extras -> the extra that installs them.
 EXTRAS = {"mujoco": "physics", "dask": "sweep", "distributed": "sweep", "pyarrow": "sweep",
           "starlette": "app", "uvicorn": "app", "ompl": "plan-ompl",
-          "selenium": "app-test"}
+          "selenium": "app-test", "matplotlib": "viz"}
 
 
 def _missing_extra(exc: ModuleNotFoundError) -> str | None:
@@ -198,8 +225,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(argv: list[str] | None) -> int:
+    args = sys.argv[1:] if argv is None else list(argv)
     try:
-        result = app(args=argv, prog_name="taut", standalone_mode=False)
+        result = build_app(_needed(args))(args=args, prog_name="taut", standalone_mode=False)
     except TautError as exc:
         return _fail(str(exc))
     except KeyboardInterrupt:
