@@ -34,7 +34,7 @@ NOT_CALLED: dict[str, str] = {
         "LiftBound TallestWorkspace Mode HPolytopeBatch Interference CableFKResult "
         "ControlEvent ControlResult MonteCarloResult SettleResult StateCheck "
         "EquilibriaCheck TippingCheck TippingGridCheck SweepResult SheetScenario "
-        "Reference Task MovingDeploymentResult").split()},
+        "Reference Task MovingDeploymentResult BaseDrivePlan").split()},
     **{name: "typing alias (Literal), not a function" for name in
        ("ModeName", "QPSolver", "TensionMethod")},
     "UnknownObstacleError": "an exception class",
@@ -90,8 +90,9 @@ class _Point(BaseModel):
 
 def valid_arguments(module: str, name: str) -> dict[str, Any]:
     """One valid value for each required argument of ``module.name`` (keyword form)."""
-    from taut.cdpr import ModelErrors, TorqueController
+    from taut.cdpr import BaseMotion, ModelErrors, Sensing, TorqueController
     f = fixtures()
+    base_poses = np.array([b.pose for b in f["robot"].bases], dtype=float)
     box6 = [-0.3, 0.3, -0.1, 0.1, 0.8, 1.2]
     by_name: dict[str, Any] = {
         "sheet": f["sheet"], "formation": f["formation"], "formations": f["formation"][None],
@@ -103,7 +104,7 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         "half_widths": np.ones(6), "twist": np.zeros(6), "limits": f["limits"],
         "md": f["mode"], "ats": f["ats"], "direction": np.eye(6)[0], "lengths":
         f["state"].lengths[0], "waypoints": [[0, 0, 1.0], [0.05, 0, 1.0]],
-        "times": [0.0, 0.1], "reference": f["reference"], "controller": TorqueController(),
+        "times": [0.0, 0.1], "reference": f["reference"], "controller": TorqueController(), "sensing": Sensing(),
         "model_errors": [], "friction": 0.5, "deployed": True, "stages": 2,
         "positions": np.zeros((1, len(f["robot"].bases), 3)), "fld": "footprint",
         "scenario": f["scenario"], "team": f["scenario"].team, "clearance": 0.05,
@@ -146,6 +147,8 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.cdpr", "BaseMotion"): {"times": [0.0, 1.0],
                                      "poses": np.zeros((2, len(f["robot"].bases), 3))},
         ("taut.cdpr", "simulate"): {"duration": 0.02},
+        ("taut.cdpr", "plan_base_drive"): {"base_motion": BaseMotion(
+            times=[0.0, 1.0], poses=np.stack([base_poses, base_poses]))},
         ("taut.cdpr", "monte_carlo"): {"duration": 0.02},
         ("taut.cdpr", "evaluate_deployment"): {"points": np.array([[0.0, 0.0, 1.0]]),
                                               "external_wrench": None, "twists": None,
@@ -176,6 +179,8 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.sweep", "sweep_from_mapping"): {
             "data": {"task": "plan_suite", "parameters": {"scenario_seed": [0, 1]}}},
         ("taut.sweep", "read_results"): {"folder": "{tmp}"},
+        ("taut.sweep", "iter_results"): {"folder": "{tmp}"},
+        ("taut.sweep", "results_columns"): {"folder": "{tmp}"},
         ("taut.io", "validate_mapping"): {"model": _Point, "data": {"x": 1.0}},
         ("taut.io", "read_mapping"): {"path": str(ROOT / "examples/sheet/example1.yaml")},
         ("taut.io", "read_text"): {"path": "pyproject.toml"},

@@ -59,6 +59,7 @@ EXEMPT = {
     "reference_from_samples": "a trajectory: always a time series",
     "place_bases": "takes base poses, returns a robot",
     "evaluate_deployment": "scores one placement over a set of sample points",
+    "plan_base_drive": "one platform pose held along a base drive (a time series of bases)",
 }
 
 

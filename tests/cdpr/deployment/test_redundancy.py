@@ -91,3 +91,29 @@ def test_bad_input(fastkit):
         resolve_redundancy(fastkit, POSE, np.zeros(6), objective="fastest")
     with pytest.raises(InvalidInputError, match="ghost"):
         resolve_redundancy(fastkit, POSE, np.zeros(6), moving=("ghost",))
+
+
+@pytest.mark.parametrize("objective", ["min_norm", "least_base"])
+def test_the_qp_solver_and_its_slsqp_fallback_agree(fastkit, objective, monkeypatch):
+    """DAQP (taut._qp) and SciPy's SLSQP (the fallback without it) solve the same convex
+    QP: the same joint rates, both within limits, DAQP's objective never above SLSQP's."""
+    pytest.importorskip("daqp")
+    from taut import _qp
+    from taut.cdpr._tol import LEAST_BASE_CABLE_WEIGHT
+    g = np.random.default_rng(17)
+    cap = twist_capacities(fastkit, POSE).positive[0]
+    twists = [g.normal(size=6) * [0.3, 0.3, 0.3, 0.2, 0.2, 0.2] for _ in range(6)]
+    twists.append(np.array([0.9 * cap, 0, 0, 0, 0, 0]))            # needs the base
+    solved = [resolve_redundancy(fastkit, POSE, t, objective=objective) for t in twists]
+    monkeypatch.setattr(_qp, "_daqp", lambda: None)                  # DAQP not installed
+    fallback = [resolve_redundancy(fastkit, POSE, t, objective=objective) for t in twists]
+    w = 1.0 / HI
+    cable_w = 1.0 if objective == "min_norm" else LEAST_BASE_CABLE_WEIGHT
+    weight = np.r_[w[:3], cable_w * w[3:]]
+    for t, a, b in zip(twists, solved, fallback):
+        assert a.success and b.success
+        _check(fastkit, a, t)
+        _check(fastkit, b, t)
+        fa, fb = np.sum((a.q_dot * weight) ** 2), np.sum((b.q_dot * weight) ** 2)
+        assert fa <= fb * (1 + 1e-7) + 1e-18
+        np.testing.assert_allclose(a.base_rates, b.base_rates, atol=1e-5)
