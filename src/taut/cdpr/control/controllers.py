@@ -277,7 +277,23 @@ class VelocityController(Controller):
 
 
 @dataclass(frozen=True)
-class TorqueController(Controller):
+class _TaskSpaceTorque(Controller):
+    """Gains shared by the torque-mode controllers: task-space PD on the estimated pose and
+    motor-speed damping (defaults: 3 Hz, damping ratio 0.9; 2e-3 N m s/rad)."""
+
+    position_stiffness: float = 355.0
+    position_damping: float = 34.0
+    rotation_stiffness: float = 355.0
+    rotation_damping: float = 34.0
+    joint_damping: float = 2.0e-3
+    mode: ClassVar[CommandMode] = "torque"
+
+    def __post_init__(self) -> None:
+        _validated(self)
+
+
+@dataclass(frozen=True)
+class TorqueController(_TaskSpaceTorque):
     """Torque control (FASTKIT §2.2): task-space PD plus feed-forward of gravity and platform
     dynamics, tensions from the tension distribution, motor torques with friction
     compensation from the *estimated* (nominal) friction model.
@@ -311,16 +327,7 @@ class TorqueController(Controller):
     'torque'
     """
 
-    position_stiffness: float = 355.0
-    position_damping: float = 34.0
-    rotation_stiffness: float = 355.0
-    rotation_damping: float = 34.0
-    joint_damping: float = 2.0e-3
     name: ClassVar[str] = "torque"
-    mode: ClassVar[CommandMode] = "torque"
-
-    def __post_init__(self) -> None:
-        _validated(self)
 
     def command(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
         ref = ctx.ref_poses[k]
@@ -358,7 +365,7 @@ def _winch_torques(ctx: ControlContext, k: int, t: np.ndarray, speed: np.ndarray
 
 
 @dataclass(frozen=True)
-class ComputedTorqueController(Controller):
+class ComputedTorqueController(_TaskSpaceTorque):
     """Computed-torque control of a cable robot: inverse dynamics of the platform at the
     *estimated* state, tensions distributed online, motor torques on the nominal winch model.
 
@@ -397,16 +404,7 @@ class ComputedTorqueController(Controller):
     'torque'
     """
 
-    position_stiffness: float = 355.0
-    position_damping: float = 34.0
-    rotation_stiffness: float = 355.0
-    rotation_damping: float = 34.0
-    joint_damping: float = 2.0e-3
     name: ClassVar[str] = "computed_torque"
-    mode: ClassVar[CommandMode] = "torque"
-
-    def __post_init__(self) -> None:
-        _validated(self)
 
     def command(self, ctx: ControlContext, k: int, meas: Measurement) -> np.ndarray:
         return _winch_torques(ctx, k, self.tensions(ctx, k, meas), meas.speed,
