@@ -632,6 +632,40 @@ def test_job_flood_is_bounded_and_ids_stay_valid(app):
         assert st == 200 and out["state"] in ("running", "done", "error")
 
 
+def test_a_planning_step_past_its_budget_ends_the_job_not_the_app():
+    """A planning step (a worker call inside a job) that overruns the app's time budget
+    ends its job with the budget's message; its worker is replaced and the app goes on
+    answering. The planner's own ``time_budget`` caps each search only, so the budget of
+    the pool is what bounds a whole step."""
+    from taut.app import server
+    from taut.app.browser import served
+    from taut.app.catalog import Catalog
+
+    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1, budget_s=0.3)
+    with served(app) as url:
+        port, token = urlparse(url).port, app.state.token
+        deadline = time.monotonic() + 90
+        st, out = 503, {}
+        while st == 503 and time.monotonic() < deadline:      # the worker starts
+            st, _, out, _ = api(port, token, "/api/plan/load",
+                                {"example": "turned_corridor_5.yaml"})
+        assert st == 200
+        st, _, job, _ = api(port, token, "/api/plan/run", {"scenario": out["scenario"]})
+        while st == 503 and time.monotonic() < deadline:      # scenario check vs. budget
+            st, _, job, _ = api(port, token, "/api/plan/run", {"scenario": out["scenario"]})
+        assert st == 200, job
+        state = {"state": "running"}
+        while state["state"] == "running" and time.monotonic() < deadline:
+            time.sleep(0.1)
+            state = api(port, token, f"/api/plan/job/{job['job']}", method="GET")[2]
+        assert state["state"] == "error", state
+        assert "took longer than its 0.3 s budget" in state["error"]
+        st = 503
+        while st == 503 and time.monotonic() < deadline:      # the fresh worker answers
+            st, _, out, _ = api(port, token, "/api/plan/load", {"example": "paper_corridor.yaml"})
+        assert st == 200 and "scenario" in out
+
+
 # --- Ctrl-C ------------------------------------------------------------------------------
 
 def test_ctrl_c_stops_the_app_during_a_heavy_request():

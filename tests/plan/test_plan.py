@@ -293,6 +293,25 @@ def test_scenario_file_errors(paper):
         plan_scenario_from_mapping(bad)
 
 
+@pytest.mark.parametrize("path, value, unit", [
+    (("team", "speed"), 1e300, "m/s"), (("team", "rotation_speed"), 1e9, "rad/s"),
+    (("team", "robot_radius"), 1e12, "m"), (("team", "lateral_safety"), 1e10, "m"),
+    (("obstacles", 0, "height"), 1e30, "m"), (("obstacles", 1, "radius"), 1e7, "m")])
+def test_scenario_values_past_the_limits_name_their_field(paper, path, value, unit):
+    """Positive but absurd values are refused at the file, naming the dotted field and the
+    accepted range (the limits of taut._validate), not planned with."""
+    bad = json.loads(json.dumps(plan_scenario_to_mapping(paper)))
+    node = bad
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    with pytest.raises(ScenarioError) as e:
+        plan_scenario_from_mapping(bad)
+    assert e.value.field == ".".join(str(p) for p in path).replace(".0.", "[0].").replace(
+        ".1.", "[1].")
+    assert "exceeds the accepted range" in e.value.problem and unit in e.value.problem
+
+
 # ------------------------------------------------------------------ CLI
 
 

@@ -126,8 +126,11 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
         carrier = SheetTeam(sheet, t.hold_height, t.mass)
     except TautError as exc:
         raise ScenarioError(f"team.{exc.field}", exc.problem) from None
-    team = Team(carrier, t.robot_radius, t.height_safety, t.lateral_safety, t.speed,
-                t.rotation_speed)
+    try:
+        team = Team(carrier, t.robot_radius, t.height_safety, t.lateral_safety, t.speed,
+                    t.rotation_speed)
+    except TautError as exc:
+        raise ScenarioError(f"team.{exc.field}", exc.problem) from None
     obstacles = []
     for k, o in enumerate(raw.obstacles):
         try:
@@ -136,7 +139,9 @@ def plan_scenario_from_mapping(data: dict) -> Scenario:
                 center=None if o.center is None else np.asarray(o.center, dtype=float),
                 polygon=None if o.polygon is None else np.asarray(o.polygon, dtype=float)))
         except TautError as exc:
-            raise ScenarioError(f"obstacles[{k}]", exc.problem) from None
+            part = exc.field.rsplit(".", 1)[1] if "." in exc.field else ""
+            raise ScenarioError(f"obstacles[{k}]" + (f".{part}" if part else ""),
+                                exc.problem) from None
     try:
         world = World(np.array(raw.free_space, dtype=float), tuple(obstacles))
     except ScenarioError:

@@ -15,7 +15,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Point, Polygon
 
-from .._validate import as_array, as_nonnegative, as_points, as_positive
+from .._validate import MAX_SHEET_LENGTH, MAX_SPEED, as_array, as_bounded, as_points
+from .._validate import check_range
 from .._validate import require_instances
 from ..errors import InvalidInputError, PlanningError
 from ..sheet.model import Sheet
@@ -83,15 +84,17 @@ class Obstacle:
     def __post_init__(self) -> None:
         f = f"obstacle {self.id!r}"
         object.__setattr__(self, "id", str(self.id))
-        object.__setattr__(self, "height", as_positive(self.height, f"{f}.height"))
+        object.__setattr__(self, "height", as_bounded(self.height, f"{f}.height",
+                                                      MAX_SHEET_LENGTH, "m"))
         if (self.polygon is None) == (self.center is None):
             raise InvalidInputError(f, "give either center and radius (a cylinder) or a "
                                        "polygon, not both or neither")
         if self.polygon is None:
-            c = as_array(self.center, f"{f}.center", shape=(2,))
+            c = check_range(as_array(self.center, f"{f}.center", shape=(2,)), f"{f}.center",
+                            MAX_SHEET_LENGTH, "m")
             if self.radius is None:
                 raise InvalidInputError(f"{f}.radius", "required for a circular obstacle")
-            r = as_positive(self.radius, f"{f}.radius")
+            r = as_bounded(self.radius, f"{f}.radius", MAX_SHEET_LENGTH, "m")
             geom = _circle_polygon(c, r)
             object.__setattr__(self, "center", c)
             object.__setattr__(self, "radius", r)
@@ -99,7 +102,8 @@ class Obstacle:
         else:
             if self.radius is not None:
                 raise InvalidInputError(f"{f}.radius", "not allowed with a polygon")
-            pts = as_points(self.polygon, f"{f}.polygon", min_count=3)
+            pts = check_range(as_points(self.polygon, f"{f}.polygon", min_count=3),
+                              f"{f}.polygon", MAX_SHEET_LENGTH, "m")
             geom = Polygon(pts)
             if not geom.is_valid or not geom.area > 0:
                 raise InvalidInputError(f"{f}.polygon", "must be a simple polygon with "
@@ -143,7 +147,8 @@ class World:
     _width: float = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        pts = as_points(self.free_space, "free_space", min_count=3)
+        pts = check_range(as_points(self.free_space, "free_space", min_count=3), "free_space",
+                          MAX_SHEET_LENGTH, "m")
         geom = Polygon(pts)
         if not geom.is_valid or not geom.area > 0:
             raise InvalidInputError("free_space", "must be a simple polygon with positive "
@@ -245,10 +250,14 @@ class Team:
         if self.carrier.n > MAX_TEAM_ROBOTS:
             raise InvalidInputError("carrier", f"a planning team has at most "
                                                f"{MAX_TEAM_ROBOTS} robots, got {self.carrier.n}")
-        for name in ("robot_radius", "speed", "rotation_speed"):
-            object.__setattr__(self, name, as_positive(getattr(self, name), name))
-        for name in ("height_safety", "lateral_safety"):
-            object.__setattr__(self, name, as_nonnegative(getattr(self, name), name))
+        for name, limit, unit, positive in (
+                ("robot_radius", MAX_SHEET_LENGTH, "m", True),
+                ("speed", MAX_SPEED, "m/s", True),
+                ("rotation_speed", MAX_SPEED, "rad/s", True),
+                ("height_safety", MAX_SHEET_LENGTH, "m", False),
+                ("lateral_safety", MAX_SHEET_LENGTH, "m", False)):
+            object.__setattr__(self, name, as_bounded(getattr(self, name), name, limit, unit,
+                                                      positive=positive))
 
     @property
     def sheet(self) -> Sheet:

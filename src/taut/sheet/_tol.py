@@ -131,14 +131,6 @@ SNAP_MIN = 1e-13
 #: Relative widening of the compiled pre-screen of the snap test (its closed-form fit
 #: agrees with the SVD-based one to ~1e-12; the exact test runs on what passes).
 SCREEN_SLACK = 1e-6
-#: Circumcircle of three robots (geometry.minimum_enclosing_circle): the triangle counts as
-#: collinear when ``2 ab x ac`` (four times its area) is below this times its longest
-#: squared side (dimensionless; ~50 ulps, so only rounding-level triangles take the
-#: circle on their farthest pair).
-COLLINEAR_RTOL = 1e-14
-#: Slack of "inside the enclosing circle" in Welzl's algorithm, relative to the largest
-#: centred coordinate: rounding of the circle fit must not reject a point on the circle.
-CIRCLE_RTOL = 1e-12
 #: An IK contact point must lie inside the sheet by this much (relative to the sheet size;
 #: ``Sheet.contains(tol=-...)``): the same rounding margin as GEOMETRY_RTOL, on the other side,
 #: so a point given "on" an edge is rejected as not strictly inside.
