@@ -5,17 +5,27 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
+# `make demo` installs only what the demo needs: the core and the viz extra (its --plot),
+# not the test extra (MuJoCo, Dask, OMPL, Selenium, mypy); `make test` adds the rest.
+DEMO_STAMP := $(VENV)/.demo-stamp
 
 .PHONY: demo test test-slow bench clean clean-cache
 
-$(STAMP): pyproject.toml
+$(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(DEMO_STAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[viz]'
+	$(BIN)/taut compile
+	touch $(DEMO_STAMP)
+
+$(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	$(BIN)/taut compile
 	touch $(STAMP)
 
-demo: $(STAMP)
+demo: $(DEMO_STAMP)
 	$(BIN)/taut fk examples/sheet/example2_r2_r4_353mm.yaml --mass 1.0 --plot out/example2.png
 
 # `taut compile` returns at once when the kernels are cached; after a kernel edit it

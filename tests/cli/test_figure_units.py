@@ -1,7 +1,8 @@
 """Every figure type rendered headless (Agg) and inspected: each data panel has a title
 (its own or the figure's), axis labels with units (``[m]``, ``(N)``, ...) unless the axis is
-categorical (named ticks), and a legend wherever more than one labelled artist is drawn. The
-wrench-capacity chart says which direction it plots."""
+categorical (named ticks), and a legend wherever more than one labelled artist is drawn; no
+legend or title covers an axis label and no title is cut by the figure's edge (drawn
+extents, issue 29.5). The wrench-capacity chart says which direction it plots."""
 
 from __future__ import annotations
 
@@ -24,7 +25,41 @@ def _panels(fig):
     return [ax for ax in fig.axes if ax.get_label() != "<colorbar>" and ax.has_data()]
 
 
+def _overlap(a, b) -> bool:
+    """Whether two display boxes share area (touching edges do not count)."""
+    return (min(a.x1, b.x1) - max(a.x0, b.x0) > 0.5) and (min(a.y1, b.y1) - max(a.y0, b.y0) > 0.5)
+
+
+def _check_layout(fig):
+    """No legend or title covers an axis label; every title lies inside the figure."""
+    if not hasattr(fig.canvas, "get_renderer"):       # a figure closed after saving
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        FigureCanvasAgg(fig)
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    labels = [(t.get_text(), t.get_window_extent(r)) for ax in fig.axes
+              for t in [ax.xaxis.label, ax.yaxis.label] + ([ax.zaxis.label]
+                                                            if hasattr(ax, "zaxis") else [])
+              if t.get_text() and t.get_visible()]
+    legends = [lg for lg in [ax.get_legend() for ax in fig.axes] + list(fig.legends)
+               if lg is not None]
+    titles = [t for ax in fig.axes for t in (ax.title, ax._left_title, ax._right_title)
+              if t.get_text()] + ([fig._suptitle] if fig._suptitle is not None else [])
+    page = fig.bbox
+    for lg in legends:
+        box = lg.get_window_extent(r)
+        for text, lab in labels:
+            assert not _overlap(box, lab), f"legend covers the axis label {text!r}"
+    for t in titles:
+        box = t.get_window_extent(r)
+        assert (box.x0 >= page.x0 - 1 and box.x1 <= page.x1 + 1 and box.y0 >= page.y0 - 1
+                and box.y1 <= page.y1 + 1), f"title {t.get_text()!r} is cut by the figure edge"
+        for text, lab in labels:
+            assert not _overlap(box, lab), f"title {t.get_text()!r} covers the label {text!r}"
+
+
 def _check(fig, *, min_panels: int = 1):
+    _check_layout(fig)
     panels = _panels(fig)
     assert len(panels) >= min_panels
     suptitle = fig._suptitle.get_text() if fig._suptitle is not None else ""
@@ -37,7 +72,10 @@ def _check(fig, *, min_panels: int = 1):
         for name, label, ticks in axes:
             categorical = name == "x" and any(re.search("[A-Za-z]", t.get_text())
                                                for t in ticks)
-            assert categorical or UNIT.search(label), f"{name} axis {label!r} has no unit"
+            shared = name == "x" and not label and any(     # sharex: labelled at the bottom
+                UNIT.search(a.get_xlabel()) for a in ax.get_shared_x_axes().get_siblings(ax))
+            assert categorical or shared or UNIT.search(label), \
+                f"{name} axis {label!r} has no unit"
         labelled = [h for h in ax.get_legend_handles_labels()[1] if not h.startswith("_")]
         if len(labelled) > 1:
             assert ax.get_legend() is not None or fig.legends, f"no legend for {labelled}"
@@ -159,4 +197,60 @@ def test_plan_figure_shows_sides_only_for_algorithm2_crossings(tmp_path, method)
         assert sc.team.clearance in rule and sc.team.robot_radius in rule
     distances = fig.axes[3]
     assert "sheet limit" in [t.get_text() for t in distances.get_legend().get_texts()]
+    pairs = [ln for ln in distances.get_lines() if ln.get_label().startswith("|r")]
+    looks = {(ln.get_linestyle(), ln.get_linewidth()) for ln in pairs}
+    assert len(looks) == len(pairs) == 3          # a pair drawn over an equal one still shows
+    for k, ln in enumerate(pairs):                # and a coinciding pair says which it equals
+        same = [m for m in pairs[:k] if np.allclose(m.get_ydata(), ln.get_ydata(), atol=1e-3)]
+        assert ("(= " in ln.get_label()) == bool(same)
     _check(fig, min_panels=4)
+
+
+@pytest.mark.slow                     # a 1 s control simulation (about 5 s with set-up)
+def test_cable_simulation_figure_and_animation_bases(tmp_path, monkeypatch):
+    from taut.cdpr import TorqueController, pick_and_place, simulate, with_stabilisers
+    from taut.io import load_cdpr_model
+    from taut.io.cdpr_dynamics import load_cdpr_dynamics
+    import taut.viz.cdpr_sim as vs
+    robot = with_stabilisers(load_cdpr_model("fastkit"))
+    ref = pick_and_place(robot, [[-0.2, 0, 0.9], [0.2, 0, 0.9]], dwell=0.1)
+    run = simulate(robot, ref, TorqueController(), dynamics=load_cdpr_dynamics("fastkit"))
+    fig = vs.plot_control(run, title="torque control: " + "a long message " * 12)
+    tipping = fig.axes[2]
+    assert tipping.get_legend() is not None                # one entry per support edge
+    assert len(tipping.get_legend().get_texts()) == len(run.edge_names) + 1
+    _check(fig, min_panels=4)
+    captured = {}
+
+    def keep(anim, path, fps):                 # instead of saving: keep it to inspect
+        anim._draw_was_started = True          # (matplotlib warns about unsaved animations)
+        captured["a"] = anim
+
+    monkeypatch.setattr(vs, "save_animation", keep)
+    vs.animate_control(robot, run, tmp_path / "a.gif", frames=2)
+    anim = captured["a"]
+    anim._func(0)
+    ax = anim._fig.axes[0]
+    assert "base footprint" in [ln.get_label() for ln in ax.get_lines()]
+    drawn = [ln for ln in ax.get_lines() if ln.get_color() == "0.25"]
+    assert len(drawn) == sum(b.footprint is not None for b in robot.bases) == 2
+    for ln in drawn:                                       # wheel footprints on the ground
+        x, y, z = ln.get_data_3d()
+        assert len(x) >= 4 and np.allclose(z, 0.0)
+    posts = next(ln for ln in ax.get_lines() if ln.get_label() == "base posts")
+    assert np.nanmax(posts.get_data_3d()[2]) > 1.0          # up to the exit points
+
+
+def test_wrench_set_figure_says_infeasible():
+    from taut.cdpr import axis_capacities
+    from taut.io import load_cdpr_model
+    from taut.viz.cdpr import plot_axis_capacities
+    robot = load_cdpr_model("fastkit")
+    pose = [0.0, 0.0, 1.2]                                  # a mobile base tips here
+    tip = axis_capacities(robot, pose)
+    assert not tip.feasible.all()
+    fig = plot_axis_capacities(axis_capacities(robot, pose, tipping=False), tip)
+    assert "with tipping: infeasible" in fig._suptitle.get_text()
+    notes = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert notes.count(" 0: infeasible") == 6
+    _check(fig, min_panels=2)

@@ -45,7 +45,8 @@ def test_ik_json_round_trips_through_fk(capsys):
 
 
 def test_ik_table_and_heading(capsys):
-    code, out, _ = run(capsys, "ik", SCENARIO, "--object", "0", "0", "1", "--heading", "90")
+    code, out, _ = run(capsys, "ik", SCENARIO, "--object", "0", "0", "1", "--heading",
+                         "1.5707963267948966")       # rad, as inverse_kinematics(heading=)
     assert code == 0
     assert "all 4 cables taut" in out and out.count("\n") == 6
     # At heading 90 deg robot 1 (sheet corner (1, 1)) stands at (-a, a).

@@ -14,6 +14,7 @@ from ..errors import InvalidInputError
 from ..io.serialize import ik_to_dict, simulation_to_dict, to_json
 from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
+from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, sheet_unit, write_recordings
 
 if TYPE_CHECKING:
     from ..sheet.ik.inverse import IKResult
@@ -63,12 +64,13 @@ def register(app: typer.Typer) -> None:
                                         "hold_height and sheet (a formation, if present, is "
                                         "validated but not used)."),
         object_position: Tuple[float, float, float] = typer.Option(
-            ..., "--object", help="Target object position X Y Z (scenario units)."),
+            ..., "--object", help="Target object position X Y Z (sheet units: the "
+            "scenario's units)."),
         contact: Optional[Tuple[float, float]] = typer.Option(
-            None, "--contact", help="Contact point U V on the sheet (sheet frame); default "
-            "the sheet's area centroid."),
-        heading: float = typer.Option(0.0, "--heading", help="Formation heading in "
-                                      "degrees (turn about the vertical)."),
+            None, "--contact", help="Contact point U V on the sheet (sheet frame, sheet "
+            "units); default the sheet's area centroid."),
+        heading: float = typer.Option(0.0, "--heading", help="Formation heading, rad "
+                                      "(counter-clockwise turn about the vertical)."),
         mass: Optional[float] = typer.Option(None, "--mass", help="Object mass in kg "
                                              "(overrides the scenario's); gives tensions."),
         as_json: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
@@ -80,15 +82,15 @@ def register(app: typer.Typer) -> None:
         from ..io.sheet_scenario import load_sheet_scenario
         from ..sheet.ik.inverse import inverse_kinematics
 
-        check_range(object_position, "--object", MAX_SHEET_LENGTH, "scenario units")
+        check_range(object_position, "--object", MAX_SHEET_LENGTH, "sheet units")
         if contact is not None:
-            check_range(contact, "--contact", MAX_SHEET_LENGTH, "scenario units")
-        check_range(heading, "--heading", 1e6, "degrees")
+            check_range(contact, "--contact", MAX_SHEET_LENGTH, "sheet units")
+        check_range(heading, "--heading", 1e4, "rad")
         m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
         team = sc.team if m is None else replace(sc.team, mass=m)
         r = inverse_kinematics(team, object_position, contact=contact,
-                               heading=np.radians(heading))
+                               heading=heading)
         if not r.success:                      # a valid question answered "no": exit 1
             typer.echo(f"taut: {r.status}: {r.message}", err=True)
             raise typer.Exit(1)
@@ -107,6 +109,8 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print JSON instead of a summary."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write a figure (object "
                                             "height with events; top view of all paths)."),
+        mcap: Optional[Path] = typer.Option(None, "--mcap", help=MCAP_HELP),
+        rerun: Optional[Path] = typer.Option(None, "--rerun", help=RERUN_HELP),
     ) -> None:
         """Quasi-static simulation of the object while the robots follow a trajectory."""
         from dataclasses import replace
@@ -116,8 +120,10 @@ def register(app: typer.Typer) -> None:
         from ..sheet.sim.simulate import simulate
 
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
+        mcap, rerun = recording_paths(mcap, rerun)
         m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
+        unit = sheet_unit(sc.units, mcap, rerun)
         team = sc.team if m is None else replace(sc.team, mass=m)
         traj = load_trajectory(trajectory)
         if traj.n_robots != team.n:
@@ -135,3 +141,4 @@ def register(app: typer.Typer) -> None:
             plot_simulation(r, plot, time=traj.time, units=sc.units, title=sc.name)
             if not as_json:
                 typer.echo(f"figure written to {plot}")
+        write_recordings(r, mcap, rerun, quiet=as_json, length_unit=unit, times=traj.time)

@@ -22,6 +22,7 @@ from ..errors import ScenarioError, TautError
 from ..sheet.model import Sheet, check_formation
 from ..sheet.team import SheetTeam
 from .files import read_mapping, validate_mapping
+from .._repr import CompactRepr
 
 __all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"]
 
@@ -46,8 +47,8 @@ class _SheetScenarioFile(BaseModel):
     object: _ObjectFile | None = None
 
 
-@dataclass(frozen=True, eq=False)
-class SheetScenario:
+@dataclass(frozen=True, eq=False, repr=False)
+class SheetScenario(CompactRepr):
     """A validated sheet scenario.
 
     Attributes

@@ -19,12 +19,13 @@ import numpy as np
 from .._validate import MAX_BATCH, MAX_SHEET_LENGTH
 from ..errors import InvalidTrajectoryError
 from .files import read_text, write_text_atomic
+from .._repr import CompactRepr
 
 __all__ = ["Trajectory", "load_trajectory", "parse_trajectory", "save_trajectory"]
 
 
-@dataclass(frozen=True, eq=False)
-class Trajectory:
+@dataclass(frozen=True, eq=False, repr=False)
+class Trajectory(CompactRepr):
     """A time series of formations.
 
     Attributes

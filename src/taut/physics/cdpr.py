@@ -24,12 +24,13 @@ from ..cdpr import (CableRobot, TensionMethod, distribute_tensions, rotation_mat
 from ..cdpr.kinematics.cables import as_poses
 from ..errors import InvalidInputError
 from . import _tol
+from .._repr import CompactRepr
 
 __all__ = ["TippingCheck", "TippingGridCheck", "replay_tipping", "replay_tipping_grid"]
 
 
-@dataclass(frozen=True, eq=False)
-class TippingCheck:
+@dataclass(frozen=True, eq=False, repr=False)
+class TippingCheck(CompactRepr):
     """Bases of a cable robot at one pose under given tensions, in MuJoCo and in taut.
 
     Attributes
@@ -64,8 +65,8 @@ class TippingCheck:
     message: str
 
 
-@dataclass(frozen=True, eq=False)
-class TippingGridCheck:
+@dataclass(frozen=True, eq=False, repr=False)
+class TippingGridCheck(CompactRepr):
     """:func:`replay_tipping` over a batch of poses, as arrays.
 
     ``verdicts`` (B, n_bases) of str, ``margin`` (B,), ``taut_stays`` / ``physics_stays``

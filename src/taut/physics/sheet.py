@@ -23,6 +23,7 @@ from . import _run, _tol
 from ._mesh import SheetMesh, sheet_mesh, sheet_mesh_spacing
 from ._sheet_model import build_sheet_sim
 from ._statics import barrier, model_pull
+from .._repr import CompactRepr
 
 __all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "replay_equilibria",
            "DEFAULT_MESH"]
@@ -36,8 +37,8 @@ __all__ = ["SettleResult", "StateCheck", "EquilibriaCheck", "settle", "replay_eq
 DEFAULT_MESH = 10
 
 
-@dataclass(frozen=True, eq=False)
-class SettleResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class SettleResult(CompactRepr):
     """Where a dropped object came to rest on the simulated sheet.
 
     Attributes
@@ -75,8 +76,8 @@ class SettleResult:
     message: str
 
 
-@dataclass(frozen=True, eq=False)
-class StateCheck:
+@dataclass(frozen=True, eq=False, repr=False)
+class StateCheck(CompactRepr):
     """One of taut's rest states checked in MuJoCo.
 
     Attributes

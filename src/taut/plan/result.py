@@ -16,12 +16,13 @@ from .formations.optimal import Formation, _optimal_formation
 from .roadmap.route import _find_route
 from .checks.verify import Verification, _verify_motion
 from .world import Scenario
+from .._repr import CompactRepr
 
 __all__ = ["PlanResult"]
 
 
-@dataclass(frozen=True, eq=False)
-class PlanResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class PlanResult(CompactRepr):
     """A transport plan (or why there is none).
 
     Attributes

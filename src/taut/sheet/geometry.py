@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike
 
 from .._validate import as_array, as_finite_scalar, as_nonnegative
 from ..errors import InvalidInputError
+from .._repr import CompactRepr
 
 __all__ = ["FormationMetrics", "formation_metrics", "minimum_enclosing_circle",
            "formation_size", "max_obstacle_height", "min_robot_distance",
@@ -122,8 +123,8 @@ def max_obstacle_diameter(formation: ArrayLike, margin: float = 0.0) -> float:
     return dmin - 2.0 * as_nonnegative(margin, "margin")
 
 
-@dataclass(frozen=True, eq=False)
-class FormationMetrics:
+@dataclass(frozen=True, eq=False, repr=False)
+class FormationMetrics(CompactRepr):
     """The planning paper's formation quantities (eqs. 1-4) for one formation.
 
     Attributes

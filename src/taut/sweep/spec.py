@@ -17,6 +17,7 @@ import numpy as np
 
 from .._validate import as_choice
 from ..errors import InvalidInputError, SweepError
+from .._repr import CompactRepr
 
 __all__ = ["Parameter", "SweepSpec", "Distribution", "DISTRIBUTIONS"]
 
@@ -32,8 +33,8 @@ def _choice(value: Any, choices: Any, field: str) -> str:
         raise SweepError(exc.field, exc.problem) from None
 
 
-@dataclass(frozen=True, eq=False)
-class Parameter:
+@dataclass(frozen=True, eq=False, repr=False)
+class Parameter(CompactRepr):
     """One swept parameter.
 
     Parameters

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from .._repr import CompactRepr
 
 __all__ = ["Task", "Columns", "BaseKind"]
 
@@ -24,8 +25,8 @@ Columns = dict[str, np.ndarray]
 BaseKind = Literal["sheet scenario", "plan scenario", "cdpr model", ""]
 
 
-@dataclass(frozen=True)
-class Task:
+@dataclass(frozen=True, repr=False)
+class Task(CompactRepr):
     """A sweep task.
 
     Attributes

@@ -101,6 +101,14 @@ def plot_workspace(result: WorkspaceResult, robot: CableRobot,
     return fig
 
 
+def _pose_row(cap: AxisCapacities, pose_index: int
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(positive, negative, feasible)`` of one pose (row ``pose_index`` of a batch)."""
+    if cap.positive.ndim == 1:
+        return cap.positive, cap.negative, cap.feasible
+    return cap.positive[pose_index], cap.negative[pose_index], cap.feasible[pose_index]
+
+
 def plot_axis_capacities(without: AxisCapacities, with_tipping: AxisCapacities | None = None,
                          path: str | Path | None = None, *, title: str | None = None,
                          pose_index: int = 0):
@@ -116,18 +124,27 @@ def plot_axis_capacities(without: AxisCapacities, with_tipping: AxisCapacities |
                                                    if n == 6 else [])
     fig, axes = plt.subplots(1, len(groups), figsize=(4.5 * len(groups), 3.6), squeeze=False)
     width = 0.8 / len(sets)
+    infeasible = []
     for ax, (gname, ks) in zip(axes[0], groups):
         kl = list(ks)
         x = np.arange(len(kl))
         for s, (sname, cap) in enumerate(sets):
-            pos, neg = ((cap.positive, cap.negative) if cap.positive.ndim == 1 else
-                        (cap.positive[pose_index], cap.negative[pose_index]))
-            val = np.minimum(pos[kl], neg[kl])
-            ax.bar(x + (s - (len(sets) - 1) / 2) * width, val, width, label=sname)
+            pos, neg, ok = _pose_row(cap, pose_index)
+            at = x + (s - (len(sets) - 1) / 2) * width
+            bars = ax.bar(at, np.minimum(pos, neg)[kl], width, label=sname)
+            if not ok.all():                # the weight alone is not held at this pose
+                infeasible.append(sname)
+            for xb, k in zip(at, kl):
+                if not ok[k].all():
+                    ax.text(xb, 0.0, " 0: infeasible", rotation=90, ha="center",
+                            va="bottom", fontsize=7, color=bars.patches[0].get_facecolor())
         ax.set_xticks(x, [without.labels[k] for k in kl])
         ax.set_ylabel(gname)
         ax.legend(fontsize=7)
-    fig.suptitle(title or "wrench capability (min of + and - directions)", fontsize=10)
+    head = title or "wrench capability (min of + and - directions)"
+    for sname in dict.fromkeys(infeasible):
+        head += f"\n{sname}: infeasible at this pose (the weight alone is not held)"
+    fig.suptitle(head, fontsize=10)
     fig.tight_layout()
     if path is not None:
         save_figure(fig, path, dpi=150)

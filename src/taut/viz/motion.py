@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 
 from ..sheet.sim.simulate import SimulationResult  # noqa: E402
 from ._save import save_figure  # noqa: E402
+from .sheet import sheet_unit  # noqa: E402
 
 __all__ = ["plot_simulation"]
 
@@ -48,7 +49,7 @@ def plot_simulation(result: SimulationResult, path: str | Path | None = None, *,
     """
     T = len(result)
     t = np.arange(T) if time is None else np.asarray(time, dtype=float)
-    u = f" [{units}]" if units else ""
+    u = f" [{sheet_unit(units)}]"
     fig, (ax_h, ax_xy) = plt.subplots(1, 2, figsize=(12, 5))
     ax_h.plot(t, result.object[:, 2], color="tab:blue", lw=1.5, label="object height $z_o$")
     seen = set()
@@ -70,7 +71,7 @@ def plot_simulation(result: SimulationResult, path: str | Path | None = None, *,
         lo, hi = float(z.min()), float(z.max())
         pad = max(0.08 * (hi - lo), 1e-3 * max(abs(hi), 1.0))
         ax_h.set_ylim(lo - pad, hi + pad)
-    unit_word = f" {units}" if units else ""
+    unit_word = f" {sheet_unit(units)}"
     ax_h.set_title(f"hold height $z_r$ = {result.hold_height:g}{unit_word}", fontsize=9)
     ax_h.legend(loc="best", fontsize=8)
     ax_h.grid(alpha=0.3)

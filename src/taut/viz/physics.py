@@ -14,14 +14,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..physics.sheet import EquilibriaCheck, SettleResult  # noqa: E402
-from .sheet import KIND_COLOURS  # noqa: E402
+from .sheet import KIND_COLOURS, sheet_unit  # noqa: E402
 from ._save import save_figure, save_animation  # noqa: E402
 
 __all__ = ["plot_equilibria_check", "animate_settle"]
 
 
 def _draw_sheet(ax: Any, nodes: np.ndarray, triangles: np.ndarray, formation: np.ndarray,
-                hold_height: float) -> None:
+                hold_height: float, units: str | None = None) -> None:
     ax.plot_trisurf(nodes[:, 0], nodes[:, 1], nodes[:, 2], triangles=triangles,
                     color="tab:blue", alpha=0.35, edgecolor="0.3", linewidth=0.3)
     for i, (x, y) in enumerate(formation):
@@ -29,7 +29,7 @@ def _draw_sheet(ax: Any, nodes: np.ndarray, triangles: np.ndarray, formation: np
         ax.text(x, y, hold_height * 1.05, str(i + 1), fontsize=8, ha="center")
     ax.set_zlim(0, hold_height * 1.1)
     for axis in "xyz":           # sheets use any consistent length unit (examples: mm)
-        getattr(ax, f"set_{axis}label")(f"{axis} [sheet units]", fontsize=7)
+        getattr(ax, f"set_{axis}label")(f"{axis} [{sheet_unit(units)}]", fontsize=7)
     span = np.ptp(np.vstack([nodes[:, :2], formation]), axis=0)
     ax.set_box_aspect((max(span[0], 1e-9), max(span[1], 1e-9), hold_height * 1.1))
 
@@ -46,10 +46,10 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
     cols = min(n, 3)
     rows = math.ceil(n / cols)
     fig = plt.figure(figsize=(4.2 * cols, 4.0 * rows))
-    u = f" {units}" if units else ""
+    u = f" {sheet_unit(units)}"
     for k, s in enumerate(check.states):
         ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
-        _draw_sheet(ax, s.nodes, s.triangles, np.asarray(formation), hold_height)
+        _draw_sheet(ax, s.nodes, s.triangles, np.asarray(formation), hold_height, units)
         ax.scatter(*s.predicted, s=60, color=KIND_COLOURS.get(s.kind, "k"),
                    edgecolor="k", depthshade=False, label="taut")
         if s.success or s.status == "not_strict":
@@ -75,8 +75,9 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
 
 
 def animate_settle(result: SettleResult, formation: np.ndarray, hold_height: float,
-                   path: str | Path, *, fps: int = 10) -> None:
-    """Write a GIF of a drop (:func:`taut.physics.settle` with ``trace=True``)."""
+                   path: str | Path, *, fps: int = 10, units: str | None = None) -> None:
+    """Write a GIF of a drop (:func:`taut.physics.settle` with ``trace=True``); axes in
+    ``units`` (the scenario's, default "sheet units")."""
     from matplotlib.animation import FuncAnimation
 
     if result.frames is None or result.trace is None:
@@ -87,7 +88,8 @@ def animate_settle(result: SettleResult, formation: np.ndarray, hold_height: flo
 
     def draw(k: int) -> None:
         ax.clear()
-        _draw_sheet(ax, frames[k], result.triangles, np.asarray(formation), hold_height)
+        _draw_sheet(ax, frames[k], result.triangles, np.asarray(formation), hold_height,
+                    units)
         ax.scatter(*trace[k, 1:], s=40, color="tab:red", depthshade=False)
         ax.set_title(f"t = {trace[k, 0]:.1f} s", fontsize=9)
 

@@ -103,7 +103,10 @@ def _clearances(ax, scenario: Scenario, r: PlanResult) -> None:
 
 def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
     """Pairwise robot distances against their sheet limits (and the margin); above ten
-    pairs the others are grey and only the pair with the least slack is named."""
+    pairs the others are grey and only the pair with the least slack is named. Up to ten,
+    each pair has its own dash and a thinner line than the one before, so a pair drawn on
+    top of an equal one (a rigid formation) still shows, and its label names the pair it
+    coincides with."""
     n = r.robots.shape[1]
     V = scenario.team.sheet.vertices
     iu, ju = np.triu_indices(n, 1)
@@ -111,10 +114,14 @@ def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
     limit = np.linalg.norm(V[iu] - V[ju], axis=1)
     ratio = d / limit
     tightest = int(np.argmin((limit[None] - d).min(axis=0)))
+    names = [f"|r{i + 1} - r{j + 1}|" for i, j in zip(iu, ju)]
     for k in range(len(iu)):
-        name = f"|r{iu[k] + 1} - r{ju[k] + 1}|"
+        name = names[k]
         if len(iu) <= 10:
-            ax.plot(r.times, ratio[:, k], lw=0.8, label=name)
+            same = [m for m in range(k) if np.allclose(ratio[:, m], ratio[:, k], atol=1e-3)]
+            ax.plot(r.times, ratio[:, k], lw=max(0.8, 2.6 - 0.45 * k),
+                    ls=("-", "--", ":", "-.")[k % 4],
+                    label=name + (f" (= {names[same[0]]})" if same else ""))
         elif k == tightest:               # many pairs: name only the one nearest its limit
             ax.plot(r.times, ratio[:, k], lw=1.2, color="tab:red",
                     label=f"{name} (least slack)", zorder=3)
@@ -132,14 +139,29 @@ def _distances(ax, scenario: Scenario, r: PlanResult) -> None:
     ax.legend(fontsize=6, ncol=2 if len(iu) <= 10 else 1)
 
 
-def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path) -> None:
+def _headings(ax, tr) -> None:
+    """Robot headings of executed trajectories (:func:`taut.plan.robot_trajectories`) as
+    arrows at about 12 instants (one robot radius long, in the top view's m)."""
+    T = len(tr.times)
+    at = np.unique(np.linspace(0, T - 1, min(T, 12)).round().astype(int))
+    p = tr.poses[at]
+    ax.quiver(p[..., 0], p[..., 1], np.cos(p[..., 2]), np.sin(p[..., 2]), color="tab:red",
+              angles="xy", scale_units="xy", scale=8.0, width=0.004,
+              label=f"{tr.drive} robot headings")
+
+
+def plot_plan(scenario: Scenario, result: PlanResult, path: str | Path, *,
+              trajectories=None) -> None:
     """Four-panel summary figure of a successful plan (PNG/PDF by extension): top view
-    with robot footprints, sheet outlines and the object's path; object height against
+    with robot footprints, sheet outlines and the object's path (and, given executed
+    ``trajectories``, the robots' headings as arrows); object height against
     the obstacles beneath the sheet; entering/exiting sides of Algorithm 2 crossings
     (plans with such crossings) or else the robots' clearance against its rule;
     pairwise robot distances against their sheet limits."""
     r = result
     fig, axs = plt.subplots(2, 2, figsize=(12, 8))
+    if trajectories is not None and trajectories.success:
+        _headings(axs[0, 0], trajectories)
     _top_view(axs[0, 0], scenario, r)
     ax = axs[0, 1]
     profile = plan_profile(r)

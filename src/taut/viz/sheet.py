@@ -23,6 +23,12 @@ __all__ = ["draw_equilibrium", "plot_fk", "KIND_COLOURS"]
 KIND_COLOURS = {"stable": "tab:green", "saddle": "tab:orange", "not_equilibrium": "tab:red"}
 
 
+def sheet_unit(units: str | None) -> str:
+    """The length unit every sheet figure prints: the scenario's ``units:`` (e.g. ``mm``),
+    else ``sheet units`` (sheets take any consistent length unit)."""
+    return units or "sheet units"
+
+
 def legend_handles() -> list[Line2D]:
     """Legend entries of :func:`draw_equilibrium`'s marks."""
     obj = [Line2D([], [], ls="none", marker="o", ms=7, mec="k", color=c,
@@ -67,15 +73,29 @@ def draw_equilibrium(ax: Any, formation: np.ndarray, hold_height: float, e: Equi
     ax.plot([e.object[0]] * 2, [e.object[1]] * 2, [0, e.object[2]], color="0.7", lw=0.6)
     label = "{" + ",".join(str(i + 1) for i in e.taut) + "}"
     ax.set_title(f"taut {label}: {e.kind.replace('_', ' ')}\n"
-                 f"z_o = {e.object[2]:.4g}{' ' + units if units else ''}", fontsize=9)
+                 f"z_o = {e.object[2]:.4g} {sheet_unit(units)}", fontsize=9)
     ax.set_zlim(0, hold_height * 1.08)
     span = np.ptp(formation, axis=0)
     ax.set_box_aspect((max(span[0], 1e-9), max(span[1], 1e-9), hold_height * 1.08))
-    unit = f" [{units}]" if units else ""
+    unit = f" [{sheet_unit(units)}]"
     ax.set_xlabel("x" + unit, fontsize=8)
     ax.set_ylabel("y" + unit, fontsize=8)
     ax.set_zlabel("z" + unit, fontsize=8)
     ax.tick_params(labelsize=7)
+
+
+def _lift_above(fig: Any, legend: Any) -> None:
+    """Raise the panels' bottom edge until no axis label reaches down into ``legend``
+    (tight_layout does not count the labels of 3D axes, drawn outside their boxes)."""
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    top = legend.get_window_extent(r).y1
+    lowest = min((t.get_window_extent(r).y0 for ax in fig.axes
+                  for t in (ax.xaxis.label, ax.yaxis.label) if t.get_text()), default=top)
+    if lowest < top + 2:
+        shift = (top + 2 - lowest) / fig.bbox.height
+        bottom = fig.subplotpars.bottom
+        fig.subplots_adjust(bottom=min(bottom + shift, fig.subplotpars.top - 0.05))
 
 
 def plot_fk(result: FKResult, path: str | Path | None = None, *, units: str | None = None,
@@ -104,9 +124,12 @@ def plot_fk(result: FKResult, path: str | Path | None = None, *, units: str | No
                  f"({left_out} left out; `taut fk --json` lists all)")
     if head:
         fig.suptitle(head, fontsize=10)
-    fig.legend(handles=legend_handles(), loc="lower center", ncol=4, fontsize=8,
-               frameon=False)
-    fig.tight_layout(rect=(0, 0.08 if rows == 1 else 0.05, 1, 1))
+    legend = fig.legend(handles=legend_handles(), loc="lower center", ncol=4, fontsize=8,
+                        frameon=False)
+    fig.canvas.draw()                   # the legend's measured height, not a guess
+    below = legend.get_window_extent().height / fig.bbox.height
+    fig.tight_layout(rect=(0, below + 0.02, 1, 1))
+    _lift_above(fig, legend)
     if path is not None:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         save_figure(fig, path, dpi=150)

@@ -39,8 +39,8 @@ def test_cli_simulate_writes_the_result_fields(capsys, tmp_path):
 
 def test_cli_velocity_control_with_exit_errors_answers_no(capsys):
     code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
-                           "--waypoints", WP, "--controller", "velocity", "--exit-error", "5",
-                           "--dwell", "0.1")
+                           "--waypoints", WP, "--controller", "velocity", "--exit-error",
+                           "0.005", "--dwell", "0.1")
     assert code == 1
     assert "slack" in text or "over_tension" in text
     assert len(err.strip().splitlines()) == 1 and err.startswith("taut: infeasible:")
@@ -140,7 +140,7 @@ def test_cli_simulate_from_a_reference_csv(capsys, tmp_path, fastkit):
 def test_cli_tension_feedback_and_ideal_pose_options(capsys):
     code, text, err = _cli(capsys, "cdpr", "simulate", "fastkit", "--stabilisers",
                            "--waypoints", WP, "--controller", "velocity", "--dwell", "0.1",
-                           "--tension-gain", "200", "--exit-error", "5", "--json")
+                           "--tension-gain", "200", "--exit-error", "0.005", "--json")
     data = json.loads(text)
     assert data["controller"]["tension_gain"] == 200.0
     lib = simulate_lib("velocity", tension_gain=200.0)

@@ -241,7 +241,7 @@ def test_cli_computed_torque_with_latency_uses_the_gain_rule(capsys):
     from taut.cli import main
     args = ["cdpr", "simulate", "fastkit", "--stabilisers", "--waypoints",
             "-0.2,0,0.9; 0.2,0,0.9", "--dwell", "0.1", "--controller", "computed_torque"]
-    assert main(args + ["--latency", "2", "--json"]) == 0
+    assert main(args + ["--latency", "0.002", "--json"]) == 0      # s, as Sensing
     data = json.loads(capsys.readouterr().out)
     want, _ = tune_for_rate(ComputedTorqueController(), Sensing(latency=0.002), 1000.0)
     assert data["controller"] == json.loads(json.dumps(want.describe()))

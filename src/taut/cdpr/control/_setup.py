@@ -21,6 +21,7 @@ from ..kinematics.cables import gravity_wrench, rotation_matrices
 from ..model.robot import CableRobot
 from .references import Reference
 from ..statics.tension import distribute_tensions
+from ..._repr import CompactRepr
 
 __all__ = ["BaseMotion", "drive_tensions", "DRIVE_TENSION_METHOD"]
 
@@ -34,8 +35,8 @@ _BASE_STRIDE = 20
 _TENSION_STRIDE = 10
 
 
-@dataclass(frozen=True)
-class BaseMotion:
+@dataclass(frozen=True, repr=False)
+class BaseMotion(CompactRepr):
     """Poses of every base over time (FASTKIT task mode: the active base moves, eq. 8).
 
     Parameters

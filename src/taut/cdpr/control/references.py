@@ -20,14 +20,15 @@ from ...errors import InvalidInputError, InvalidTrajectoryError
 from .._tol import MAX_REFERENCE_SPEED, WAYPOINT_SAME
 from ..kinematics.cables import as_poses
 from ..model.robot import CableRobot
+from ..._repr import CompactRepr
 
 __all__ = ["Reference", "pick_and_place", "reference_from_samples"]
 
 Profile = Literal["quintic", "trapezoidal"]
 
 
-@dataclass(frozen=True)
-class Reference:
+@dataclass(frozen=True, repr=False)
+class Reference(CompactRepr):
     """A sampled platform reference.
 
     Attributes

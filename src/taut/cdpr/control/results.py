@@ -13,12 +13,13 @@ from .._tol import EVENT_TENSION_TOL, SATURATION_REL
 from ..kinematics.forward import rpy_from_matrices
 from .controllers import Controller
 from .monitors import ControlEvent, episodes, tipping_margins
+from ..._repr import CompactRepr
 
 __all__ = ["ControlResult", "MonteCarloResult"]
 
 
-@dataclass(frozen=True)
-class ControlResult:
+@dataclass(frozen=True, repr=False)
+class ControlResult(CompactRepr):
     """One simulated run (T recorded control instants).
 
     Attributes
@@ -88,8 +89,8 @@ class ControlResult:
         check_status(self.status)
 
 
-@dataclass(frozen=True)
-class MonteCarloResult:
+@dataclass(frozen=True, repr=False)
+class MonteCarloResult(CompactRepr):
     """B seeded runs; every array has shape (B,).
 
     Attributes

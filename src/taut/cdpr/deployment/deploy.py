@@ -46,6 +46,7 @@ from ..sets.twist import available_twist_set
 from ..workspace.wrench_feasible import grid_points
 from ..sets.wrench import capacity_margin, wrench_feasible
 from ..._validate import require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["DeploymentOptions", "DeploymentResult", "plan_deployment", "evaluate_deployment"]
 
@@ -91,8 +92,8 @@ class DeploymentOptions:
                                               f"got {value!r}")
 
 
-@dataclass(frozen=True)
-class DeploymentResult:
+@dataclass(frozen=True, repr=False)
+class DeploymentResult(CompactRepr):
     """Outcome of :func:`plan_deployment`.
 
     When the placement-independent certificate refutes the box (``lift_bound.refutes``)

@@ -22,6 +22,7 @@ from .placement import workspace_box
 from ..workspace.wrench_feasible import grid_points
 from ..._validate import as_tolerance, require_instance
 from ..._validate import require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["LiftBound", "lift_bound", "upward_force_bound"]
 
@@ -152,8 +153,8 @@ def _max_mean_lift(q: np.ndarray, t: float, c: float, rtol: float = LIFT_RTOL,
     return bound, best, arg
 
 
-@dataclass(frozen=True)
-class LiftBound:
+@dataclass(frozen=True, repr=False)
+class LiftBound(CompactRepr):
     """Outcome of :func:`lift_bound`: can any placement of the mobile bases lift platform
     and payload everywhere on the top face of a workspace box?
 

@@ -53,6 +53,7 @@ from ..kinematics.modes import MotionLimits, fastkit_motion_limits, resolve_mode
 from .placement import place_bases, workspace_box
 from ..workspace.wrench_feasible import grid_points
 from ..sets.wrench import wrench_feasible
+from ..._repr import CompactRepr
 
 #: Most stages (placements of the moving base) a deployment may use: each adds a full
 #: placement search, and the per-slice certificate already stops refuting at 5 (FASTKIT).
@@ -90,8 +91,8 @@ def staged_lift_bound(robot: CableRobot, workspace: ArrayLike, stages: int, *,
     return min(certs, key=lambda c: c.bound - c.required)
 
 
-@dataclass(frozen=True)
-class MovingDeploymentResult:
+@dataclass(frozen=True, repr=False)
+class MovingDeploymentResult(CompactRepr):
     """Outcome of :func:`plan_moving_deployment`.
 
     Attributes
@@ -262,8 +263,8 @@ def plan_moving_deployment(robot: CableRobot, workspace: ArrayLike, *, stages: i
                                   results[0].robot, calls, cert)
 
 
-@dataclass(frozen=True)
-class BaseDrivePlan:
+@dataclass(frozen=True, repr=False)
+class BaseDrivePlan(CompactRepr):
     """Outcome of :func:`plan_base_drive`: the platform held while bases drive on their
     wheels, then their stabilisers deployed in place.
 

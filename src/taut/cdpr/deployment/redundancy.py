@@ -36,6 +36,7 @@ from ..kinematics.first_order import FirstOrderModel, first_order_model
 from ..model.robot import CableRobot
 from ..kinematics.modes import ModeName, MotionLimits, fastkit_motion_limits, joint_bounds
 from ..._validate import as_tolerance, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["OBJECTIVES", "RedundancyResult", "resolve_redundancy"]
 
@@ -43,8 +44,8 @@ OBJECTIVES = ("min_norm", "least_base")
 Objective = Literal["min_norm", "least_base"]
 
 
-@dataclass(frozen=True)
-class RedundancyResult:
+@dataclass(frozen=True, repr=False)
+class RedundancyResult(CompactRepr):
     """Joint rates for one desired platform twist.
 
     Attributes

@@ -19,12 +19,13 @@ from .deploy import DeploymentResult, plan_deployment
 from .lift import LiftBound, lift_bound
 from ..model.robot import CableRobot
 from .placement import workspace_box
+from ..._repr import CompactRepr
 
 __all__ = ["TallestWorkspace", "tallest_workspace"]
 
 
-@dataclass(frozen=True)
-class TallestWorkspace:
+@dataclass(frozen=True, repr=False)
+class TallestWorkspace(CompactRepr):
     """Outcome of :func:`tallest_workspace`.
 
     Attributes

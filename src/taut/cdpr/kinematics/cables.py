@@ -20,6 +20,7 @@ from ...errors import InfeasiblePoseError, InvalidInputError
 from .._batching import is_single, unbatch
 from .._tol import BOX_REL, ZERO_LENGTH_REL
 from ..model.robot import CableRobot
+from ..._repr import CompactRepr
 
 __all__ = ["as_poses", "rotation_matrices", "CableState", "cable_state", "wrench_matrix",
            "gravity_wrench", "tipping_matrix"]
@@ -77,8 +78,8 @@ def rotation_matrices(rpy: ArrayLike) -> np.ndarray:
     return R
 
 
-@dataclass(frozen=True)
-class CableState:
+@dataclass(frozen=True, repr=False)
+class CableState(CompactRepr):
     """Inverse kinematics of a batch of poses (one pose: every leading B axis dropped).
 
     Attributes

@@ -42,6 +42,7 @@ from .cables import as_poses, cable_state
 from ..model.robot import CableRobot
 from .modes import BASE_JOINTS, Mode, ModeName, resolve_mode
 from ..._validate import as_array, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["FirstOrderModel", "first_order_model", "parallel_jacobian", "base_jacobians"]
 
@@ -93,8 +94,8 @@ def parallel_jacobian(robot: CableRobot, poses: ArrayLike) -> np.ndarray:
     return np.swapaxes(-cable_state(robot, poses).W, -1, -2)
 
 
-@dataclass(frozen=True)
-class FirstOrderModel:
+@dataclass(frozen=True, repr=False)
+class FirstOrderModel(CompactRepr):
     """``A t = B q_dot`` at B poses (FASTKIT eqs. 4, 8, 9).
 
     Attributes

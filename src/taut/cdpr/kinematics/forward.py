@@ -30,6 +30,7 @@ from .._batching import unbatch
 from .cables import as_poses, rotation_matrices
 from ..model.robot import CableRobot
 from ..._validate import as_count, as_flag, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["CableFKResult", "cable_forward_kinematics"]
 
@@ -66,8 +67,8 @@ def rpy_from_matrices(R: np.ndarray) -> np.ndarray:
     return np.column_stack([roll, pitch, yaw])
 
 
-@dataclass(frozen=True)
-class CableFKResult:
+@dataclass(frozen=True, repr=False)
+class CableFKResult(CompactRepr):
     """Poses for a batch of cable-length vectors (one vector (m,): the leading B axis of
     every array dropped, ``success`` a bool, ``status`` a str).
 

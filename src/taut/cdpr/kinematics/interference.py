@@ -34,6 +34,7 @@ from ...errors import InvalidInputError
 from ..model.robot import CableRobot
 from ..._validate import (MAX_CDPR_LENGTH_M, as_array, as_bounded, as_tolerance, check_range,
     require_instance)
+from ..._repr import CompactRepr
 
 __all__ = ["segment_distance", "Interference", "cable_interference"]
 
@@ -76,8 +77,8 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
     return np.sqrt(np.einsum("...i,...i", gap, gap))
 
 
-@dataclass(frozen=True)
-class Interference:
+@dataclass(frozen=True, repr=False)
+class Interference(CompactRepr):
     """Interference of the cables at B poses (one pose: the leading B axis dropped).
 
     Attributes

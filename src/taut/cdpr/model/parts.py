@@ -20,6 +20,7 @@ from .._tol import INERTIA_REL
 from .footprint import check_footprint
 from .footprint import convex_hull_2d as _convex_hull_2d
 from .footprint import inside_convex as _inside_convex
+from ..._repr import CompactRepr
 
 __all__ = ["Base", "Platform", "Payload", "Cable"]
 
@@ -37,8 +38,8 @@ def _named_points(points: Mapping[str, Any], fld: str) -> tuple[tuple[str, ...],
     return names, arr
 
 
-@dataclass(frozen=True, eq=False)
-class Base:
+@dataclass(frozen=True, eq=False, repr=False)
+class Base(CompactRepr):
     """A cable robot base: a fixed frame or a mobile base carrying cable exit points.
 
     Parameters
@@ -149,8 +150,8 @@ class Base:
         return self.footprint
 
 
-@dataclass(frozen=True, eq=False)
-class Platform:
+@dataclass(frozen=True, eq=False, repr=False)
+class Platform(CompactRepr):
     """The moving platform.
 
     Parameters

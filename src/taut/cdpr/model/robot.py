@@ -25,13 +25,14 @@ from ...errors import InvalidModelError
 from .footprint import check_footprint
 from .parts import Base, Cable, Payload, Platform
 from ..._validate import as_flag, require_instance, require_instances
+from ..._repr import CompactRepr
 
 __all__ = ["Base", "Platform", "Payload", "Cable", "CableRobot", "check_footprint",
            "with_stabilisers", "with_friction"]
 
 
-@dataclass(frozen=True, eq=False)
-class CableRobot:
+@dataclass(frozen=True, eq=False, repr=False)
+class CableRobot(CompactRepr):
     """A validated cable-driven parallel robot (fixed or on mobile bases).
 
     Parameters

@@ -21,12 +21,13 @@ from scipy.optimize import linprog
 from ..._validate import as_array, as_flag, check_range
 from ...errors import InvalidInputError
 from .._tol import CONTAINS_TOL, SPAN_TOL, ZERO_ROW
+from ..._repr import CompactRepr
 
 __all__ = ["HPolytopeBatch", "lp_max_step"]
 
 
-@dataclass(frozen=True)
-class HPolytopeBatch:
+@dataclass(frozen=True, repr=False)
+class HPolytopeBatch(CompactRepr):
     """B polyhedra ``{x : H x <= h, E x = 0}`` in R^n, or one polyhedron.
 
     One polyhedron (the set at one pose) has no leading axis (``H`` (S, n), ``h`` (S,),

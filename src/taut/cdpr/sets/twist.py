@@ -31,12 +31,13 @@ from ..kinematics.modes import (TWIST_LABELS, Mode, ModeName, MotionLimits, fast
 from .polytope import HPolytopeBatch, lp_max_step
 from .zonotope import _facets_base_and_identity, zonotope_hrep
 from ..._validate import as_choice, as_count, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["AvailableTwistSet", "available_twist_set", "TwistCapacities", "twist_capacities",
            "support"]
 
-@dataclass(frozen=True)
-class AvailableTwistSet(HPolytopeBatch):
+@dataclass(frozen=True, repr=False)
+class AvailableTwistSet(HPolytopeBatch, CompactRepr):
     """Exact available twist set at B poses: ``{t : H t <= h, E t = 0}``, a
     :class:`~taut.cdpr.sets.polytope.HPolytopeBatch` of platform twists.
 
@@ -161,8 +162,8 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     return ats
 
 
-@dataclass(frozen=True)
-class TwistCapacities:
+@dataclass(frozen=True, repr=False)
+class TwistCapacities(CompactRepr):
     """Largest pure platform velocity along each axis (FASTKIT Fig. 13), per pose.
 
     ``positive[b, k]`` is the largest ``s >= 0`` with ``s e_k`` in the ATS (the other five

@@ -42,6 +42,7 @@ from .._tol import CONTAINS_TOL, VERTEX_SLACK, ZERO_ROW
 from ..kinematics.cables import as_poses, cable_state, gravity_wrench
 from ..model.robot import CableRobot
 from .polytope import HPolytopeBatch, lp_max_step
+from ..._repr import CompactRepr
 
 __all__ = ["AvailableWrenchSet", "available_wrench_set", "wrench_feasible",
            "AxisCapacities", "axis_capacities", "capacity_margin", "external_wrench_box",
@@ -50,8 +51,8 @@ __all__ = ["AvailableWrenchSet", "available_wrench_set", "wrench_feasible",
 AXIS_LABELS = ("fx", "fy", "fz", "mx", "my", "mz")
 
 
-@dataclass(frozen=True)
-class AvailableWrenchSet(HPolytopeBatch):
+@dataclass(frozen=True, repr=False)
+class AvailableWrenchSet(HPolytopeBatch, CompactRepr):
     """H-representation ``{w : H w <= h}`` of the AWS at B poses (FASTKIT eq. 24), a
     :class:`~taut.cdpr.sets.polytope.HPolytopeBatch` of cable wrenches.
 
@@ -245,8 +246,8 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     return first(out) if single else out
 
 
-@dataclass(frozen=True)
-class AxisCapacities:
+@dataclass(frozen=True, repr=False)
+class AxisCapacities(CompactRepr):
     """Largest extra external wrench along each axis the platform can resist on top of its
     weight (FASTKIT Fig. 14), per pose.
 

@@ -45,6 +45,7 @@ from .sliding import sliding_rows
 from .._tol import QP_PARALLEL, QP_ROW_SQ, RESIDUAL_REL, SLSQP_FTOL, SLSQP_REL
 from ..kinematics.cables import CableState, as_poses, cable_state, tipping_matrix
 from ..model.robot import CableRobot
+from ..._repr import CompactRepr
 
 __all__ = ["TensionResult", "distribute_tensions", "METHODS"]
 
@@ -54,8 +55,8 @@ QPSolver = Literal["auto", "enumeration", "daqp", "scipy"]
 METHODS: tuple[str, ...] = get_args(TensionMethod)
 
 
-@dataclass(frozen=True)
-class TensionResult:
+@dataclass(frozen=True, repr=False)
+class TensionResult(CompactRepr):
     """Tensions for a batch of poses; for one pose every leading B axis is dropped
     (``tensions`` (m,), ``success`` a bool, ``status`` and ``binding`` a str, ``residual`` a
     float).

@@ -26,12 +26,13 @@ from .._batching import is_single, unbatch
 from ._common import feas_tol
 from ..kinematics.cables import as_poses, cable_state, tipping_matrix
 from ..model.robot import CableRobot
+from ..._repr import CompactRepr
 
 __all__ = ["TippingResult", "tipping_moments"]
 
 
-@dataclass(frozen=True)
-class TippingResult:
+@dataclass(frozen=True, repr=False)
+class TippingResult(CompactRepr):
     """Edge moments at a batch of poses (one pose: the leading B axis dropped).
 
     Attributes

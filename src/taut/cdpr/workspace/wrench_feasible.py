@@ -16,6 +16,7 @@ from .closure import closure_pass, inside_pass
 from ..model.robot import CableRobot
 from ..sets.wrench import wrench_feasible
 from ..._validate import as_count, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["WorkspaceResult", "grid_points", "wrench_feasible_workspace"]
 
@@ -41,8 +42,8 @@ def grid_points(box: ArrayLike, shape: ArrayLike) -> tuple[np.ndarray, tuple[int
     return np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]), eff
 
 
-@dataclass(frozen=True)
-class WorkspaceResult:
+@dataclass(frozen=True, repr=False)
+class WorkspaceResult(CompactRepr):
     """Wrench-feasible workspace on a set of positions.
 
     Attributes

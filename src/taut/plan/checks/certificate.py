@@ -31,12 +31,13 @@ from shapely.ops import unary_union
 from .. import _tol
 from ..world import Scenario
 from ..._validate import as_count, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["Certificate", "find_certificate"]
 
 
-@dataclass(frozen=True, eq=False)
-class Certificate:
+@dataclass(frozen=True, eq=False, repr=False)
+class Certificate(CompactRepr):
     """Proof that no plan exists (see module docstring).
 
     Attributes

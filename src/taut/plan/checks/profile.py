@@ -20,12 +20,13 @@ from ...errors import InvalidInputError
 from ..._validate import require_instance
 from ..result import PlanResult
 from ._geometry import beneath_height, pair_slack
+from ..._repr import CompactRepr
 
 __all__ = ["PlanProfile", "plan_profile"]
 
 
-@dataclass(frozen=True, eq=False)
-class PlanProfile:
+@dataclass(frozen=True, eq=False, repr=False)
+class PlanProfile(CompactRepr):
     """Per-sample profile of a plan (:func:`plan_profile`); every array has shape (T,).
 
     Attributes

@@ -57,6 +57,7 @@ from ..world import Scenario
 from ..._validate import (MAX_SHEET_LENGTH, as_array, as_bounded, as_count, require_instance,
     require_nonempty)
 from .._tol import MAX_SHEET_MARGIN_M
+from ..._repr import CompactRepr
 
 __all__ = ["Verification", "verify_motion", "resample_motion"]
 
@@ -64,8 +65,8 @@ __all__ = ["Verification", "verify_motion", "resample_motion"]
 TOLERANCE = _tol.GEOMETRY_TOL
 
 
-@dataclass(frozen=True, eq=False)
-class Verification:
+@dataclass(frozen=True, eq=False, repr=False)
+class Verification(CompactRepr):
     """Outcome of :func:`verify_motion`.
 
     Attributes

@@ -64,6 +64,7 @@ from ._problem import (MIN_DEPTH_FRACTION, CostWeights, _curvature_constraint, _
     _nominal_ik, _problem)
 from ..world import Team
 from ..._validate import MAX_SHEET_LENGTH, as_bounded, as_choice, as_count, require_instance
+from ..._repr import CompactRepr
 
 __all__ = ["CostWeights", "Formation", "optimal_formation", "crossing_pairs",
            "offset_crossings"]
@@ -73,8 +74,8 @@ FormationKind = Literal["crossing", "compact", "narrow"]
 FORMATION_KINDS: tuple[str, ...] = ("crossing", "compact", "narrow")
 
 
-@dataclass(frozen=True, eq=False)
-class Formation:
+@dataclass(frozen=True, eq=False, repr=False)
+class Formation(CompactRepr):
     """A rigid team formation holding the object stably with every cable taut.
 
     Attributes

@@ -39,6 +39,7 @@ from ...sheet import forward_kinematics
 from .route import Leg, Route
 from ..world import Scenario
 from ..._validate import require_instance, require_instances
+from ..._repr import CompactRepr
 
 __all__ = ["CrossingRecord", "Motion", "motion_from_legs"]
 
@@ -52,8 +53,8 @@ def _wrap(a: float) -> float:
     return float(np.angle(np.exp(1j * a)))
 
 
-@dataclass(frozen=True, eq=False)
-class CrossingRecord:
+@dataclass(frozen=True, eq=False, repr=False)
+class CrossingRecord(CompactRepr):
     """One execution of Algorithm 2.
 
     Attributes
@@ -81,8 +82,8 @@ class CrossingRecord:
     kind: str = "algorithm2"
 
 
-@dataclass(frozen=True, eq=False)
-class Motion:
+@dataclass(frozen=True, eq=False, repr=False)
+class Motion(CompactRepr):
     """Sampled motion of the team.
 
     Attributes

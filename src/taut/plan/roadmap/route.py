@@ -39,6 +39,7 @@ from .. import _tol
 from ..formations.optimal import Formation, _crossing_pairs, _offset_crossings
 from ..world import Obstacle, Scenario
 from ..._validate import as_flag, require_instance, require_instances
+from ..._repr import CompactRepr
 
 __all__ = ["Leg", "Route", "find_route"]
 
@@ -51,8 +52,8 @@ QUAD_SEGS = 8
 _EPS = _tol.CROSSING_OVERSHOOT
 
 
-@dataclass(frozen=True, eq=False)
-class Leg:
+@dataclass(frozen=True, eq=False, repr=False)
+class Leg(CompactRepr):
     """One piece of a route: a straight ``"move"``, a ``"cross"``-ing of ``obstacle``
     (Algorithm 2) from ``start`` through the obstacle's centre to ``end``, or a
     ``"reform"`` into formation number ``formation`` in place. ``formation`` indexes

@@ -52,6 +52,7 @@ from scipy.optimize import linprog
 from ._branch import BranchProof, branch_proof, pair_cosine_limits, verify_branch_proof
 from .._tol import (CERTIFICATE_MIN_MARGIN, DEPTH_RTOL, MULTIPLIER_SUM_TOL, RELAX_COS_SLACK,
     SPACING_MARGIN)
+from ..._repr import CompactRepr
 
 __all__ = ["IKCertificate", "CertificateKind", "depth_certificate", "radial_certificate",
            "triangle_certificate", "closure_lp_certificate", "verify_certificate",
@@ -61,8 +62,8 @@ CertificateKind = Literal["depth", "radial_spacing", "triangle", "closure_lp",
                           "closure_branch"]
 
 
-@dataclass(frozen=True, eq=False)
-class IKCertificate:
+@dataclass(frozen=True, eq=False, repr=False)
+class IKCertificate(CompactRepr):
     """Why no stable all-taut formation exists for a target (module docstring).
 
     Attributes

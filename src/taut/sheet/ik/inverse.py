@@ -417,8 +417,8 @@ def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
         Target :math:`\\mathbf{p}_o = (x_o, y_o, z_o)`, :math:`z_o > 0`, same length unit
         as the sheet.
     contact : array_like, shape (2,), optional
-        Where the object sits on the sheet, :math:`\\mathbf{v}_o` (sheet frame), strictly
-        inside the sheet. Default: the sheet's area centroid.
+        Where the object sits on the sheet, :math:`\\mathbf{v}_o` (sheet frame, same length
+        unit as the sheet), strictly inside the sheet. Default: the sheet's area centroid.
     heading : float
         Rotation (radians, counter-clockwise) of the formation about the vertical through
         the object; at 0 cable ``i`` points roughly along :math:`\\mathbf{v}_i - \\mathbf{v}_o`.

@@ -10,12 +10,13 @@ from ..._outcome import check_status
 from ._certificate import IKCertificate
 from .._tol import IK_FEASIBLE_RTOL, TINY
 from ..model import GEOMETRY_RTOL
+from ..._repr import CompactRepr
 
 __all__ = ["IKResult", "IKConstraints"]
 
 
-@dataclass(frozen=True, eq=False)
-class IKResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class IKResult(CompactRepr):
     """Outcome of inverse kinematics: a formation that holds the object stably at the
     target with every cable taut, or why there is none.
 
@@ -89,8 +90,8 @@ class IKResult:
         return float(self.weights.min())
 
 
-@dataclass(frozen=True, eq=False)
-class IKConstraints:
+@dataclass(frozen=True, eq=False, repr=False)
+class IKConstraints(CompactRepr):
     """Conditions of an all-taut stable rest state for given angles (and weights).
 
     Every field is zero/non-negative at a valid IK solution; optimisers over the angles

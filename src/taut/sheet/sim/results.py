@@ -9,14 +9,15 @@ from typing import Literal
 import numpy as np
 
 from ..._outcome import check_status
+from ..._repr import CompactRepr
 
 __all__ = ["EventKind", "SimulationEvent", "SimulationResult", "SimulatorState"]
 
 EventKind = Literal["taut_change", "jump", "lost", "recovered"]
 
 
-@dataclass(frozen=True, eq=False)
-class SimulationEvent:
+@dataclass(frozen=True, eq=False, repr=False)
+class SimulationEvent(CompactRepr):
     """Something discontinuous that happened between steps ``step - 1`` and ``step``.
 
     Attributes
@@ -48,8 +49,8 @@ class SimulationEvent:
     drop: float
 
 
-@dataclass(frozen=True, eq=False)
-class SimulationResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class SimulationResult(CompactRepr):
     """Object state at every step of a quasi-static simulation.
 
     Attributes
@@ -111,8 +112,8 @@ class SimulationResult:
 
 
 
-@dataclass(frozen=True, eq=False)
-class SimulatorState:
+@dataclass(frozen=True, eq=False, repr=False)
+class SimulatorState(CompactRepr):
     """The object after a :meth:`taut.sheet.Simulator.step`.
 
     Attributes
