@@ -28,6 +28,9 @@ Equilibrium
     One rest state: taut cables, object, contact point, load shares, tensions, kind.
 Funnel
     Step counts of Algorithm 1 (``method="exhaustive"``).
+object_covariance
+    Object position covariance from robot position covariance through an equilibrium's
+    ``jacobian`` (its sensitivities: docs/sheet_sensitivity.md).
 
 Inverse kinematics
 ------------------
@@ -107,6 +110,7 @@ from ._options import METHODS, Backend, Method
 if TYPE_CHECKING:                   # the real names, for type checkers
     from .fk.forward import forward_kinematics, forward_kinematics_batch
     from .fk.results import BatchFKResult, Equilibrium, EquilibriumKind, FKResult, Funnel
+    from .sensitivity import object_covariance
     from .fk.solver import COMPILED_MAX_N, HAVE_NUMBA, FKSolver
     from .geometry import (FormationMetrics, formation_metrics, formation_size,
                            max_obstacle_diameter, max_obstacle_height, min_robot_distance,
@@ -125,6 +129,7 @@ _HOME = {
     "forward_kinematics": "fk.forward", "forward_kinematics_batch": "fk.forward",
     "BatchFKResult": "fk.results", "Equilibrium": "fk.results",
     "EquilibriumKind": "fk.results", "FKResult": "fk.results", "Funnel": "fk.results",
+    "object_covariance": "sensitivity",
     "COMPILED_MAX_N": "fk.solver", "HAVE_NUMBA": "fk.solver", "FKSolver": "fk.solver",
     "FormationMetrics": "geometry", "formation_metrics": "geometry",
     "formation_size": "geometry", "max_obstacle_diameter": "geometry",
@@ -146,7 +151,7 @@ __all__ = [
     "Sheet", "SheetTeam", "check_formation", "check_formations", "check_hold_height",
     # Forward kinematics
     "forward_kinematics", "forward_kinematics_batch", "FKSolver", "FKResult",
-    "BatchFKResult", "Equilibrium", "Funnel",
+    "BatchFKResult", "Equilibrium", "Funnel", "object_covariance",
     # Inverse kinematics
     "inverse_kinematics", "IKResult", "IKCertificate", "IKConstraints", "ik_constraints",
     "formation_from_angles", "contact_weights",

@@ -21,9 +21,11 @@ from ...errors import InvalidInputError
 from .._lifted import KIND_NAMES, KIND_NOT_EQUILIBRIUM, KIND_STABLE
 from .._tol import MERGE_RTOL
 from ..model import Sheet, check_formation
-from ._lowest import OFF_SHEET, lowest_by_descent, may_find_stable
+from ._lowest import NO_REST, OFF_SHEET, lowest_by_descent, may_find_stable
 from ._merge import coincident_groups, merged_weights
 from ._solve import explain_no_equilibrium
+from ._sensitivity import Sensitivity, equilibrium_sensitivity
+from ..._repr import CompactRepr
 
 __all__ = ["Equilibrium", "Funnel", "FKResult", "BatchFKResult", "EquilibriumKind"]
 
@@ -86,10 +88,62 @@ class Equilibrium:
         """Object height :math:`z_o`."""
         return float(self.object[2])
 
+    @property
+    def jacobian(self) -> np.ndarray:
+        """Derivative of the object position with respect to every robot's position,
+        shape (3, N, 2): ``jacobian[c, j, a]`` = d (x_o, y_o, z_o)[c] / d (robot j)[a]
+        (dimensionless), exact within the taut set (implicit function theorem on the
+        stationarity conditions, docs/sheet_sensitivity.md); zero for slack robots, NaN
+        where the state's system is singular (more than five taut cables, or dependent
+        ones). Computed on first access."""
+        return self._sensitivity().object
+
+    @property
+    def contact_jacobian(self) -> np.ndarray:
+        """d v_o / d (robot j), shape (2, N, 2), dimensionless (as :attr:`jacobian`)."""
+        return self._sensitivity().contact
+
+    @property
+    def weight_jacobian(self) -> np.ndarray:
+        """d w_i / d (robot j), shape (k, N, 2), per length unit (as :attr:`jacobian`;
+        rows in the order of :attr:`weights`)."""
+        return self._sensitivity().weights
+
+    @property
+    def tension_jacobian(self) -> np.ndarray | None:
+        """d F_i / d (robot j), shape (k, N, 2), N per length unit of
+        :math:`F_i = w_i m g l_i / d`; None without a mass."""
+        return self._sensitivity().tensions
+
+    @property
+    def taut_margin(self) -> float:
+        """Robot motion (length unit: the Frobenius norm of the (N, 2) displacement) to
+        the nearest change of taut set predicted by the linearisation: a load share
+        reaching 0 or a slack cable becoming taut (0 when a share is not positive; a
+        motion with every robot within ``taut_margin / sqrt(N)`` stays inside)."""
+        return self._sensitivity().margin
+
+    def _sensitivity(self) -> Sensitivity:
+        """The cached :class:`~taut.sheet.fk._sensitivity.Sensitivity` (the formation it
+        needs is attached by the :class:`FKResult` that reports this state)."""
+        sens = self.__dict__.get("_sens")
+        if sens is None:
+            ctx = self.__dict__.get("_ctx")
+            if ctx is None:
+                raise InvalidInputError("equilibrium", "has no formation attached: "
+                                        "sensitivities exist for states reported by "
+                                        "forward kinematics")
+            vertices, formation, hold_height, mass, scale = ctx
+            sens = equilibrium_sensitivity(vertices, formation, hold_height, mass, scale,
+                                           self.taut, self.object, self.contact,
+                                           self.weights)
+            self.__dict__["_sens"] = sens
+        return sens
+
     def __repr__(self) -> str:
-        taut = "{" + ",".join(str(i + 1) for i in self.taut) + "}"
-        p = ", ".join(f"{c:.6g}" for c in self.object)
-        return f"Equilibrium(taut={taut} (1-based), object=({p}), kind={self.kind!r})"
+        p = ", ".join(f"{c:.6g}" for c in self.object)      # taut as the attribute: 0-based
+        return (f"Equilibrium(taut={tuple(int(i) for i in self.taut)}, object=({p}), "
+                f"kind={self.kind!r})")
 
 
 @dataclass(frozen=True)
@@ -294,6 +348,10 @@ class FKResult:
         eqs, direct, why = _with_lowest(eqs, self.sheet, self.formation, self.hold_height,
                                         self.mass)
         self.__dict__.update(_direct=direct, _why=why)
+        ctx = (self.sheet.vertices, self.formation, self.hold_height, self.mass,
+               self.sheet.size)                  # for the states' lazy sensitivities
+        for e in eqs:
+            e.__dict__["_ctx"] = ctx
         return eqs
 
     def _row_states(self, rows: np.ndarray) -> tuple[Equilibrium, ...]:
@@ -374,9 +432,11 @@ class FKResult:
 
     def _describe(self) -> str:
         eqs = self.equilibria
-        off = ("; the object slides off the sheet (descending its height carries the "
-               "contact point over the sheet's edge: no rest state)"
-               if self._why == OFF_SHEET else "")
+        off = {OFF_SHEET: "; the object slides off the sheet (descending its height carries "
+                          "the contact point over the sheet's edge: no rest state)",
+               NO_REST: "; no rest state: a direct minimisation of the height stops where "
+                        "no non-negative load shares balance the object",
+               }.get(self._why or "", "")
         if not eqs:
             return "no equilibrium: " + explain_no_equilibrium(
                 self.sheet, self.formation, self.hold_height) + off
@@ -462,15 +522,16 @@ class FKResult:
                 f"equilibria={len(self)}, stable={len(self.stable)})")
 
 
-@dataclass(frozen=True, eq=False)
-class BatchFKResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class BatchFKResult(CompactRepr):
     """Forward kinematics of ``B`` formations of one sheet, as padded arrays.
 
     Row ``b`` holds ``count[b]`` solutions in slots ``0..count[b]-1`` (same order as
     :class:`FKResult`); later slots are padding (``valid`` False, NaN positions). A
     formation the sheet cannot span (a robot pair farther apart than its sheet vertices)
     has no solutions, ``feasible`` False and ``status`` ``"infeasible"``; the other rows
-    are answered as usual.
+    are answered as usual. The states' sensitivities (``jacobian``, ``taut_margin``, ...:
+    docs/sheet_sensitivity.md) are read per state, ``result(b).equilibria[k].jacobian``.
 
     Attributes
     ----------
