@@ -13,12 +13,15 @@ from ..errors import InvalidInputError
 from ..io.serialize import plan_to_dict, robustness_to_dict, to_json
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
+from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, write_recordings
 
 __all__ = ["register", "plan_command"]
 
 #: The command-line option of each library keyword whose name differs (the others are
 #: ``--`` and the keyword with dashes).
-_OPTION_OF = {"time_budget": "--budget", "sigma": "--robustness"}
+_OPTION_OF = {"time_budget": "--budget", "sigma": "--robustness",
+              "max_speed": "--max-speed-mps", "max_accel": "--max-accel-mps2",
+              "max_yaw_rate": "--max-yaw-rate-radps", "reform_speed": "--reform-speed-mps"}
 
 
 def plan_command(
@@ -61,18 +64,41 @@ def plan_command(
                                                "(seeded Monte Carlo): failure "
                                                "probabilities."),
     trials: int = typer.Option(100, "--trials", help="Trials of --robustness."),
+    mcap: Optional[Path] = typer.Option(None, "--mcap", help=MCAP_HELP + " With "
+                                        "--trajectories: the per-robot trajectories."),
+    rerun: Optional[Path] = typer.Option(None, "--rerun", help=RERUN_HELP),
+    trajectories: Optional[Path] = typer.Option(
+        None, "--trajectories", help="Also write one trajectory per robot (time s, x m, y "
+        "m, heading rad; the object m), re-verified on the executed motion (.csv or "
+        ".json); needs --max-speed-mps, --max-accel-mps2 and --max-yaw-rate-radps."),
+    drive: str = typer.Option("holonomic", "--drive", help="Robot drive of --trajectories: "
+                              "holonomic or differential (faces its motion, turns in "
+                              "place)."),
+    max_speed: Optional[float] = typer.Option(None, "--max-speed-mps", help="Largest robot "
+                                              "speed of --trajectories, m/s."),
+    max_accel: Optional[float] = typer.Option(None, "--max-accel-mps2", help="Largest "
+                                              "robot acceleration of --trajectories, "
+                                              "m/s^2."),
+    max_yaw_rate: Optional[float] = typer.Option(None, "--max-yaw-rate-radps",
+                                                 help="Largest robot turn rate of "
+                                                      "--trajectories, rad/s."),
+    reform_speed: Optional[float] = typer.Option(None, "--reform-speed-mps",
+                                                 help="Largest robot speed during "
+                                                      "formation changes, m/s (default "
+                                                      "the library's 0.05: quasi-static)."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad
-    input."""
+    input. (Long because typer declares every option as a parameter; the body validates,
+    calls the library and hands the outputs to the helpers below.)"""
     from ..io.plan_scenario import load_plan_scenario
-    from ..plan.checks.robustness import monte_carlo
     from ..plan._options import plan_options, robustness_options
     from ..plan.planner import run_plan
 
     out = output_path(out, "--out", JSON_SUFFIXES)
     plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
     animate = output_path(animate, "--animate", ANIMATION_SUFFIXES)
+    mcap, rerun = recording_paths(mcap, rerun)
     if baseline and disc_baseline:
         raise InvalidInputError("--baseline", "give at most one of --baseline and "
                                 "--disc-baseline")
@@ -84,26 +110,83 @@ def plan_command(
             search=search, spacing=spacing)
         replays = robustness_options(0.0 if robustness is None else robustness, trials,
                                      seed=seed)
+        executed = _trajectory_options(trajectories, drive, max_speed, max_accel,
+                                       max_yaw_rate, reform_speed)
     sc = load_plan_scenario(scenario)
     with working("plan"):
         result = run_plan(sc, options)
+    rob, traj, doc = _analyses(result, replays if robustness is not None else None,
+                               executed, trajectories)
+    _write_outputs(sc, result, traj, doc, out, plot, animate, mcap, rerun, as_json)
+    _report(result, rob, doc, as_json, plot, animate, mcap, rerun)
+    return 0 if result.success and (traj is None or traj.success) else 1
+
+
+def _analyses(result, replays, executed, trajectories: Optional[Path]):
+    """The plan's JSON form with what was asked of it: the robustness replays (``replays``
+    given) and the per-robot trajectories (``executed`` given, written to their file)."""
+    from ..plan.checks.robustness import monte_carlo
+
     doc = plan_to_dict(result)
-    rob = None
-    if robustness is not None and result.success:
+    rob = traj = None
+    if replays is not None and result.success:
         with working("robustness"):
             rob = monte_carlo(result, replays)
         doc["robustness"] = robustness_to_dict(rob)
+    if executed is not None and result.success:
+        from ..plan.execution.trajectories import _robot_trajectories
+        with working("trajectories"):
+            traj = _robot_trajectories(result, *executed)
+        _write_trajectories(trajectories, traj, doc)
+    return rob, traj, doc
+
+
+def _write_outputs(sc, result, traj, doc: dict, out: Optional[Path], plot: Optional[Path],
+                   animate: Optional[Path], mcap: Optional[Path], rerun: Optional[Path],
+                   as_json: bool) -> None:
+    """The recordings, the JSON file and the figures of a plan (none without a plan)."""
+    if result.success:
+        if traj is not None and traj.success:
+            write_recordings(traj, mcap, rerun, quiet=as_json, plan=result)
+        else:
+            write_recordings(result, mcap, rerun, quiet=as_json)
     if out is not None:
         from ..io.files import write_text_atomic
         write_text_atomic(out, to_json(doc, indent=None) + "\n")
     if result.success and (plot is not None or animate is not None):
         from ..viz.plan import animate_plan, plot_plan
         if plot is not None:
-            plot_plan(sc, result, plot)
+            plot_plan(sc, result, plot, trajectories=traj)
         if animate is not None:
             animate_plan(sc, result, animate)
-    _report(result, rob, doc, as_json, plot, animate)
-    return 0 if result.success else 1
+
+
+def _trajectory_options(path: Optional[Path], drive: str, max_speed: Optional[float],
+                        max_accel: Optional[float], max_yaw_rate: Optional[float],
+                        reform_speed: Optional[float]):
+    """The validated options of ``--trajectories`` (None without it): the library's
+    validation, the limits it needs named as options."""
+    if path is None:
+        return None
+    from ..plan.execution.trajectories import trajectory_options
+    output_path(path, "--trajectories", (".csv", *JSON_SUFFIXES))
+    if max_speed is None or max_accel is None or max_yaw_rate is None:
+        name = ("max_speed" if max_speed is None else "max_accel" if max_accel is None
+                else "max_yaw_rate")                          # named as options below
+        raise InvalidInputError(name, "needed with --trajectories")
+    extra = {} if reform_speed is None else {"reform_speed": reform_speed}
+    return trajectory_options(drive, max_speed, max_accel, max_yaw_rate, **extra)
+
+
+def _write_trajectories(path, traj, doc: dict) -> None:
+    """Write the trajectories file and add their outcome to the plan's JSON."""
+    from ..io.robot_trajectories import robot_trajectories_to_dict, save_robot_trajectories
+    save_robot_trajectories(path, traj)
+    summary = robot_trajectories_to_dict(traj)
+    for key in ("times_s", "poses", "object_m"):
+        summary.pop(key)
+    doc["trajectories"] = summary
+    typer.echo(f"trajectories: {traj.message}", err=True)
 
 
 @contextmanager
@@ -118,7 +201,8 @@ def _named_as_options() -> Iterator[None]:
 
 
 def _report(result, rob, doc: dict, as_json: bool, plot: Optional[Path],
-            animate: Optional[Path]) -> None:
+            animate: Optional[Path], mcap: Optional[Path] = None,
+            rerun: Optional[Path] = None) -> None:
     """The plan's JSON, or its summary (and the robustness line); why figures were not
     written."""
     if as_json:
@@ -137,7 +221,8 @@ def _report(result, rob, doc: dict, as_json: bool, plot: Optional[Path],
     else:
         typer.echo(f"no plan ({result.status}): {result.message}")
     if not result.success:
-        for name, path in (("--plot", plot), ("--animate", animate)):
+        for name, path in (("--plot", plot), ("--animate", animate), ("--mcap", mcap),
+                           ("--rerun", rerun)):
             if path is not None:
                 typer.echo(f"taut: {name}: {path} not written: there is no plan to draw",
                            err=True)

@@ -66,6 +66,16 @@ plan_profile, PlanProfile
     it, least sheet slack over robot pairs.
 plan_robustness, Robustness
     Failure probabilities of a plan under robot position error (seeded Monte Carlo).
+object_feedback, ObjectFeedback
+    Closed-loop control of the measured object through the equilibria's Jacobians
+    against open loop, under the same robot errors.
+
+Execution
+---------
+robot_trajectories, RobotTrajectories
+    One time-parameterised trajectory per robot (holonomic or differential drive) under
+    speed, acceleration and yaw-rate limits, re-verified on the executed motion; its
+    outcome.
 
 Suite
 -----
@@ -81,9 +91,11 @@ UnknownObstacleError
 """
 
 from .checks.certificate import Certificate, find_certificate
+from .checks.feedback import ObjectFeedback, object_feedback
 from .checks.profile import PlanProfile, plan_profile
 from .checks.robustness import Robustness, plan_robustness
 from .checks.verify import Verification, resample_motion, verify_motion
+from .execution.trajectories import RobotTrajectories, robot_trajectories
 from .formations.library import formation_library
 from .formations.optimal import (CostWeights, Formation, crossing_pairs, offset_crossings,
     optimal_formation)
@@ -106,7 +118,10 @@ __all__ = [
     "Leg", "Route", "find_route", "Motion", "CrossingRecord", "motion_from_legs",
     # Checks and analyses
     "Verification", "verify_motion", "resample_motion", "Certificate", "find_certificate",
-    "PlanProfile", "plan_profile", "Robustness", "plan_robustness",
+    "PlanProfile", "plan_profile", "Robustness", "plan_robustness", "ObjectFeedback",
+    "object_feedback",
+    # Execution
+    "robot_trajectories", "RobotTrajectories",
     # Suite
     "generate_scenario", "generate_suite",
     # Results and errors

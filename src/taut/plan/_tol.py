@@ -169,3 +169,56 @@ MAX_TRIALS = 100_000
 #: Largest ``correlation`` time of the robustness analysis's position error, s (one hour:
 #: longer than any plan, so the error is then constant along it).
 MAX_CORRELATION_S = 3600.0
+
+# ---------------------------------------------------------------- executed trajectories
+# Per-robot trajectories of a plan (:mod:`taut.plan.execution`).
+
+#: Fastest any robot moves during a formation change, m/s: the planner's model is
+#: quasi-static (the object is taken at rest at every instant), so changes are driven
+#: slowly enough that the object settles. At 5 cm/s a robot moves 0.05 m in the ~1 s it
+#: takes a metre-sized sheet's pendulum (period 2 pi sqrt(L / g) ~ 1.4-2 s) to swing once,
+#: and the formation changes of the shipped plans move robots 0.1-0.5 m.
+REFORM_MAX_SPEED = 0.05
+#: A differential-drive robot whose direction of motion turns by more than this between
+#: two samples stops (with the whole team) and turns in place, rad; smaller turns are
+#: steered while moving (the heading changes linearly over the sample interval, so it is
+#: never further than this from the direction of motion).
+TURN_IN_PLACE = 0.1
+#: A robot moving less than this over a sample interval is standing still (its heading is
+#: kept), m: a differential drive then slips sideways by at most this much.
+STANDING_STILL = 1e-6
+#: Largest accepted ``max_speed`` (m/s), ``max_yaw_rate`` (rad/s), ``max_accel`` (m/s^2) and
+#: ``reform_speed`` (m/s) of a robot: far beyond any mobile robot's.
+MAX_ROBOT_LIMIT = 100.0
+
+# ---------------------------------------------------------------- feedback on the object
+# The object-feedback controller and its simulation (:mod:`taut.plan.checks.feedback`).
+
+#: Default standard deviation of the object measurement per axis, m (a camera or motion
+#: capture tracking the object: about a millimetre).
+MEASUREMENT_NOISE = 0.001
+#: Default gain of the controller: the fraction of the measured object error the robots
+#: correct per plan sample (an integrator; 0.5 at the plans' ~12 Hz samples settles in
+#: a few tenths of a second, faster than the 1 s drift of the robot errors).
+FEEDBACK_GAIN = 0.5
+#: Default damping of the damped least squares (dimensionless, as the Jacobian): keeps
+#: corrections along poorly controllable directions (the object's height, mostly) small.
+FEEDBACK_DAMPING = 0.1
+#: A correction step moves the robots by at most this fraction of the state's
+#: ``taut_margin`` (Frobenius norm), so the linearisation's taut set is kept.
+FEEDBACK_MARGIN_FRACTION = 0.5
+#: Largest accepted measurement noise, m, and gain / damping (dimensionless).
+MAX_MEASUREMENT_NOISE_M = 1.0
+MAX_FEEDBACK_GAIN = 1.0
+MAX_FEEDBACK_DAMPING = 10.0
+#: Largest correction step of the object-feedback controller per robot and plan sample, m
+#: (applied as this times sqrt(N) to the Frobenius norm over the robots): 3 mm per ~0.08 s
+#: sample follows the robustness errors' drift (up to 10 mm/s) with room.
+FEEDBACK_MAX_STEP = 0.003
+#: Controller steps at the plan's first sample before the team moves off (the object is
+#: lifted, measured and corrected first; at ~12 Hz about 1.7 s).
+FEEDBACK_SETTLE = 20
+#: Halvings of the object-feedback correction before it is dropped, when a commanded
+#: robot pair would come closer to its sheet distance than the plan's own slack or
+#: twice the robot error plus ``SHEET_MARGIN`` (whichever is less).
+FEEDBACK_HALVINGS = 6
