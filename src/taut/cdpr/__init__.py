@@ -145,6 +145,30 @@ Control
    CONTROLLERS -- the built-in controllers by name
    tune_for_rate -- built-in gains for another control rate and latency (one delay rule)
    ControlEvent -- one limit episode of a run
+
+Mission
+-------
+
+   Warehouse -- the floor, shelves, start and tasks of a mobile cable robot's mission
+   Shelf -- a rack or station footprint the bases keep off
+   Task -- a box to move from a pick point to a place point
+   coupled_footprint -- the rigid footprint of the coupled bases (navigation mode)
+   to_robot_frame -- world points in the robot frame of the coupled bases at a pose
+   to_world_frame -- robot-frame points in the world
+   plan_navigation -- a verified route of the coupled bases between two poses
+   NavigationResult -- its outcome: timed poses, or a refusal with a certificate
+   NavigationCertificate -- what a refusal proves
+   choose_sites -- deployment sites serving the tasks (greedy set cover)
+   SitesResult -- its outcome: sites and unserved tasks
+   Site -- one deployment: pose, deployed robot, tasks and platform targets
+   UnservedTask -- a task no site serves, and why
+   time_optimal_path -- time-optimal platform motion through waypoints (TOPP-RA)
+   TimedPath -- its outcome: the sampled law, speed limits, acceleration bounds
+   with_box -- the robot carrying a box of a given mass as its payload
+   plan_mission -- the whole mission planned and simulated, with its 1 m/s baseline
+   MissionResult -- its outcome: phases, total and baseline times, unserved tasks
+   Phase -- one phase: kind, task, times, margins
+   PHASE_KINDS -- the kinds of phase
 """
 
 from .model.parts import Base, Cable, Payload, Platform
@@ -189,6 +213,12 @@ from .control.references import Reference, pick_and_place, reference_from_sample
 from .control.controllers import (CONTROLLERS, ComputedTorqueController, Controller,
                                   TorqueController, VelocityController, tune_for_rate)
 from .control.monitors import ControlEvent
+from .mission.warehouse import (Shelf, Task, Warehouse, coupled_footprint, to_robot_frame,
+                                to_world_frame)
+from .mission.navigation import NavigationCertificate, NavigationResult, plan_navigation
+from .mission.sites import Site, SitesResult, UnservedTask, choose_sites
+from .mission.timing import TimedPath, time_optimal_path, with_box
+from .mission.mission import PHASE_KINDS, MissionResult, Phase, plan_mission
 
 __all__ = [
     # Model
@@ -224,4 +254,9 @@ __all__ = [
     "DynamicsModel", "ModelErrors", "Sensing", "Reference", "pick_and_place",
     "reference_from_samples", "Controller", "VelocityController", "TorqueController", "ComputedTorqueController",
     "CONTROLLERS", "tune_for_rate", "ControlEvent",
+    # Mission
+    "Warehouse", "Shelf", "Task", "coupled_footprint", "to_robot_frame", "to_world_frame",
+    "plan_navigation", "NavigationResult", "NavigationCertificate", "choose_sites",
+    "SitesResult", "Site", "UnservedTask", "time_optimal_path", "TimedPath", "with_box",
+    "plan_mission", "MissionResult", "Phase", "PHASE_KINDS",
 ]

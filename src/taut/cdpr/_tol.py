@@ -261,3 +261,14 @@ TALLEST_CERTIFICATE_TOL = 1e-3
 #: quadratically: two iterations leave < 1e-9 m), and at the first step from the reference.
 SENSING_FK_ITERATIONS = 2
 SENSING_FK_FIRST_ITERATIONS = 30
+
+# --- mission: navigation and sites (issue 30) -------------------------------------------
+#: Absolute tolerance of the navigation verifier's and the sites' clearance checks (m):
+#: shapely distances of metre-sized polygons are exact to ~1e-12 m; 1e-9 m forgives their
+#: round-off and nothing physical.
+NAV_TOL = 1e-9
+
+#: Bisections of the navigation verifier before an interval counts as not proved. Each
+#: halves the corner travel of the interval; 12 reach 1/4096 of a 0.1 s sample's travel
+#: (about 12 um at 0.5 m/s), far below any clearance a route is planned with.
+NAV_PROOF_DEPTH = 12

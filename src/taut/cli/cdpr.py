@@ -21,6 +21,7 @@ from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
 from .cdpr_motion import add_commands
 from .cdpr_sim import add_simulate
+from .cdpr_mission import add_mission
 
 __all__ = ["register"]
 
@@ -289,4 +290,5 @@ def register(app: typer.Typer) -> None:
 
     add_commands(sub)
     add_simulate(sub)
+    add_mission(sub)
     app.add_typer(sub, name="cdpr")

@@ -33,7 +33,7 @@ __all__ = ["to_json", "json_ready", "finite_or_none", "equilibrium_to_dict", "fk
            "ik_to_dict", "simulation_to_dict", "plan_to_dict", "tensions_to_dict",
            "wrench_set_to_dict", "workspace_to_dict", "twist_set_to_dict",
            "deployment_to_dict", "equilibria_check_to_dict", "control_result_to_dict",
-           "monte_carlo_to_dict", "robustness_to_dict"]
+           "monte_carlo_to_dict", "robustness_to_dict", "mission_to_dict"]
 
 def finite_or_none(x: Any, digits: int | None = None) -> float | None:
     """``float(x)`` (rounded to ``digits`` when given), or ``None`` when not finite.
@@ -369,3 +369,27 @@ def monte_carlo_to_dict(r: "MonteCarloResult") -> dict[str, Any]:
     out["success"] = [bool(x) for x in r.success]
     out["status"] = [str(x) for x in r.status]
     return out
+
+
+def mission_to_dict(r: Any) -> dict[str, Any]:
+    """A :class:`taut.cdpr.MissionResult` (SI units in every key; sites 1-based)."""
+    return {
+        "success": bool(r.success), "status": r.status, "message": r.message,
+        "total_time_s": finite_or_none(r.total_time, 6),
+        "baseline_total_time_s": finite_or_none(r.baseline_total_time, 6),
+        "speedup": finite_or_none(r.speedup, 6),
+        "motion_time_s": finite_or_none(r.motion_time, 6),
+        "baseline_motion_time_s": finite_or_none(r.baseline_motion_time, 6),
+        "served": list(r.served),
+        "unserved": [{"task": u.name, "reason": u.reason} for u in r.unserved],
+        "sites": [{"site": k + 1, "pose_m_rad": _rounded_list(s.pose, 6), "shelf": s.shelf,
+                   "tasks": list(s.task_names)} for k, s in enumerate(r.sites)],
+        "routes": [{"success": bool(n.success), "status": n.status, "message": n.message,
+                    "duration_s": finite_or_none(n.duration, 6)} for n in r.routes],
+        "phases": [{"kind": p.kind, "task": p.task or None, "site": p.site + 1,
+                    "start_s": finite_or_none(p.start, 6), "end_s": finite_or_none(p.end, 6),
+                    "min_tension_margin_N": finite_or_none(p.min_tension_margin, 6),
+                    "min_tipping_margin_Nm": finite_or_none(p.min_tipping_margin, 6),
+                    "min_sliding_margin_N": finite_or_none(p.min_sliding_margin, 6),
+                    "success": bool(p.success), "message": p.message} for p in r.phases],
+    }

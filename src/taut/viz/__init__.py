@@ -11,7 +11,9 @@ Cable-driven parallel robots
     wrench-feasible workspace, :func:`draw_robot_outline` a robot's frame on given axes,
     :func:`plot_axis_capacities` and :func:`plot_capacity_bars` wrench and twist
     capacities, :func:`plot_deployment` a deployment, :func:`plot_control`,
-    :func:`plot_comparison` and :func:`animate_control` control simulations.
+    :func:`plot_comparison` and :func:`animate_control` control simulations,
+    :func:`plot_mission` and :func:`animate_mission` a warehouse mission (:func:`draw_floor`
+    its floor plan on given axes).
 Physics replays
     :func:`plot_equilibria_check` the settled sheets of a :func:`taut.physics.replay_equilibria`
     beside taut's states, :func:`animate_settle` a drop.
@@ -34,6 +36,7 @@ if TYPE_CHECKING:                   # the real names, for type checkers
     from .cdpr_compare import plot_workspace_comparison
     from .cdpr_motion import plot_capacity_bars, plot_deployment
     from .cdpr_sim import animate_control, plot_comparison, plot_control
+    from .cdpr_mission import animate_mission, draw_floor, plot_mission
     from .motion import plot_simulation
     from .physics import animate_settle, plot_equilibria_check
     from .plan import animate_plan, draw_world, plot_plan
@@ -48,7 +51,7 @@ __all__ = [
     # cable-driven parallel robots
     "plot_workspace", "plot_binding", "plot_workspace_comparison", "draw_robot_outline",
     "plot_axis_capacities", "plot_capacity_bars", "plot_deployment", "plot_control",
-    "plot_comparison", "animate_control",
+    "plot_comparison", "animate_control", "plot_mission", "animate_mission", "draw_floor",
     # physics replays
     "plot_equilibria_check", "animate_settle",
     # sweeps
@@ -64,6 +67,8 @@ _HOME = {
     "plot_binding": "cdpr_binding", "plot_workspace_comparison": "cdpr_compare",
     "plot_capacity_bars": "cdpr_motion", "plot_deployment": "cdpr_motion",
     "plot_control": "cdpr_sim", "plot_comparison": "cdpr_sim", "animate_control": "cdpr_sim",
+    "plot_mission": "cdpr_mission", "animate_mission": "cdpr_mission",
+    "draw_floor": "cdpr_mission",
     "plot_equilibria_check": "physics", "animate_settle": "physics",
     "plot_sweep": "sweep",
 }

@@ -7,7 +7,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from taut.plan import Obstacle, Scenario, World, formation_library, generate_scenario, plan
-from taut.plan.se2 import _lattice
+from taut.plan.se2 import _lattice, _rigid
 from taut.plan import _tol
 from taut.plan._kernels.lattice import OFFSETS
 from taut.plan._kernels.clearance import morph_clear
@@ -81,7 +81,8 @@ def _oracle(sc, forms, checkers, grid):
                         rows.append(node(a, c, k))
                         cols.append(node(b, c, k))
                         w.append(cost[a, b])
-    ids, gcost = _lattice._goal_links(sc, grid, checkers)
+    ids, gcost = _rigid.goal_links(grid, checkers, sc.goal, sc.team.speed,
+                                   sc.team.rotation_speed)
     rows += list(ids)
     cols += [goal] * len(ids)
     w += list(gcost)
@@ -91,11 +92,17 @@ def _oracle(sc, forms, checkers, grid):
     return float(dijkstra(g, indices=starts, min_only=True)[goal])
 
 
+def _grid(sc, spacing, radius, layers):
+    """The lattice of the shared core (:func:`taut.plan.se2._rigid.lattice_grid`)."""
+    return _rigid.lattice_grid(sc.world.geometry, sc.world.free_space, sc.start, spacing,
+                               radius, layers)
+
+
 def test_astar_finds_the_fastest_lattice_path(small, monkeypatch):
     sc, forms, checkers = small
     res = _lattice.lattice_search(sc, forms, checkers, spacing=0.1, expansions=10**7,
                                   rng=np.random.default_rng(0))
-    grid = _lattice._grid(sc, 0.1, max(c.radius for c in checkers), len(forms))
+    grid = _grid(sc, 0.1, max(c.radius for c in checkers), len(forms))
     best = _oracle(sc, forms, checkers, grid)
     assert np.isfinite(best) and res.pieces is not None
     assert res.cost == pytest.approx(best, rel=1e-12)
@@ -127,17 +134,17 @@ def test_budget_and_coarsening_are_reported(small, monkeypatch):
     res = _lattice.lattice_search(sc, forms, checkers, spacing=0.05, expansions=10,
                                   rng=np.random.default_rng(0))
     assert res.pieces is None and res.exhausted and res.expanded == 11
-    monkeypatch.setattr(_lattice, "MAX_NODES", 20_000)
+    monkeypatch.setattr(_rigid, "MAX_NODES", 20_000)
     res = _lattice.lattice_search(sc, forms, checkers, spacing=0.01, expansions=10**7,
                                   rng=np.random.default_rng(0))
     assert res.spacing > 0.01
-    grid = _lattice._grid(sc, 0.01, max(c.radius for c in checkers), len(forms))
+    grid = _grid(sc, 0.01, max(c.radius for c in checkers), len(forms))
     assert len(grid.cells) * grid.nk * len(forms) <= 20_000
 
 
 def test_neighbour_table_matches_offsets(small):
     sc, forms, checkers = small
-    grid = _lattice._grid(sc, 0.1, 0.5, 1)
+    grid = _grid(sc, 0.1, 0.5, 1)
     for c in range(len(grid.cells)):
         for m, (di, dj) in enumerate(OFFSETS):
             n = grid.nbr[c, m]
@@ -150,10 +157,18 @@ def test_neighbour_table_matches_offsets(small):
 def test_two_formation_changes_in_an_l_corridor():
     """Suite scenario 2034 (7 robots, L-shaped corridor): the lattice crosses the first
     low obstacle, changes formation to cross one taller, and changes again in the
-    corner; one formation alone (or one change) does not get through."""
+    corner: the crossing search's own plan, before the planner compares it with the
+    bypass search's (which gets through in one squeezed formation and is faster here)."""
+    from taut.plan import planner
+    from taut.plan._options import plan_options
+
     sc = generate_scenario(2034, 7)
-    r = plan(sc, search="lattice")
+    opts = plan_options(search="lattice")
+    r = planner._se2(sc, allow_crossing=True, sheet_margin=opts.sheet_margin,
+                     budget=opts.budget, planner="crossing",
+                     library=planner.library(sc, opts.sheet_margin), search="lattice")
     assert r.success, r.message
+    assert plan(sc, search="lattice").duration <= r.duration
     assert len(r.formations) >= 2
     rigid = np.abs(np.diff(np.linalg.norm(r.robots[:, 0] - r.robots[:, 1], axis=1))) < 1e-9
     changes = np.flatnonzero(np.diff(np.concatenate([[1], (~rigid).astype(int)])) == 1)

@@ -24,6 +24,10 @@ lattice poses near it, joined by proved moves); tighter passages need a finer sp
 the sampling search. The path is then shortened rigid piece by rigid piece
 (:func:`~taut.plan.se2._rrt.shortcut`, seeded), and returned as pieces for sampling and
 verification.
+
+The lattice, the goal links and the merging of the path are the footprint-agnostic core
+of :mod:`taut.plan.se2._rigid`, shared with the navigation of a mobile cable robot's
+coupled bases (:mod:`taut.cdpr.mission.navigation`): one search, two users.
 """
 
 from __future__ import annotations
@@ -31,24 +35,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import shapely
 
 from .. import _tol
-from .._kernels.lattice import OFFSETS, lattice_astar
-from ._rrt import shortcut
-from .._kernels.clearance import motion_clear
+from .._kernels.lattice import lattice_astar
 from ._motion import Piece, change_profile
+from ._rigid import MAX_NODES, goal_links, lattice_grid, merge_straight
 from ._space import PoseChecker
 from ..checks.robustness import change_tolerates
 from ..formations.optimal import Formation
 from ..world import Scenario
 
 __all__ = ["LatticeResult", "lattice_search", "MAX_NODES"]
-
-#: Most lattice nodes (every layer together); a larger problem gets a coarser spacing
-#: (reported in the result) so that memory (about 17 bytes a node) stays bounded.
-MAX_NODES = 8_000_000
-
 
 @dataclass(frozen=True, eq=False)
 class LatticeResult:
@@ -82,50 +79,6 @@ class LatticeResult:
     cost: float = np.inf
 
 
-@dataclass(frozen=True, eq=False)
-class _Grid:
-    cells: np.ndarray        # (C, 2) positions in the free space
-    nbr: np.ndarray          # (C, 8) neighbour cells in OFFSETS order, -1 for none
-    spacing: float
-    nk: int
-    start_cell: int
-
-    @property
-    def dpsi(self) -> float:
-        return 2 * np.pi / self.nk
-
-
-def _grid(scenario: Scenario, spacing: float, radius: float, layers: int) -> _Grid:
-    """Lattice cells in the free space, aligned on the start; coarser than ``spacing``
-    when the problem would exceed ``MAX_NODES``."""
-    lo, hi = scenario.world.free_space.min(axis=0), scenario.world.free_space.max(axis=0)
-    h = float(spacing)
-    while True:
-        nk = int(max(16, 8 * np.ceil(2 * np.pi * radius / h / 8)))
-        below = np.floor((scenario.start - lo) / h).astype(int)
-        origin = scenario.start - below * h
-        n = np.floor((hi - origin) / h).astype(int) + 1
-        if float(n[0]) * float(n[1]) * nk * layers > 4 * MAX_NODES:   # cheap bound first
-            h *= 1.25
-            continue
-        i, j = np.meshgrid(np.arange(n[0]), np.arange(n[1]), indexing="ij")
-        x, y = origin[0] + i.ravel() * h, origin[1] + j.ravel() * h
-        inside = shapely.contains_xy(scenario.world.geometry, x, y)
-        if inside.sum() * nk * layers <= MAX_NODES:
-            break
-        h *= 1.25
-    index = np.full(n[0] * n[1], -1, dtype=np.int64)
-    index[inside] = np.arange(inside.sum())
-    ci, cj = i.ravel()[inside], j.ravel()[inside]
-    nbr = np.full((len(ci), 8), -1, dtype=np.int64)
-    for m, (di, dj) in enumerate(OFFSETS):
-        ii, jj = ci + di, cj + dj
-        ok = (ii >= 0) & (ii < n[0]) & (jj >= 0) & (jj < n[1])
-        nbr[ok, m] = index[ii[ok] * n[1] + jj[ok]]
-    return _Grid(np.column_stack([x[inside], y[inside]]), nbr, h, nk,
-                 int(index[below[0] * n[1] + below[1]]))
-
-
 def _changes(scenario: Scenario, forms: list[Formation], checkers: list[PoseChecker]
              ) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Cost (L, L) of every allowed change (inf: refused by the quasi-static model) and
@@ -157,28 +110,6 @@ def _changes(scenario: Scenario, forms: list[Formation], checkers: list[PoseChec
     return cost, obst, refused
 
 
-def _goal_links(scenario: Scenario, grid: _Grid, checkers: list[PoseChecker]
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """Node ids joined to the exact goal (the four cells around it, every heading at which
-    the goal pose is valid, each layer) and the time of that last straight move."""
-    d = np.linalg.norm(grid.cells - scenario.goal, axis=1)
-    near = np.flatnonzero(d <= grid.spacing * np.sqrt(2) + _tol.GEOMETRY_TOL)
-    C, links = len(grid.cells), {}
-    for L, c in enumerate(checkers):
-        for k in range(grid.nk):
-            g = np.array([*scenario.goal, -np.pi + k * grid.dpsi])
-            if not c.valid(g[None])[0]:
-                continue
-            for cell in near:
-                p = np.array([*grid.cells[cell], g[2]])
-                if c.valid(p[None])[0] and motion_clear(
-                        c._local, c.radius, c._walls, c._obst, c._verts, c.clearance_rule, p,
-                        g, _tol.MOTION_MARGIN, _tol.MIN_ADVANCE) > 0:
-                    links[(L * C + int(cell)) * grid.nk + k] = d[cell] / scenario.team.speed
-    ids = np.array(sorted(links), dtype=np.int64)
-    return ids, np.array([links[i] for i in ids])
-
-
 def lattice_search(scenario: Scenario, formations: list[Formation],
                    checkers: list[PoseChecker], *, spacing: float, expansions: int,
                    rng: np.random.Generator) -> LatticeResult:
@@ -199,9 +130,12 @@ def lattice_search(scenario: Scenario, formations: list[Formation],
     """
     team = scenario.team
     radius = max(c.radius for c in checkers)
-    grid = _grid(scenario, spacing, radius, len(formations))
+    world = scenario.world
+    grid = lattice_grid(world.geometry, world.free_space, scenario.start, spacing, radius,
+                        len(formations))
     cost, change_obst, refused = _changes(scenario, formations, checkers)
-    goals, goal_cost = _goal_links(scenario, grid, checkers)
+    goals, goal_cost = goal_links(grid, list(checkers), scenario.goal, team.speed,
+                                  team.rotation_speed)
     C, nk = len(grid.cells), grid.nk
     starts = np.array([(L * C + grid.start_cell) * nk + k for L in range(len(checkers))
                        for k in range(nk)], dtype=np.int64)
@@ -261,16 +195,6 @@ def _pieces(forms: list[Formation], checkers: list[PoseChecker],
 
 def _rigid(checker: PoseChecker, f: Formation, run: list[np.ndarray],
            rng: np.random.Generator) -> Piece:
-    """A rigid piece through ``run`` (headings unwrapped), runs of equal lattice moves
-    merged into one straight motion while they turn by at most pi/2 in all (the shortcut
-    needs edges that turn by less than pi), then shortcut."""
-    w = np.array(run)
-    w[:, 2] = np.unwrap(w[:, 2])
-    if len(w) > 2:
-        keep = [0]
-        for k in range(1, len(w) - 1):
-            bend = np.abs((w[k + 1] - w[k]) - (w[k] - w[k - 1])).max() > _tol.GEOMETRY_TOL
-            if bend or abs(w[k + 1, 2] - w[keep[-1], 2]) > np.pi / 2:
-                keep.append(k)
-        w = shortcut(checker, w[keep + [len(w) - 1]], rng)
-    return Piece(f, w)
+    """A rigid piece through ``run``, merged and shortcut
+    (:func:`~taut.plan.se2._rigid.merge_straight`)."""
+    return Piece(f, merge_straight(checker, run, rng))

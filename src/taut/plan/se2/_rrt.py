@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._body import BodyChecker
 from ._space import PoseChecker
 
 __all__ = ["SearchOutcome", "rrt_connect", "shortcut", "valid_headings"]
@@ -194,7 +195,7 @@ def _unwrap(path: np.ndarray) -> np.ndarray:
     return out
 
 
-def shortcut(checker: PoseChecker, path: np.ndarray, rng: np.random.Generator,
+def shortcut(checker: BodyChecker, path: np.ndarray, rng: np.random.Generator,
              rounds: int = 60, passes: int = 3) -> np.ndarray:
     """Shorten ``path`` (every edge turning by at most pi) by replacing sub-paths with
     straight SE(2) motions where valid (and turning by at most pi):
@@ -209,7 +210,7 @@ def shortcut(checker: PoseChecker, path: np.ndarray, rng: np.random.Generator,
     return p
 
 
-def _shortcut_once(checker: PoseChecker, path: np.ndarray, rng: np.random.Generator,
+def _shortcut_once(checker: BodyChecker, path: np.ndarray, rng: np.random.Generator,
                    rounds: int) -> np.ndarray:
     p = _unwrap(path)
     out = [p[0]]
@@ -232,7 +233,7 @@ def _shortcut_once(checker: PoseChecker, path: np.ndarray, rng: np.random.Genera
     return _unwrap(p)
 
 
-def _straight(checker: PoseChecker, a: np.ndarray, b: np.ndarray) -> bool:
+def _straight(checker: BodyChecker, a: np.ndarray, b: np.ndarray) -> bool:
     """Can the straight motion from ``a`` to ``b`` replace the path between them? It must
     be valid and turn by at most pi (paths are unwrapped edge by edge, which would turn a
     larger turn the other way)."""

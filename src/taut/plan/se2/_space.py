@@ -34,7 +34,8 @@ from shapely.geometry.polygon import orient
 from shapely.ops import unary_union
 
 from .. import _tol
-from .._kernels.clearance import OBST_COLS, morph_clear, motion_clear, poses_clearance
+from .._kernels.clearance import morph_clear
+from ._body import BodyChecker, kernel_world
 from ..formations.optimal import Formation
 from ..world import Scenario
 
@@ -44,28 +45,7 @@ __all__ = ["PoseChecker", "SLICES", "morph_valid"]
 SLICES = 72
 
 
-def _kernel_world(scenario: Scenario, blocked: list[bool]) -> tuple[np.ndarray, np.ndarray,
-                                                                     np.ndarray]:
-    """Walls (M, 2), obstacle rows (``OBST_COLS``) and polygon vertices for the kernel."""
-    world = scenario.world
-    walls = np.ascontiguousarray(world.free_space, dtype=float)
-    rows, verts = [], []
-    count = 0
-    margin = _tol.POSITION_ACCURACY
-    for o, bl in zip(world.obstacles, blocked):
-        if o.polygon is None:
-            rows.append([*o.mec_center, o.mec_radius, float(bl), 0.0, 0.0, 0.0, margin])
-        else:
-            v = np.asarray(o.polygon, dtype=float)
-            rows.append([*o.mec_center, o.mec_radius, float(bl), 1.0, count, len(v), margin])
-            verts.append(v)
-            count += len(v)
-    obst = np.array(rows, dtype=float).reshape(-1, OBST_COLS)
-    vv = np.concatenate(verts) if verts else np.zeros((0, 2))
-    return walls, obst, np.ascontiguousarray(vv)
-
-
-class PoseChecker:
+class PoseChecker(BodyChecker):
     """Batched validity of states ``(K, 3)`` of one formation (see module docstring).
 
     Parameters
@@ -83,11 +63,9 @@ class PoseChecker:
         self.allow_crossing = bool(allow_crossing)
         blocked = [not allow_crossing or o.height > formation.max_height + _tol.GEOMETRY_TOL
                    for o in world.obstacles]
-        self._walls, self._obst, self._verts = _kernel_world(scenario, blocked)
-        self._local = np.ascontiguousarray(formation.robots, dtype=float)
-        self.clearance_rule = float(team.clearance)
-        self.radius = float(np.linalg.norm(formation.robots, axis=1).max())
-        self.checks = 0
+        super().__init__(formation.robots,
+                         *kernel_world(world, blocked, _tol.POSITION_ACCURACY),
+                         team.clearance)
         # Shapely geometry of the samplers only (validity is decided by the kernel).
         pad = self.pad = _tol.STATE_CLEARANCE
         c = team.clearance + pad
@@ -186,30 +164,6 @@ class PoseChecker:
         """Robot positions ``(K, N, 2)`` of states ``(K, 3)``."""
         s = np.asarray(states, dtype=float).reshape(-1, 3)
         return self.formation.placed(s[:, :2], s[:, 2])
-
-    def clearance(self, states: np.ndarray) -> np.ndarray:
-        """Float ``(K,)``: how far (m) every robot may move from each state before a rule
-        breaks (negative: broken); :mod:`taut.plan._kernels.clearance`."""
-        s = np.ascontiguousarray(np.asarray(states, dtype=float).reshape(-1, 3))
-        out = np.empty(len(s))
-        poses_clearance(self._local, self.radius, self._walls, self._obst, self._verts,
-                        self.clearance_rule, s, out)
-        self.checks += len(s)
-        return out
-
-    def valid(self, states: np.ndarray) -> np.ndarray:
-        """Bool ``(K,)``: which states keep every rule with ``STATE_CLEARANCE`` to
-        spare."""
-        return self.clearance(states) >= _tol.STATE_CLEARANCE
-
-    def motion_valid(self, a: np.ndarray, b: np.ndarray) -> bool:
-        """Is the straight SE(2) motion from ``a`` to ``b`` (position and heading linear in
-        a common parameter) valid at every pose, with ``MOTION_MARGIN`` to spare?"""
-        n = motion_clear(self._local, self.radius, self._walls, self._obst, self._verts,
-                         self.clearance_rule, np.asarray(a, dtype=float),
-                         np.asarray(b, dtype=float), _tol.MOTION_MARGIN, _tol.MIN_ADVANCE)
-        self.checks += abs(n)
-        return n > 0
 
 
 def _reflex_vertices(scenario: Scenario) -> np.ndarray:
