@@ -142,7 +142,8 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("fk", ["fk", f]) for f in files + sheets]
     cases += [("fk", ["fk", sheet, "--mass", v]) for v in BAD_NUMBERS + ["0", "-1"]]
     cases += [("fk", ["fk", sheet, "--method", m]) for m in ["", "magic", "FAST"]]
-    cases += [("fk", ["fk", sheet, "--plot", o]) for o in outs]
+    cases += [("fk", ["fk", sheet, opt, o]) for opt in ("--plot", "--mcap", "--rerun")
+              for o in outs]
     cases += [("fk", ["fk", sheet, "--nosuch"]), ("fk", ["fk"])]
     # ik
     cases += [("ik", ["ik", f, "--object", "0", "0", "300"]) for f in files + sheets[:12]]
@@ -161,7 +162,7 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
               for v in BAD_NUMBERS]
     # plan
     cases += [("plan", ["plan", f]) for f in files + [str(p) for p in _plan_mutations(tmp)]]
-    for opt in ("--plot", "--animate", "--out"):
+    for opt in ("--plot", "--animate", "--out", "--mcap", "--rerun"):
         cases += [("plan", ["plan", str(PLAN), opt, o]) for o in outs]
     cases += [("plan", ["plan", str(PLAN), "--search", v])
               for v in ["", "ompl", "RRTConnect", "ompl-rrt", "prm", "1"]]
@@ -227,7 +228,7 @@ def generate(tmp: Path) -> list[tuple[str, list[str]]]:
     cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", *wp, "--controller", c])
               for c in ("", "pid", "VELOCITY")]
     cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", *wp, opt, o])
-              for opt in ("--plot", "--animate", "--out") for o in outs]
+              for opt in ("--plot", "--animate", "--out", "--mcap") for o in outs]
     cases += [("cdpr simulate", ["cdpr", "simulate", "fastkit", "--reference", c])
               for c in [str(p) for p in _bad_csvs(tmp)]]
     # physics (MuJoCo): every check comes before the model is built

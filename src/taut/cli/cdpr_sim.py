@@ -20,6 +20,7 @@ from .._validate import as_choice
 from ._cdpr_common import given, load_robot
 from ._paths import ANIMATION_SUFFIXES, FIGURE_SUFFIXES, JSON_SUFFIXES, output_path
 from ._progress import working
+from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, write_recordings
 
 __all__ = ["add_simulate"]
 
@@ -56,8 +57,8 @@ def add_simulate(sub: typer.Typer) -> None:
                                        "the control rate and latency by "
                                        "taut.cdpr.tune_for_rate."),
         exit_error: Optional[float] = typer.Option(
-            None, "--exit-error", help="Std. dev. of seeded exit-point errors, mm (default: "
-                                       "the library's, none)."),
+            None, "--exit-error", help="Std. dev. of seeded exit-point errors, m (default: "
+                                       "the library's, none; taut.cdpr.ModelErrors)."),
         seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the model errors "
                                            "(default: the library's)."),
         speed: Optional[float] = typer.Option(
@@ -77,7 +78,7 @@ def add_simulate(sub: typer.Typer) -> None:
                                          "control; the tension is estimated from the drive "
                                          "torques)."),
         latency: Optional[float] = typer.Option(
-            None, "--latency", help="Delay from measurement to actuation, ms (default: the "
+            None, "--latency", help="Delay from measurement to actuation, s (default: the "
                                     "library's, taut.cdpr.Sensing)."),
         ideal_pose: bool = typer.Option(False, "--ideal-pose", help="Give the controller "
                                         "the true platform pose (default: estimated from "
@@ -90,19 +91,23 @@ def add_simulate(sub: typer.Typer) -> None:
                                                 "to this file (.json)."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Figure (PNG/PDF)."),
         animate: Optional[Path] = typer.Option(None, "--animate", help="3D animation (GIF)."),
+        mcap: Optional[Path] = typer.Option(None, "--mcap", help=MCAP_HELP + " Bases as "
+                                            "robot_<i>, the platform as the object."),
+        rerun: Optional[Path] = typer.Option(None, "--rerun", help=RERUN_HELP),
     ) -> None:
         """``taut cdpr simulate`` (help text above); long because its options, one typer
         declaration each, are in the signature."""
         if (waypoints is None) == (reference is None):
             raise InvalidInputError("--waypoints", "give exactly one of --waypoints and "
                                                    "--reference")
-        if exit_error is not None and not (np.isfinite(exit_error) and 0 <= exit_error <= 1000):
-            raise InvalidInputError("--exit-error", "must be a number of mm in [0, 1000]")
-        if latency is not None and not (np.isfinite(latency) and 0 <= latency <= 1000):
-            raise InvalidInputError("--latency", "must be a number of ms in [0, 1000]")
+        if exit_error is not None and not (np.isfinite(exit_error) and 0 <= exit_error <= 1):
+            raise InvalidInputError("--exit-error", "must be a number of m in [0, 1]")
+        if latency is not None and not (np.isfinite(latency) and 0 <= latency <= 1):
+            raise InvalidInputError("--latency", "must be a number of s in [0, 1]")
         output_path(json_out, "--out", JSON_SUFFIXES)
         output_path(plot, "--plot", FIGURE_SUFFIXES)
         output_path(animate, "--animate", ANIMATION_SUFFIXES)
+        mcap, rerun = recording_paths(mcap, rerun)
         from ..cdpr import CONTROLLERS, ModelErrors, pick_and_place
         as_choice(controller, CONTROLLERS, "--controller")
         from ..io.cdpr_dynamics import load_cdpr_dynamics
@@ -118,13 +123,12 @@ def add_simulate(sub: typer.Typer) -> None:
                                  **given(speed=speed, profile=profile, dwell=dwell))
         else:
             ref = read_reference_csv(robot, reference)  # type: ignore[arg-type]
-        errs = ModelErrors(**given(exit_offset=None if exit_error is None else exit_error * 1e-3,
-                                   seed=seed))
+        errs = ModelErrors(**given(exit_offset=exit_error, seed=seed))
         if tension_gain is not None and controller != "velocity":
             raise InvalidInputError("--tension-gain", "applies to --controller velocity")
         from ..cdpr import Sensing, tune_for_rate
         sens = Sensing(ideal_pose=ideal_pose,
-                       **given(latency=None if latency is None else latency * 1e-3))
+                       **given(latency=latency))
         ctl, sens = tune_for_rate(CONTROLLERS[controller](**given(tension_gain=tension_gain)),
                                   sens, **given(control_rate=control_rate), dynamics=dyn)
         run = _run(robot, ref, ctl, errs, control_rate, dyn, sens)
@@ -138,8 +142,9 @@ def add_simulate(sub: typer.Typer) -> None:
         if animate is not None:
             from ..viz.cdpr_sim import animate_control
             animate_control(robot, run, animate)
+        write_recordings(run, mcap, rerun, quiet=True, robot=robot)
         if not as_json:
-            _report(run, json_out, plot, animate)
+            _report(run, json_out, plot, animate, mcap, rerun)
         if not run.success:
             print(f"taut: {run.status}: {run.message}", file=sys.stderr)
             raise typer.Exit(1)
@@ -155,7 +160,7 @@ def _run(robot, ref, ctl, errs, rate, dyn, sensing):
                         **given(control_rate=rate))
 
 
-def _report(run, json_out, plot, animate) -> None:
+def _report(run, json_out, plot, animate, mcap=None, rerun=None) -> None:
     typer.echo(f"{run.controller['name']} control over {run.times[-1]:.2f} s: {run.status}")
     typer.echo(f"  tracking error: max {1e3 * run.tracking_error.max():.3f} mm, rms "
                f"{1e3 * np.sqrt(np.mean(run.tracking_error ** 2)):.3f} mm")
@@ -169,6 +174,7 @@ def _report(run, json_out, plot, animate) -> None:
         typer.echo(f"  event: {e.describe()}")
     if len(run.events) > 10:
         typer.echo(f"  ... {len(run.events) - 10} more events")
-    for label, p in (("result", json_out), ("figure", plot), ("animation", animate)):
+    for label, p in (("result", json_out), ("figure", plot), ("animation", animate),
+                     ("ROS 2 recording", mcap), ("Rerun recording", rerun)):
         if p is not None:
             typer.echo(f"{label} written to {p}")

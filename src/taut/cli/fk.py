@@ -13,6 +13,7 @@ from ..errors import ScenarioError
 from ..io.serialize import fk_result_to_dict, to_json
 from ._paths import FIGURE_SUFFIXES, output_path
 from ._progress import working
+from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, sheet_unit, write_recordings
 
 if TYPE_CHECKING:
     from ..sheet.fk.results import FKResult
@@ -81,6 +82,9 @@ def register(app: typer.Typer) -> None:
                                              "(overrides the scenario's); gives tensions in N."),
         plot: Optional[Path] = typer.Option(None, "--plot", help="Write a 3D figure of every "
                                             "equilibrium to this file (.png, .pdf, .svg)."),
+        mcap: Optional[Path] = typer.Option(None, "--mcap", help=MCAP_HELP + " Records the "
+                                            "lowest rest state."),
+        rerun: Optional[Path] = typer.Option(None, "--rerun", help=RERUN_HELP),
     ) -> int:
         """Forward kinematics: every place the object can rest, which are stable, and
         each robot's cable tension. Exit 0 with at least one equilibrium, 1 when there is
@@ -91,11 +95,13 @@ def register(app: typer.Typer) -> None:
         from ..sheet import forward_kinematics
 
         plot = output_path(plot, "--plot", FIGURE_SUFFIXES)
+        mcap, rerun = recording_paths(mcap, rerun)
         m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
         if sc.formation is None:
             raise ScenarioError("formation", "required key is missing (taut fk needs the "
                                 "robots' positions)")
+        unit = sheet_unit(sc.units, mcap, rerun)
         team = sc.team if m is None else replace(sc.team, mass=m)
         if method == FKMethod.subsets:
             as_count(team.n, "sheet", maximum=SUBSETS_MAX_ROBOTS)
@@ -118,4 +124,5 @@ def register(app: typer.Typer) -> None:
             note = f" ({panels} of {n} equilibria drawn, stable first)" if n > panels else ""
             if not as_json:
                 typer.echo(f"figure written to {plot}{note}")
+        write_recordings(result, mcap, rerun, quiet=as_json, length_unit=unit)
         return 0 if result.equilibria else 1

@@ -10,6 +10,7 @@ import typer
 
 from ..errors import InvalidInputError, ScenarioError
 from ._paths import ANIMATION_SUFFIXES, output_path
+from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, sheet_unit, write_recordings
 
 
 def format_check(check: Any, *, name: str | None, units: str | None) -> str:
@@ -56,6 +57,9 @@ def register(app: typer.Typer) -> None:
                                              "a ball dropped over the robots (.gif)."),
         mesh: Optional[int] = typer.Option(None, "--mesh", help="Mesh spacings across the "
                                            "sheet's widest vertex pair (default 10)."),
+        mcap: Optional[Path] = typer.Option(None, "--mcap", help=MCAP_HELP + " One checked "
+                                            "state a second, on its settled sheet."),
+        rerun: Optional[Path] = typer.Option(None, "--rerun", help=RERUN_HELP),
     ) -> None:
         """Check taut's rest states in MuJoCo: tie the object at each state's contact
         point, settle, release; exit 1 when physics disagrees with taut, a simulation
@@ -71,6 +75,8 @@ def register(app: typer.Typer) -> None:
         if sc.formation is None:
             raise ScenarioError("formation", "required key is missing (taut physics needs "
                                 "the robots' positions)")
+        mcap, rerun = recording_paths(mcap, rerun)
+        unit = sheet_unit(sc.units, mcap, rerun)
         try:
             from ..physics import DEFAULT_MESH, replay_equilibria, settle
             import mujoco  # noqa: F401
@@ -102,8 +108,10 @@ def register(app: typer.Typer) -> None:
         if video is not None:
             from ..viz.physics import animate_settle
             drop = settle(sc.team, sc.formation, trace=True, mesh=div, ball=sc.object_radius)
-            animate_settle(drop, sc.formation, sc.team.hold_height, video)
+            animate_settle(drop, sc.formation, sc.team.hold_height, video, units=sc.units)
             if not as_json:
                 typer.echo(f"animation written to {video}")
+        write_recordings(check, mcap, rerun, quiet=as_json, length_unit=unit, team=sc.team,
+                         formation=sc.formation)
         if not check.success:
             raise typer.Exit(1)

@@ -17,6 +17,15 @@ Plan scenarios
 Cable-robot models
     :func:`load_cdpr_model` (a file or a preset name) and :func:`cdpr_model_from_mapping`
     build a :class:`taut.cdpr.CableRobot`.
+Warehouses
+    :func:`load_warehouse` and :func:`warehouse_from_mapping` build a
+    :class:`taut.cdpr.Warehouse` (a mobile cable robot's floor, shelves, start and tasks).
+Recordings (for robot viewers; metres and seconds)
+    :func:`write_mcap` writes a result as a ROS 2 MCAP file (standard message types on the
+    topics of :mod:`taut.io.mcap`, for Foxglove, RViz and ``ros2 bag play``; extra ``mcap``)
+    and :func:`write_rerun` as a Rerun ``.rrd`` recording with a blueprint (extra
+    ``rerun``): sheet FK, simulations, plans, MuJoCo checks, cable-robot simulations
+    (docs/recordings.md).
 
 Other file formats have their own modules: :mod:`taut.io.trajectory` (formation time
 series, CSV), :mod:`taut.io.cdpr_reference` (platform reference poses, CSV),
@@ -42,6 +51,9 @@ if TYPE_CHECKING:                   # the real names, for type checkers
     from .plan_scenario import (load_plan_scenario, plan_scenario_from_mapping,
                                 plan_scenario_to_mapping)
     from .sheet_scenario import SheetScenario, load_sheet_scenario, sheet_scenario_from_mapping
+    from .warehouse import load_warehouse, warehouse_from_mapping
+    from .mcap import write_mcap
+    from .rerun import write_rerun
 
 _HOME = {
     "cdpr_model_from_mapping": "cdpr_model", "load_cdpr_model": "cdpr_model",
@@ -53,6 +65,8 @@ _HOME = {
     "plan_scenario_to_mapping": "plan_scenario",
     "SheetScenario": "sheet_scenario", "load_sheet_scenario": "sheet_scenario",
     "sheet_scenario_from_mapping": "sheet_scenario",
+    "load_warehouse": "warehouse", "warehouse_from_mapping": "warehouse",
+    "write_mcap": "mcap", "write_rerun": "rerun",
 }
 
 __all__ = [
@@ -65,6 +79,10 @@ __all__ = [
     "load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping",
     # cable-robot models
     "load_cdpr_model", "cdpr_model_from_mapping",
+    # warehouses
+    "load_warehouse", "warehouse_from_mapping",
+    # recordings
+    "write_mcap", "write_rerun",
 ]
 
 
