@@ -1,11 +1,14 @@
 """The app in a real browser (headless Chromium driven by Selenium): drag robot 2 of
 Example 2 and compare the displayed equilibria with forward_kinematics; play the paper
 corridor's plan to its end; push the cable robot's platform out of the feasible
-workspace and see it flagged; bad uploads, shared links and YAML downloads.
+workspace and see it flagged; bad uploads, shared links and YAML and plan downloads.
+The charts (Plotly.js, vendored) are checked for the library's numbers and for axis titles
+with units; the 3D cable-robot view for the library's cable geometry.
 
 Skipped, with the reason, when Chromium, chromedriver or the app extras are missing.
 """
 
+import json
 import re
 from pathlib import Path
 
@@ -13,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from taut.cdpr import distribute_tensions
+from taut.cdpr import cable_state, distribute_tensions
 from taut.errors import InfeasibleFormationError
 from taut.io import load_cdpr_model, load_plan_scenario, load_sheet_scenario, \
     sheet_scenario_from_mapping
@@ -51,6 +54,34 @@ def wait_for(d, script, timeout=60.0):
 def drag(d, css, moves):
     from taut.app.browser import drag as real_drag
     real_drag(d, css, moves)
+
+
+def drag_platform(d, view, moves):
+    """Press on the platform where the chart ``view`` draws it and drag it."""
+    from taut.app.browser import drag_at
+    d.execute_script("document.getElementById(arguments[0]).scrollIntoView()", view)
+    drag_at(d, d.execute_script("return CdprView.platformScreen(arguments[0])", view), moves)
+
+
+def chart_titles(d):
+    """{chart id: axis titles} of the charts on show; a categorical axis (cable names)
+    is reported as "category"."""
+    return {c["id"]: c["axes"] for c in d.execute_script("""return chartAxes().map(c => {
+        const fl = document.getElementById(c.id)._fullLayout;
+        if (!fl.scene && fl.yaxis.type === 'category') c.axes[1] = 'category';
+        return c; })""")}
+
+
+def assert_units(titles):
+    for chart, axes in titles.items():
+        for t in axes:
+            assert t == "category" or re.search(r"\[[^\]]+\]$", t), (chart, t)
+
+
+def trace(d, chart, name):
+    """The data of the trace called ``name`` on a chart."""
+    return d.execute_script("""return document.getElementById(arguments[0]).data
+        .find(t => t.name === arguments[1])""", chart, name)
 
 
 def by_id(d, name):
@@ -106,6 +137,12 @@ def test_drag_robot_2_shows_the_fk_equilibria(page):
     low = res.lowest
     assert f"{len(res.stable)} stable" in status
     assert f"object height {low.height:.2f} mm" in status
+    for view, axes in (("sheet-top", ["x [mm]", "y [mm]"]),
+                       ("sheet-frame", ["x, sheet frame [mm]", "y, sheet frame [mm]"])):
+        assert d.execute_script("return [...document.querySelectorAll(`#${arguments[0]} .axis-title`)]"
+                                ".map(t => t.textContent)", view) == axes
+    wait_for(d, "SheetView.view3d.timer === null && document.getElementById('sheet-3d').data")
+    assert chart_titles(d)["sheet-3d"] == ["x [mm]", "y [mm]", "z [mm]"]
 
 
 def test_dragging_too_far_names_the_pair(page):
@@ -161,14 +198,19 @@ def test_link_and_yaml_reproduce_the_view(page):
     assert rows2 == rows
 
 
-def test_paper_corridor_plays_to_the_end(page):
+def test_paper_corridor_plays_to_the_end(page, tmp_path):
     d = page
     by_id(d, "tab-plan").click()
     select(d, "plan-example", "paper_corridor.yaml")
     wait_for(d, "PlanView.world && !PlanView.result")
+    select(d, "plan-opt-search", "lattice")
+    margin = by_id(d, "plan-opt-sheet_margin")
+    margin.clear()
+    margin.send_keys("0.02")
     by_id(d, "plan-run").click()
     wait_for(d, "PlanView.result", timeout=120)
-    want = plan(load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml"))
+    sc = load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml")
+    want = plan(sc, search="lattice", sheet_margin=0.02)
     select(d, "plan-speed", "50")
     by_id(d, "plan-play").click()
     wait_for(d, "document.getElementById('plan-clock').dataset.end === '1'", timeout=30)
@@ -183,10 +225,33 @@ def test_paper_corridor_plays_to_the_end(page):
     rows = d.execute_script("""return [...document.querySelectorAll('#plan-compare tr')].slice(1)
         .map(r => [...r.cells].map(c => c.textContent))""")
     assert rows[0][1] == "yes" and rows[0][4] == ", ".join(want.crossed)
-    bypass = plan(load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml"),
-                  baseline="se2", time_budget=30.0)
+    bypass = plan(sc, baseline="se2", search="lattice", sheet_margin=0.02, time_budget=30.0)
     assert rows[1][0].startswith("baseline (SE(2) bypass") and rows[1][1] == "yes"
     assert rows[1][3] == f"{bypass.path_length:.3f}" and rows[1][4] == "-"
+    # the charts: the library's profile, axes with units
+    height = trace(d, "plan-height", "object height")
+    np.testing.assert_allclose(height["x"], want.times, atol=1e-12)
+    np.testing.assert_allclose(height["y"], want.object[:, 2], atol=1e-12)
+    titles = chart_titles(d)
+    assert set(titles) == {"plan-top", "plan-height", "plan-margin"}
+    assert titles["plan-top"] == ["x [m]", "y [m]"]
+    assert_units(titles)
+    # the download is the file `taut plan --out` writes for these settings
+    d.execute_script("taut.lastPlanJson = null")
+    by_id(d, "plan-save-json").click()
+    doc = json.loads(wait_for(d, "taut.lastPlanJson"))
+    from taut.io.serialize import plan_to_dict
+    ref = json.loads(json.dumps(plan_to_dict(want)))
+    assert doc.keys() == ref.keys() and doc["crossed"] == ref["crossed"]
+    np.testing.assert_allclose(doc["object"], ref["object"], atol=1e-12)
+    # and the ROS 2 recording is the one taut.io.write_mcap writes
+    pytest.importorskip("mcap", reason="the MCAP download needs the mcap extra")
+    by_id(d, "plan-save-mcap").click()
+    wait_for(d, "taut.lastPlanMcap")
+    import base64
+    from taut.io import write_mcap
+    got = base64.b64decode(d.execute_script("return PlanView.result.plan_mcap"))
+    assert got == write_mcap(want, tmp_path / "plan.mcap").read_bytes()
 
 
 def test_cable_robot_out_of_the_workspace_is_flagged(page):
@@ -198,7 +263,7 @@ def test_cable_robot_out_of_the_workspace_is_flagged(page):
     pose = d.execute_script("return CdprView.st.pose")
     assert distribute_tensions(robot, pose, "qp_min_norm", tipping=True).success
     assert by_id(d, "cdpr-flag").get_attribute("data-feasible") == "1"
-    drag(d, "#cdpr-side .platform", [(0, -8)] * 14)                  # lift it high
+    drag_platform(d, "cdpr-side", [(0, -8)] * 14)                   # lift it high
     wait_for(d, "!CdprView.inflight && !CdprView.pending")
     pose = d.execute_script("return CdprView.st.pose")
     assert pose[2] > 1.9
@@ -207,6 +272,23 @@ def test_cable_robot_out_of_the_workspace_is_flagged(page):
     flag = by_id(d, "cdpr-flag")
     assert flag.get_attribute("data-feasible") == "0"
     assert flag.text == want.message and flag.text.startswith("not wrench-feasible")
+    # the 3D view draws the library's cables: exit points to attachment points
+    wait_for(d, "CdprView.timer3d === null && document.getElementById('cdpr-3d').data")
+    st = cable_state(robot, np.array(pose)[None])
+    ends = np.vstack([robot.exits_world, np.array(pose[:3]) + st.r[0]])
+    shown = [trace(d, "cdpr-3d", n) for n in ("cable within limits", "cable off its limits")]
+    pts = np.array([p for t in shown if t for p in zip(t["x"], t["y"], t["z"]) if p[0] is not None])
+    assert len(pts) == 2 * robot.m
+    for p in pts:
+        assert np.min(np.linalg.norm(ends - p, axis=1)) < 1e-9
+    # the tension chart shows the reply's tensions against the library's limits
+    limits = trace(d, "cdpr-bars", "limits [t_min, t_max]")
+    np.testing.assert_allclose([v for v in limits["x"] if v is not None],
+                               np.column_stack([robot.t_min, robot.t_max]).ravel())
+    titles = chart_titles(d)
+    assert set(titles) == {"cdpr-side", "cdpr-top", "cdpr-3d", "cdpr-bars"}
+    assert titles["cdpr-3d"] == ["x [m]", "y [m]", "z [m]"]
+    assert_units(titles)
 
 
 def test_ik_click_moves_the_robots_to_the_library_formation(page):
@@ -255,7 +337,22 @@ def test_simulate_plays_the_path_and_marks_the_jump(page):
     j = want.jumps[0]
     assert text.startswith(f"jump at step {j.step}/{len(dense) - 1}: taut "
                            f"{{{','.join(str(i + 1) for i in j.taut_before)}}} -> "
-                           f"{{{','.join(str(i + 1) for i in j.taut_after)}}}, drop {j.drop:.2f}")
+                           f"{{{','.join(str(i + 1) for i in j.taut_after)}}}, drop {j.drop:.2f} m")
+    # the height and taut-set charts are the library's simulation
+    height = trace(d, "sim-height", "object height")
+    np.testing.assert_allclose(np.array(height["y"], dtype=float), want.object[:, 2], atol=1e-9,
+                               equal_nan=True)
+    assert trace(d, "sim-height", "jump")["x"] == [e.step for e in want.jumps]
+    taut = trace(d, "sim-taut", "cable taut")
+    n, steps = want.formations.shape[1], len(want.taut)
+    rows = np.array([v for v in taut["y"]], dtype=object).reshape(n, steps + 1)[:, :steps]
+    for i in range(n):
+        assert [v == i + 1 for v in rows[i]] == [i in t for t in want.taut]
+    wait_for(d, "SheetView.view3d.timer === null")              # the 3D view follows
+    titles = chart_titles(d)
+    assert titles["sim-height"] == ["step along the path [index]", "object height [m]"]
+    assert titles["sheet-3d"] == ["x [m]", "y [m]", "z [m]"]
+    assert_units(titles)
 
 
 def test_cable_robot_link_reproduces_the_pose(page):
@@ -263,7 +360,7 @@ def test_cable_robot_link_reproduces_the_pose(page):
     by_id(d, "tab-cdpr").click()
     select(d, "cdpr-example", "ipanema")
     wait_for(d, "CdprView.geo && CdprView.geo.name !== 'fastkit' && CdprView.st && !CdprView.inflight")
-    drag(d, "#cdpr-top .platform", [(3, 2)] * 8)
+    drag_platform(d, "cdpr-top", [(3, 2)] * 8)
     wait_for(d, "!CdprView.inflight && !CdprView.pending")
     pose = d.execute_script("return CdprView.st.pose")
     flag = by_id(d, "cdpr-flag").text

@@ -91,6 +91,26 @@ def test_bad_scenario_is_one_line_error():
             call({"scenario": bad})
 
 
+def test_planner_settings_are_the_library_s_and_go_to_it_unchanged():
+    """The page's settings come from taut.plan.plan's signature; unknown names are the
+    request's 422, bad values the library's own error line."""
+    import inspect
+    from taut.app.plan_api import SETTINGS, settings
+    api = PlanAPI(Catalog(ROOT / "examples"))
+    offered, params = settings(), inspect.signature(plan).parameters
+    assert set(offered) == set(SETTINGS) | {"baseline"}
+    assert offered["search"]["default"] == params["search"].default
+    assert "lattice" in offered["search"]["choices"] and offered["baseline"]["choices"] == ["se2", "disc"]
+    assert offered["sheet_margin"] == {"default": params["sheet_margin"].default, "choices": None}
+    sc = yaml.safe_load(CORRIDOR.read_text())
+    with pytest.raises(TautError, match=r"^options\.budget: unknown setting"):
+        api.check({"scenario": sc, "options": {"budget": 1}})
+    with pytest.raises(TautError, match=r"^iterations: must be an integer"):
+        api.crossing({"scenario": sc, "options": {"iterations": "many"}})
+    with pytest.raises(TautError, match=r"^search: unknown search"):
+        api.baseline({"scenario": sc, "options": {"search": "bfs"}})
+
+
 def test_feasible_pose_tensions_and_margins_are_the_library_s(cdpr):
     api, model = cdpr
     robot = load_cdpr_model("fastkit")

@@ -1,5 +1,5 @@
 """The HTTP layer: JSON error contract (one line, no traceback, server keeps running),
-static files served, and `taut app` refusing a busy port with one line and exit 2."""
+static files (the vendored Plotly.js included) served, and `taut app` refusing a busy port with one line and exit 2."""
 
 import json
 import socket
@@ -34,13 +34,30 @@ def client():
 def test_page_and_scripts_are_served(client):
     page = client.get("/")
     assert page.status_code == 200 and "<svg id=\"sheet-top\"" in page.text
-    for name in ("common.js", "sheet.js", "sheet_draw.js", "plan.js", "cdpr.js",
+    for name in ("common.js", "charts.js", "sheet.js", "sheet_draw.js", "plan.js", "cdpr.js",
                  "view3d.js", "main.js", "app.css"):
         assert (static_dir() / name).is_file()
         assert client.get(f"/static/{name}").status_code == 200
         assert f"/static/{name}" in page.text
     assert "http" not in "".join((static_dir() / n).read_text() for n in
                                  ("common.js", "main.js")).replace("http://www.w3.org", "")
+
+
+def test_vendored_charts_are_served_as_recorded(client):
+    """Plotly.js is shipped in the package (no CDN): the page loads it from /static, the
+    file's sha256 is the one its README records, and its licence ships beside it."""
+    import hashlib
+    import re
+    vendor = static_dir() / "vendor"
+    page = client.get("/").text
+    assert '<script src="/static/vendor/plotly-gl3d.min.js">' in page
+    assert not re.search(r"""src=["']?(https?:)?//""", page)
+    readme = (vendor / "README.md").read_text()
+    for name in ("plotly-gl3d.min.js", "plotly-LICENSE.txt"):
+        digest = hashlib.sha256((vendor / name).read_bytes()).hexdigest()
+        assert re.search(rf"`{re.escape(name)}`.*`{digest}`", readme), name
+        assert client.get(f"/static/vendor/{name}").status_code == 200
+    assert "MIT" in (vendor / "plotly-LICENSE.txt").read_text()
 
 
 def test_catalog_lists_the_examples(client):

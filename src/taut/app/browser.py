@@ -15,14 +15,17 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["find_browser", "served", "chromium", "wait_for", "drag", "FLAGS"]
+__all__ = ["find_browser", "served", "chromium", "wait_for", "drag", "drag_at", "FLAGS"]
 
 _CHROMIUM = ("/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome")
 _CHROMEDRIVER = "/usr/bin/chromedriver"
-#: Chromium flags that work as root on a machine without display or internet access.
+#: Chromium flags that work as root on a machine without display or internet access;
+#: WebGL (the app's 3D views) is rendered in software by SwiftShader, which Chromium
+#: only uses when asked to (the page is the app's own, served from this machine).
 FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--disable-dev-shm-usage", "--window-size=1400,1100")
+         "--disable-dev-shm-usage", "--window-size=1400,1100",
+         "--enable-unsafe-swiftshader", "--use-angle=swiftshader")
 
 
 def find_browser() -> tuple[str, str] | None:
@@ -112,3 +115,17 @@ def drag(driver: Any, css: str, moves: list[tuple[int, int]], step_ms: int = 16)
             if attempt == 2:
                 raise
             driver.execute_script("return 0")        # let the page finish its redraw
+
+
+def drag_at(driver: Any, xy: tuple[float, float], moves: list[tuple[int, int]],
+            step_ms: int = 16) -> None:
+    """Real pointer input from a point of the page: press at ``xy`` (CSS pixels in the
+    viewport, e.g. where a chart draws a point), move by each (dx, dy) step, release."""
+    from selenium.webdriver.common.actions.action_builder import ActionBuilder
+
+    ab = ActionBuilder(driver, duration=step_ms)
+    ab.pointer_action.move_to_location(int(round(xy[0])), int(round(xy[1]))).pointer_down()
+    for dx, dy in moves:
+        ab.pointer_action.move_by(dx, dy)
+    ab.pointer_action.pointer_up()
+    ab.perform()

@@ -1,14 +1,18 @@
-// Cable-robot explorer: pick a preset or model file, move the platform with sliders or
-// by dragging it in the side (x-z) or top (x-y) view; the server returns tensions (drawn
-// as bars against their limits), tipping margins of the mobile bases and whether the pose
-// is wrench-feasible; the side view shades the wrench-feasible slice of the workspace.
+// Cable-robot explorer: pick a preset or model file, move the platform with sliders or by
+// dragging it in the side (x-z) or top (x-y) view; the server returns tensions (charted
+// against their limits), tipping margins of the mobile bases and whether the pose is
+// wrench-feasible; the side view shades the wrench-feasible slice of the workspace and a
+// 3D view (turned with the mouse) shows the frame, bases, cables, platform and the slice.
+// SI units: m, rad, N, N m.
 "use strict";
 
 const AXES = [["x", "m"], ["y", "m"], ["z", "m"], ["roll", "rad"], ["pitch", "rad"], ["yaw", "rad"]];
+//: How near the platform (pixels) a press must be to start dragging it.
+const GRAB_PX = 40;
 
 const CdprView = {
   model: null, geo: null, pose: [0, 0, 0.8, 0, 0, 0], st: null, ws: null,
-  inflight: false, pending: false, source: null,
+  inflight: false, pending: false, source: null, timer3d: null,
 
   init(names) {
     const sel = document.getElementById("cdpr-example");
@@ -20,14 +24,14 @@ const CdprView = {
     const box = document.getElementById("cdpr-sliders");
     this.sliders = AXES.map(([name, unit], k) => {
       const span = document.createElement("span"); span.className = "slider";
-      span.innerHTML = `${name} <input type="range" id="cdpr-${name}" step="0.01"> <output></output> ${unit}`;
+      span.innerHTML = `${name} [${unit}] <input type="range" id="cdpr-${name}" step="0.01"> <output></output>`;
       box.appendChild(span);
       const input = span.querySelector("input");
       input.addEventListener("input", () => { this.pose[k] = Number(input.value); this.request(); });
       input.addEventListener("change", () => { if (k !== 0 && k !== 2) this.slice(); this.saveUrl(); });
       return input;
     });
-    for (const id of ["cdpr-side", "cdpr-top"]) this.dragging(document.getElementById(id), id === "cdpr-side" ? 2 : 1);
+    for (const [id, vert] of [["cdpr-side", 2], ["cdpr-top", 1]]) this.dragging(document.getElementById(id), vert);
   },
 
   async load(body, {pose = null, stabilisers = null, method = null} = {}) {
@@ -43,8 +47,6 @@ const CdprView = {
     this.sliders.forEach((s, k) => {
       s.min = k < 3 ? lo[k] : -0.6; s.max = k < 3 ? hi[k] : 0.6; s.value = this.pose[k];
     });
-    this.side = new Frame(document.getElementById("cdpr-side"), [lo[0], lo[2]], [hi[0], hi[2]], 20);
-    this.topf = new Frame(document.getElementById("cdpr-top"), [lo[0] - 0.8, lo[1] - 0.8], [hi[0] + 0.8, hi[1] + 0.8], 12);
     this.ws = null;
     showMessage(`loaded: ${g.name}`, "info");
     this.request(); this.slice(); this.saveUrl();
@@ -81,21 +83,22 @@ const CdprView = {
     if (r.ok) { this.ws = r.data; this.draw(); }
   },
 
+  // Screen position (client pixels) of the platform's centre in a 2D view.
+  platformScreen(id) {
+    return chartScreen(document.getElementById(id), this.pose[0], this.pose[id === "cdpr-side" ? 2 : 1]);
+  },
+
   // Drag the platform in a view; `vert` is the pose index of the view's vertical axis.
-  dragging(svg, vert) {
-    let on = false;
-    svg.addEventListener("pointerdown", e => {
-      if (!this.st || !e.target.closest(".platform")) return;
-      on = true; svg.setPointerCapture(e.pointerId);
-    });
-    svg.addEventListener("pointermove", e => {
-      if (!on) return;
-      const w = (vert === 2 ? this.side : this.topf).world(e);
-      this.pose[0] = w[0]; this.pose[vert] = w[1];
-      this.sliders[0].value = w[0]; this.sliders[vert].value = w[1];
+  dragging(div, vert) {
+    chartDrag(div, (xy, e) => {
+      if (!this.st) return false;
+      const [px, py] = this.platformScreen(div.id);
+      return Math.hypot(e.clientX - px, e.clientY - py) <= GRAB_PX;
+    }, xy => {
+      this.pose[0] = xy[0]; this.pose[vert] = xy[1];
+      this.sliders[0].value = xy[0]; this.sliders[vert].value = xy[1];
       this.request();
-    });
-    svg.addEventListener("pointerup", () => { if (on) { on = false; if (vert === 1) this.slice(); this.saveUrl(); } });
+    }, () => { if (vert === 1) this.slice(); this.saveUrl(); });
   },
 
   draw() {
@@ -105,60 +108,119 @@ const CdprView = {
     flag.textContent = st.message;
     flag.className = "flag " + (st.feasible ? "ok" : "bad");
     flag.dataset.feasible = st.feasible ? "1" : "0";
-    this.drawView(document.getElementById("cdpr-side"), this.side, 0, 2);
-    this.drawView(document.getElementById("cdpr-top"), this.topf, 0, 1);
+    this.drawView("cdpr-side", 0, 2);
+    this.drawView("cdpr-top", 0, 1);
+    // The 3D view follows once the input pauses (QUIET_MS, view3d.js): a WebGL redraw per
+    // drag step would slow the 2D views' drags.
+    if (this.timer3d !== null) clearTimeout(this.timer3d);
+    this.timer3d = setTimeout(() => { this.timer3d = null; this.draw3D(); }, QUIET_MS);
     this.drawBars(); this.drawMargins();
   },
 
-  drawView(svg, fr, a, b) {
-    clear(svg);
-    const g = this.geo, st = this.st, [lo, hi] = g.bounds;
-    const rect = (l, h, attrs) => el("rect", Object.assign({x: fr.x(l[a]), y: fr.y(h[b]), width: (h[a] - l[a]) * fr.s,
-                                                              height: (h[b] - l[b]) * fr.s}, attrs), svg);
-    if (b === 2 && this.ws) {
-      const ws = this.ws, dx = ws.a[1] - ws.a[0], dz = ws.b[1] - ws.b[0];
-      ws.b.forEach((z, i) => ws.a.forEach((x, j) => {
-        const lim = ws.feasible[i][j], tip = ws.feasible_tipping ? ws.feasible_tipping[i][j] : lim;
-        if (!lim) return;
-        el("rect", {x: fr.x(x - dx / 2), y: fr.y(z + dz / 2), width: dx * fr.s + 0.5, height: dz * fr.s + 0.5,
-                    fill: tip ? "rgba(40,160,60,0.28)" : "rgba(230,180,30,0.3)"}, svg);
-      }));
-    }
-    rect(lo, hi, {fill: "none", stroke: "#999", "stroke-dasharray": "4 3"});
-    if (g.desired_workspace) rect(...g.desired_workspace, {fill: "none", stroke: "#46c"});
-    if (b === 1) for (const base of g.bases) {
-      if (base.support) el("polygon", {points: fr.poly(base.support), fill: "rgba(120,120,120,0.2)", stroke: "#666"}, svg);
-    }
-    const A = st.attachments, T = st.tensions;
-    g.exits.forEach((e, i) => {
-      const t = T ? T[i] : null, bad = t === null || t < g.t_min[i] - 1e-6 || t > g.t_max[i] + 1e-6;
-      el("line", {x1: fr.x(e[a]), y1: fr.y(e[b]), x2: fr.x(A[i][a]), y2: fr.y(A[i][b]),
-                  stroke: bad ? "#c00" : "#1f5fbf", "stroke-width": 1.2}, svg);
-      el("circle", {cx: fr.x(e[a]), cy: fr.y(e[b]), r: 3, fill: "#333"}, svg);
-    });
-    const hull = A.map(p => [p[a], p[b]]);
-    el("polygon", {points: fr.poly(convexHull(hull)), fill: st.feasible ? "#3a7" : "#d33", stroke: "#222",
-                   class: "platform", cursor: "move"}, svg);
+  cableBad(i) {
+    const t = this.st.tensions ? this.st.tensions[i] : null, g = this.geo;
+    return t === null || t < g.t_min[i] - 1e-6 || t > g.t_max[i] + 1e-6;
   },
 
+  // A 2D view: axes a (horizontal) and b (vertical) of x, y, z.
+  drawView(id, a, b) {
+    const div = document.getElementById(id), g = this.geo, st = this.st, [lo, hi] = g.bounds;
+    const rect = (l, h) => [[l[a], l[b]], [h[a], l[b]], [h[a], h[b]], [l[a], h[b]]];
+    const traces = [];
+    if (b === 2 && this.ws) traces.push(...this.sliceTraces(div));
+    traces.push(polygon(rect(lo, hi), "frame box", "rgba(0,0,0,0)", "#999", {line: {color: "#999", dash: "dash", width: 1}}));
+    if (g.desired_workspace) traces.push(polygon(rect(...g.desired_workspace), "desired workspace", "rgba(0,0,0,0)", "#46c"));
+    if (b === 1) g.bases.filter(s => s.support).forEach((s, k) => traces.push(
+      polygon(s.support, "base support polygons", "rgba(120,120,120,0.2)", "#666", {legendgroup: "bases", showlegend: k === 0})));
+    const A = st.attachments;
+    for (const bad of [false, true]) {
+      const x = [], y = [];
+      g.exits.forEach((e, i) => { if (this.cableBad(i) === bad) x.push(e[a], A[i][a], null), y.push(e[b], A[i][b], null); });
+      if (x.length) traces.push(line(x, y, bad ? "cable off its limits" : "cable within limits", bad ? "#c00" : "#1f5fbf"));
+    }
+    traces.push({type: "scatter", mode: "markers", x: g.exits.map(e => e[a]), y: g.exits.map(e => e[b]),
+                 name: "cable exits", marker: {color: "#333", size: 6}});
+    const hull = convexHull(A.map(p => [p[a], p[b]]));
+    traces.push(polygon(hull, "platform (drag it)", st.feasible ? "#3a7" : "#d33", "#222", {hoverinfo: "name"}));
+    const names = ["x [m]", "y [m]", "z [m]"], pad = b === 1 ? 0.8 : 0.15;
+    // Fixed ranges: the map does not rescale while the platform is dragged.
+    chart2d(div, traces, names[a], names[b], {equal: true, drag: false,
+            x: {range: [lo[a] - pad, hi[a] + pad]}, y: {range: [lo[b] - pad, hi[b] + pad]}});
+  },
+
+  // The wrench-feasible slice as square cells (green: limits and tipping; yellow: the
+  // tension limits only, the bases would tip).
+  sliceTraces(div) {
+    const ws = this.ws, dx = ws.a[1] - ws.a[0], fl = div._fullLayout;
+    const px = fl && fl.xaxis && fl.xaxis._m ? Math.abs(fl.xaxis._m) * dx : 8;
+    const cells = [[], []];
+    ws.b.forEach((z, i) => ws.a.forEach((x, j) => {
+      const lim = ws.feasible[i][j], tip = ws.feasible_tipping ? ws.feasible_tipping[i][j] : lim;
+      if (lim) cells[tip ? 0 : 1].push([x, z]);
+    }));
+    return cells.map((c, k) => ({
+      type: "scatter", mode: "markers", x: c.map(p => p[0]), y: c.map(p => p[1]), hoverinfo: "skip",
+      name: k ? "feasible by limits, bases tip" : `wrench-feasible slice (y = ${ws.offset.toFixed(2)} m)`,
+      marker: {symbol: "square", size: Math.max(2, px), color: k ? "rgba(230,180,30,0.35)" : "rgba(40,160,60,0.3)"},
+    })).filter(t => t.x.length);
+  },
+
+  draw3D() {
+    const g = this.geo, st = this.st, [lo, hi] = g.bounds, A = st.attachments, traces = [];
+    const c = [0, 1, 2].map(k => [lo[k], hi[k]]), edges = [];
+    for (const [i, j] of [[0, 1], [1, 2], [0, 2]]) for (const u of c[i]) for (const v of c[j]) {
+      const k = 3 - i - j, p = [0, 0, 0], q = [0, 0, 0];
+      p[i] = q[i] = u; p[j] = q[j] = v; p[k] = c[k][0]; q[k] = c[k][1];
+      edges.push([p, q]);
+    }
+    traces.push(segments3(edges, "frame box", "#aaa", {line: {color: "#aaa", width: 2, dash: "dash"}}));
+    g.bases.filter(s => s.support).forEach((s, k) => traces.push(
+      line3(s.support.concat([s.support[0]]).map(p => [p[0], p[1], 0]), "base support polygons", "#666",
+            {legendgroup: "bases", showlegend: k === 0})));
+    for (const bad of [false, true]) {
+      const pairs = g.exits.map((e, i) => [e, A[i], i]).filter(p => this.cableBad(p[2]) === bad);
+      if (pairs.length) traces.push(segments3(pairs, bad ? "cable off its limits" : "cable within limits", bad ? "#c00" : "#1f5fbf"));
+    }
+    traces.push({type: "scatter3d", mode: "markers", name: "cable exits", x: g.exits.map(e => e[0]),
+                 y: g.exits.map(e => e[1]), z: g.exits.map(e => e[2]), marker: {size: 3, color: "#333"}});
+    const hullEdges = [];
+    A.forEach((p, i) => A.forEach((q, j) => { if (j > i) hullEdges.push([p, q]); }));
+    traces.push(segments3(hullEdges, "platform", st.feasible ? "#2a8a4a" : "#d33", {line: {width: 3, color: st.feasible ? "#2a8a4a" : "#d33"}}));
+    if (this.ws) {
+      const pts = [];
+      this.ws.b.forEach((z, i) => this.ws.a.forEach((x, j) => { if (this.ws.feasible[i][j]) pts.push([x, this.ws.offset, z]); }));
+      traces.push({type: "scatter3d", mode: "markers", name: `wrench-feasible slice (y = ${this.ws.offset.toFixed(2)} m)`,
+                   x: pts.map(p => p[0]), y: pts.map(p => p[1]), z: pts.map(p => p[2]), hoverinfo: "skip",
+                   marker: {size: 2, color: "rgba(40,160,60,0.35)"}});
+    }
+    chart3d(document.getElementById("cdpr-3d"), traces, ["x [m]", "y [m]", "z [m]"], {zoom: 1.5});
+  },
+
+  // Tensions against their limits: per cable the band [t_min, t_max] and the tension.
   drawBars() {
-    const svg = document.getElementById("cdpr-bars"), g = this.geo, T = this.st.tensions;
-    clear(svg);
-    const W = svg.width.baseVal.value, top = Math.max(...g.t_max) * 1.15, m = g.cables.length;
-    const h = Math.min(20, (svg.height.baseVal.value - 20) / m), L = 60, X = v => L + v / top * (W - L - 70);
-    g.cables.forEach((name, i) => {
-      const y = 4 + i * h, t = T ? T[i] : null;
-      el("text", {x: 4, y: y + h * 0.7, "font-size": 11}, svg).textContent = name;
-      el("rect", {x: X(g.t_min[i]), y, width: X(g.t_max[i]) - X(g.t_min[i]), height: h - 4, fill: "#eef", stroke: "#99b"}, svg);
-      if (t !== null) {
-        const bad = t < g.t_min[i] - 1e-6 || t > g.t_max[i] + 1e-6;
-        const tc = Math.min(Math.max(t, 0), top);                 // bar clipped to the axis
-        el("rect", {x: X(0), y: y + 3, width: X(tc) - X(0), height: h - 10, fill: bad ? "#d33" : "#3a7", class: "tension-bar"}, svg);
-        el("text", {x: X(tc) + 4, y: y + h * 0.7, "font-size": 10}, svg).textContent = t.toFixed(1);
+    const g = this.geo, T = this.st.tensions, names = g.cables, traces = [];
+    const seg = (from, to, which) => {
+      const x = [], y = [];
+      names.forEach((n, i) => { if (which(i)) x.push(from(i), to(i), null), y.push(n, n, null); });
+      return [x, y];
+    };
+    traces.push(line(...seg(i => g.t_min[i], i => g.t_max[i], () => true), "limits [t_min, t_max]", "#c8cce8",
+                     {line: {color: "#c8cce8", width: 14}}));
+    if (T) {
+      for (const bad of [false, true]) {
+        const [x, y] = seg(() => 0, i => T[i], i => this.cableBad(i) === bad);
+        if (x.length) traces.push(line(x, y, bad ? "tension off its limits" : "tension within limits", bad ? "#d33" : "#3a7",
+                                       {line: {color: bad ? "#d33" : "#3a7", width: 6}}));
       }
-    });
-    el("text", {x: L, y: 4 + m * h + 12, "font-size": 10}, svg).textContent =
-      T ? `tensions: ${this.st.shown}; band: limits [t_min, t_max]` : "no tensions: " + this.st.message;
+      traces.push({type: "scatter", mode: "text", x: T, y: names, text: T.map(t => t === null ? "" : t.toFixed(1)),
+                   textposition: T.map(t => t < 0 ? "middle left" : "middle right"), showlegend: false, hoverinfo: "skip", textfont: {size: 10}});
+    }
+    const vals = (T || []).filter(t => t !== null).concat(g.t_max, [0]);
+    const lo = Math.min(...vals), hi = Math.max(...vals), room = 0.16 * (hi - lo || 1);  // value labels
+    chart2d(document.getElementById("cdpr-bars"), traces, "tension [N]", "cable",
+            {y: {type: "category", autorange: "reversed"}, x: {range: [lo - (lo < 0 ? room : 0), hi + room]}});
+    document.getElementById("cdpr-bars-note").textContent =
+      T ? `tensions: ${this.st.shown}` : "no tensions: " + this.st.message;
   },
 
   drawMargins() {

@@ -1,5 +1,6 @@
 // Shared helpers of the taut app page: JSON requests, the one-line message bar, SVG
-// drawing with a world-to-screen frame, shareable URL state and file download/upload.
+// drawing with a world-to-screen frame and axes (the sheet explorer's editable maps; the
+// charts are Plotly.js, charts.js), shareable URL state and file download/upload.
 "use strict";
 
 const taut = {views: {}, current: null};
@@ -84,42 +85,37 @@ function grow([lo, hi], f) {
   return [[lo[0] - d, lo[1] - d], [hi[0] + d, hi[1] + d]];
 }
 
-// A small line plot: series [{t, y, color, dash, label}], with a cursor at time tc.
-function linePlot(svg, series, {tc = null, ylabel = "", zero = false} = {}) {
-  clear(svg);
-  const pts = [];
-  for (const s of series) s.t.forEach((t, i) => { if (s.y[i] !== null) pts.push([t, s.y[i]]); });
-  if (!pts.length) return;
-  let [lo, hi] = bbox(pts);
-  if (zero) lo[1] = Math.min(lo[1], 0);
-  const dy = (hi[1] - lo[1]) || Math.abs(hi[1]) || 1;
-  lo = [lo[0], lo[1] - 0.08 * dy]; hi = [hi[0], hi[1] + 0.08 * dy];
-  const W = svg.width.baseVal.value, H = svg.height.baseVal.value, L = 48, B = 18;
-  const X = t => L + (t - lo[0]) / ((hi[0] - lo[0]) || 1) * (W - L - 8);
-  const Y = v => 6 + (hi[1] - v) / (hi[1] - lo[1]) * (H - B - 6);
-  el("line", {x1: L, y1: H - B, x2: W - 8, y2: H - B, stroke: "#999"}, svg);
-  el("line", {x1: L, y1: 6, x2: L, y2: H - B, stroke: "#999"}, svg);
-  for (const v of [lo[1] + 0.08 * dy / 1.16, hi[1] - 0.08 * dy / 1.16]) {
-    el("text", {x: 2, y: Y(v) + 4, "font-size": 10}, svg).textContent = v.toPrecision(3);
-  }
-  el("text", {x: W - 60, y: H - 4, "font-size": 10}, svg).textContent = `t [s] ${hi[0].toFixed(1)}`;
-  let ly = 14;
-  for (const s of series) {
-    let d = "", pen = false;
-    s.t.forEach((t, i) => {
-      if (s.y[i] === null) { pen = false; return; }
-      d += (pen ? "L" : "M") + X(t).toFixed(1) + "," + Y(s.y[i]).toFixed(1);
-      pen = true;
-    });
-    el("path", {d, fill: "none", stroke: s.color, "stroke-width": 1.5,
-                "stroke-dasharray": s.dash || ""}, svg);
-    if (s.label) {
-      el("text", {x: W - 200, y: ly, "font-size": 10, fill: s.color}, svg).textContent = s.label;
-      ly += 12;
+// A "nice" tick step: 1, 2 or 5 times a power of ten, about `n` ticks over `span`.
+function niceStep(span, n) {
+  const raw = span / n, p = 10 ** Math.floor(Math.log10(raw)), m = raw / p;
+  return p * (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10);
+}
+
+// Axes of an editable SVG map (the sheet explorer's views, where pointer input moves the
+// robots): light grid, tick labels along the bottom and left edges and axis titles with
+// their units. Drawn first, under the content.
+function svgAxes(fr, xTitle, yTitle) {
+  const svg = fr.svg, W = fr.w, H = fr.h, L = 40, B = 30;
+  const xs = [fr.cx - (W / 2 - L) / fr.s, fr.cx + (W / 2) / fr.s];
+  const ys = [fr.cy - (H / 2 - B) / fr.s, fr.cy + (H / 2) / fr.s];
+  const g = el("g", {class: "axes"}, svg);
+  for (const [lo, hi, horiz] of [[...xs, true], [...ys, false]]) {
+    const step = niceStep(hi - lo, 5), digits = Math.max(0, -Math.floor(Math.log10(step)));
+    for (let v = Math.ceil(lo / step) * step; v <= hi; v += step) {
+      const p = horiz ? fr.x(v) : fr.y(v);
+      if (horiz ? p > W - 12 : p < 8) continue;               // no label cut by the edge
+      el("line", horiz ? {x1: p, y1: 0, x2: p, y2: H - B} : {x1: L, y1: p, x2: W, y2: p},
+         g).setAttribute("stroke", "#eee");
+      el("text", horiz ? {x: p, y: H - B + 11, "text-anchor": "middle"} : {x: L - 3, y: p + 3, "text-anchor": "end"},
+         g).textContent = v.toFixed(digits);
     }
   }
-  if (tc !== null) el("line", {x1: X(tc), y1: 6, x2: X(tc), y2: H - B, stroke: "#c00",
-                               "stroke-width": 1, class: "cursor"}, svg);
+  el("line", {x1: L, y1: H - B, x2: W, y2: H - B, stroke: "#888"}, g);
+  el("line", {x1: L, y1: 0, x2: L, y2: H - B, stroke: "#888"}, g);
+  el("text", {x: (L + W) / 2, y: H - 4, "text-anchor": "middle", class: "axis-title"}, g).textContent = xTitle;
+  el("text", {x: 11, y: (H - B) / 2, "text-anchor": "middle", class: "axis-title",
+              transform: `rotate(-90 11 ${(H - B) / 2})`}, g).textContent = yTitle;
+  for (const t of g.querySelectorAll("text")) t.setAttribute("font-size", t.classList.contains("axis-title") ? 11 : 9);
 }
 
 // --- shareable state in the URL hash (base64 of JSON) ------------------------------
@@ -140,9 +136,9 @@ function saveUrl(state) {
   history.replaceState(null, "", "#" + encodeState(state));
 }
 
-function download(text, filename) {
+function download(data, filename, type = "application/x-yaml") {
   const a = document.createElement("a");
-  a.href = URL.createObjectURL(new Blob([text], {type: "application/x-yaml"}));
+  a.href = URL.createObjectURL(new Blob([data], {type}));
   a.download = filename;
   document.body.appendChild(a);
   a.click();

@@ -30,7 +30,7 @@ async function restore() {
     let st = null;
     try { st = decodeState(hash); } catch (e) { showMessage("link: cannot read the view in this URL", "error"); }
     if (st && st.v === "sheet") { showView("sheet"); return SheetView.load({scenario: st.s}); }
-    if (st && st.v === "plan") { showView("plan"); return PlanView.load({scenario: st.s}, {run: st.k !== null, k: st.k}); }
+    if (st && st.v === "plan") { showView("plan"); return PlanView.load({scenario: st.s}, {run: st.k !== null, k: st.k, options: st.o}); }
     if (st && st.v === "cdpr") {
       showView("cdpr");
       return CdprView.load(st.src, {pose: st.pose, stabilisers: st.stab, method: st.method});

@@ -2,7 +2,8 @@
 // kinematics and draws every equilibrium (taut cables solid; the selected state also its
 // slack cables, dotted), the sheet in its own frame, a 3D view of the lowest stable
 // state and a table. IK mode: click a target. Simulate mode: record a drag path and
-// play it through the quasi-static model.
+// play it through the quasi-static model, with charts of the object's height and of the
+// taut set along the path (Plotly.js, charts.js). Lengths in the scenario's unit.
 "use strict";
 
 const KIND_COLOR = {stable: "#1a8a2a", saddle: "#d08020", not_equilibrium: "#999"};
@@ -52,10 +53,11 @@ const SheetView = {
     this.path = []; this.fk = null;
     if (sc.mass) document.getElementById("sheet-mass").value = sc.mass;
     document.getElementById("ik-height").value = (sc.hold_height / 2).toPrecision(4);
+    document.getElementById("ik-height-box").firstChild.textContent = `IK height [${this.units()}] `;
     const V = sc.sheet, cv = centroid(V);
     this.size = Math.max(...V.map(v => Math.hypot(v[0] - cv[0], v[1] - cv[1])));
-    this.frame = new Frame(this.top, ...grow(bbox(this.formation), 0.3));
-    this.sframe = new Frame(this.frameSvg, ...grow(bbox(V), 0.08), 16);
+    this.frame = new Frame(this.top, ...grow(bbox(this.formation), 0.3), 40);
+    this.sframe = new Frame(this.frameSvg, ...grow(bbox(V), 0.08), 36);
     this.requestFK(performance.now());
     this.saveUrl();
   },
@@ -162,16 +164,19 @@ const SheetView = {
     const F = this.densePath();
     const r = await api("/api/sheet/simulate", this.body({formations: F}));
     if (!r.ok) return;
-    const sim = r.data.simulation, jumps = sim.events.filter(e => e.kind === "jump");
+    const sim = r.data.simulation, jumps = sim.events.filter(e => e.kind === "jump"), u = this.units();
+    this.sim = sim;
     document.getElementById("sim-events").textContent = jumps.length ?
-      jumps.map(e => `jump at step ${e.step}/${F.length - 1}: taut {${e.taut_before.map(i => i + 1)}} -> {${e.taut_after.map(i => i + 1)}}, drop ${fmt(e.drop)}`).join("; ")
+      jumps.map(e => `jump at step ${e.step}/${F.length - 1}: taut {${e.taut_before.map(i => i + 1)}} -> {${e.taut_after.map(i => i + 1)}}, drop ${fmt(e.drop)} ${u}`).join("; ")
       : `no jump along ${F.length} steps`;
+    this.drawSimCharts(F, sim, 0);
     this.playing = true;
     const T = F.length, per = Math.max(1, Math.ceil(T / 120));
     let k = 0;
     const frame = () => {
       this.formation = F[k];
       this.drawSimulation(F, sim, k);
+      this.moveSimCursor(k);
       if (k < T - 1) { k = Math.min(T - 1, k + per); requestAnimationFrame(frame); return; }
       this.playing = false;
       document.getElementById("sheet-status").textContent += " (played)";
@@ -207,9 +212,35 @@ const SheetView = {
     }
     this.drawRobots();
     document.getElementById("sheet-status").textContent =
-      `simulate: step ${k}/${F.length - 1}, object height ${o[2] === null ? "lost" : o[2].toFixed(2)}`;
-    this.view3d.set({formation: F[k], hold: this.sc.hold_height, center: centroid(F[k]), scale: this.size,
+      `simulate: step ${k}/${F.length - 1}, object height ${o[2] === null ? "lost" : o[2].toFixed(2) + " " + this.units()}`;
+    this.view3d.set({formation: F[k], hold: this.sc.hold_height, units: this.sc.units,
                      object: o[0] === null ? null : o, taut: sim.taut[k], note: "object lost"});
+  },
+
+  units() { return this.sc && this.sc.units ? this.sc.units : "sheet units"; },
+
+  // Charts of a simulation: the object's height per step (jumps marked) and which
+  // robots' cables are taut per step; a cursor follows the playback.
+  drawSimCharts(F, sim, k) {
+    document.getElementById("sim-charts").hidden = false;
+    const steps = sim.object.map((o, j) => j), u = this.units(), jumps = sim.events.filter(e => e.kind === "jump");
+    const jumpTrace = {type: "scatter", mode: "markers", name: "jump", x: jumps.map(e => e.step),
+                       y: jumps.map(e => e.object_before[2]), marker: {symbol: "x", size: 10, color: "#c00"}};
+    chart2d(document.getElementById("sim-height"), [
+      line(steps, sim.object.map(o => o[2]), "object height", "#e07010"),
+      jumpTrace,
+    ], "step along the path [index]", `object height [${u}]`, {shapes: [cursor(k)]});
+    const x = [], y = [];
+    for (let i = 0; i < F[0].length; i++) {
+      sim.taut.forEach((t, j) => { x.push(j); y.push(t.includes(i) ? i + 1 : null); });
+      x.push(null); y.push(null);
+    }
+    chart2d(document.getElementById("sim-taut"), [line(x, y, "cable taut", "#1f5fbf", {line: {color: "#1f5fbf", width: 6}})],
+            "step along the path [index]", "robot [1-based]", {shapes: [cursor(k)], y: {dtick: 1}});
+  },
+
+  moveSimCursor(k) {
+    for (const id of ["sim-height", "sim-taut"]) Plotly.relayout(document.getElementById(id), {shapes: [cursor(k)]});
   },
 };
 

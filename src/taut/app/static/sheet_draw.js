@@ -18,6 +18,7 @@ Object.assign(SheetView, {
   drawBase(F, fk) {
     clear(this.top);
     const fr = this.frame;
+    svgAxes(fr, `x [${this.units()}]`, `y [${this.units()}]`);
     el("polygon", {points: fr.poly(F), fill: "rgba(70,120,200,0.06)", stroke: "#9ab",
                    "stroke-dasharray": "2 3"}, this.top);
     if (this.path.length > 1) {
@@ -66,6 +67,7 @@ Object.assign(SheetView, {
   drawSheetFrame(fk) {
     const svg = this.frameSvg, fr = this.sframe, V = this.sc.sheet;
     clear(svg);
+    svgAxes(fr, `x, sheet frame [${this.units()}]`, `y, sheet frame [${this.units()}]`);
     el("polygon", {points: fr.poly(V), fill: "rgba(70,120,200,0.12)", stroke: "#46c"}, svg);
     V.forEach((v, i) => {
       el("text", {x: fr.x(v[0]) + 3, y: fr.y(v[1]) - 3, "font-size": 11}, svg).textContent = String(i + 1);
@@ -104,7 +106,7 @@ Object.assign(SheetView, {
 
   draw3D(F, fk) {
     const low = fk && fk.feasible && fk.lowest !== null ? fk.equilibria[fk.lowest] : null;
-    this.view3d.set({formation: F, hold: this.sc.hold_height, center: centroid(F), scale: this.size,
+    this.view3d.set({formation: F, hold: this.sc.hold_height, units: this.sc.units,
                      object: low ? low.object : null, taut: low ? low.taut : [],
                      note: fk && !fk.feasible ? "infeasible formation" : "no stable state"});
   },
