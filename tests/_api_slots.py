@@ -20,6 +20,7 @@ import numpy as np
 from pydantic import BaseModel
 
 ROOT = Path(__file__).parents[1]
+WAREHOUSE = ROOT / "examples" / "cdpr" / "warehouse.yaml"
 MODULES = ("taut.sheet", "taut.plan", "taut.cdpr", "taut.physics", "taut.sweep", "taut.io")
 
 #: Public names not called by the fuzz, with the reason.
@@ -34,11 +35,16 @@ NOT_CALLED: dict[str, str] = {
         "LiftBound TallestWorkspace Mode HPolytopeBatch Interference CableFKResult "
         "ControlEvent ControlResult MonteCarloResult SettleResult StateCheck "
         "EquilibriaCheck TippingCheck TippingGridCheck SweepResult SheetScenario "
-        "Reference Task MovingDeploymentResult BaseDrivePlan").split()},
+        "Reference Task MovingDeploymentResult BaseDrivePlan RobotTrajectories "
+        "ObjectFeedback").split()},
     **{name: "typing alias (Literal), not a function" for name in
        ("ModeName", "QPSolver", "TensionMethod")},
     "UnknownObstacleError": "an exception class",
     "Controller": "abstract base class (its subclasses are called)",
+    **{name: "result container built by an analysis, not by users" for name in
+       "NavigationResult NavigationCertificate SitesResult Site UnservedTask".split()},
+    **{name: "result container built by an analysis, not by users" for name in
+       "TimedPath MissionResult Phase".split()},
 }
 
 #: Callables whose valid call runs a search or a simulation (seconds): only their model
@@ -48,7 +54,8 @@ HEAVY = frozenset(
     "replay_tipping_grid run_sweep tallest_workspace plan_deployment lift_bound "
     "generate_suite find_route formation_library optimal_formation inverse_kinematics "
     "find_certificate motion_from_legs verify_motion Simulator cable_forward_kinematics "
-    "evaluate_chunk plan_moving_deployment staged_lift_bound".split())
+    "evaluate_chunk plan_moving_deployment staged_lift_bound plan_navigation choose_sites object_feedback "
+    "plan_mission time_optimal_path".split())
 
 
 @functools.lru_cache(maxsize=None)
@@ -56,10 +63,10 @@ def fixtures() -> dict[str, Any]:
     """Valid models and data shared by every call (built once)."""
     from taut.cdpr import (cable_state, distribute_tensions, fastkit_motion_limits,
                            pick_and_place, resolve_mode, available_twist_set)
-    from taut.io import load_cdpr_model, plan_scenario_to_mapping
+    from taut.io import load_cdpr_model, load_warehouse, plan_scenario_to_mapping
     from taut.plan import generate_scenario, formation_library
     from taut.plan.result import failure
-    from taut.sheet import Sheet, SheetTeam
+    from taut.sheet import Sheet, SheetTeam, forward_kinematics
 
     robot = load_cdpr_model("fastkit")
     pose = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
@@ -76,16 +83,31 @@ def fixtures() -> dict[str, Any]:
         robot=robot, pose=pose, state=state, scenario=scenario, nominal=nominal,
         no_plan=failure(scenario, "no plan", "disc"),
         sheet=sheet, sheet_team=sheet_team, formation=formation, limits=limits, spec=spec,
+        equilibrium=forward_kinematics(sheet_team, formation).lowest,
         tensions=distribute_tensions(robot, pose).tensions,
         mode=resolve_mode(robot), ats=available_twist_set(robot, pose),
         reference=pick_and_place(robot, [[0, 0, 1.0], [0.05, 0, 1.0]], rate=200.0),
         scenario_map=plan_scenario_to_mapping(scenario),
-        fastkit_map=None)
+        warehouse=load_warehouse(WAREHOUSE), fastkit_map=None)
+
+
+def _warehouse_map() -> dict[str, Any]:
+    """The example warehouse file, parsed."""
+    from taut.io import read_mapping
+    return read_mapping(WAREHOUSE)
 
 
 class _Point(BaseModel):
     """A one-field pydantic model for ``validate_mapping``."""
     x: float
+
+
+def _recording_arguments(suffix: str) -> dict[str, Any]:
+    """A sheet FK result to record, its unit and a file in the test's folder."""
+    from taut.sheet import forward_kinematics
+    f = fixtures()
+    return {"result": forward_kinematics(f["sheet_team"], f["formation"]),
+            "path": f"{{tmp}}/recording.{suffix}", "length_unit": "m"}
 
 
 def valid_arguments(module: str, name: str) -> dict[str, Any]:
@@ -127,6 +149,11 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.plan", "verify_motion"): {},
         ("taut.plan", "plan_profile"): {"result": f["no_plan"]},
         ("taut.plan", "plan_robustness"): {"result": f["no_plan"]},
+        ("taut.plan", "object_feedback"): {"result": f["no_plan"]},
+        ("taut.sheet", "object_covariance"): {"equilibrium": f["equilibrium"],
+                                              "robot_covariance": 1e-6},
+        ("taut.plan", "robot_trajectories"): {"result": f["no_plan"], "max_speed": 0.2,
+                                              "max_accel": 0.5, "max_yaw_rate": 1.0},
         ("taut.plan", "generate_scenario"): {"seed": 0},
         ("taut.plan", "Obstacle"): {"id": "a", "height": 0.1, "center": (0.0, 0.0),
                                    "radius": 0.1},
@@ -160,6 +187,21 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.cdpr", "monte_carlo"): {"duration": 0.02, "model_errors": [ModelErrors()]},
         ("taut.cdpr", "check_footprint"): {"vertices": [[0, 0], [1, 0], [0, 1]]},
         ("taut.cdpr", "with_friction"): {"friction": 0.5},
+        ("taut.cdpr", "Warehouse"): {"robot": f["robot"], "floor": f["warehouse"].floor,
+                                    "shelves": f["warehouse"].shelves, "start": (4.5, 2.0, 0.0),
+                                    "tasks": f["warehouse"].tasks},
+        ("taut.cdpr", "Shelf"): {"name": "A", "footprint": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+        ("taut.cdpr", "to_robot_frame"): {"pose": (1.0, 2.0, 0.5), "points": [[1.0, 2, 3]]},
+        ("taut.cdpr", "to_world_frame"): {"pose": (1.0, 2.0, 0.5), "points": [[1.0, 2, 3]]},
+        ("taut.cdpr", "plan_navigation"): {"warehouse": f["warehouse"], "start": (4.5, 2, 0),
+                                          "goal": (5.0, 2.0, 0.0)},
+        ("taut.cdpr", "choose_sites"): {"warehouse": f["warehouse"]},
+        ("taut.cdpr", "time_optimal_path"): {"robot": f["robot"],
+                                             "waypoints": [[-0.5, 0, 0.6], [0.5, 0, 0.6]]},
+        ("taut.cdpr", "with_box"): {"robot": f["robot"], "mass": 2.0},
+        ("taut.cdpr", "plan_mission"): {"warehouse": f["warehouse"]},
+        ("taut.io", "load_warehouse"): {"source": str(WAREHOUSE)},
+        ("taut.io", "warehouse_from_mapping"): {"data": _warehouse_map()},
         ("taut.cdpr", "lp_max_step"): {"A_eq_x": np.eye(2), "step_col": np.ones(2),
                                       "b_eq": np.zeros(2), "x_bounds": [(0, 1), (0, 1)]},
         ("taut.cdpr", "support"): {"direction": np.eye(6)[0]},
@@ -185,6 +227,8 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.io", "read_mapping"): {"path": str(ROOT / "examples/sheet/example1.yaml")},
         ("taut.io", "read_text"): {"path": "pyproject.toml"},
         ("taut.io", "write_json"): {"path": "/dev/null"},
+        ("taut.io", "write_mcap"): _recording_arguments("mcap"),
+        ("taut.io", "write_rerun"): _recording_arguments("rrd"),
         ("taut.io", "parse_mapping"): {"text": "a: 1\n", "source": "inline.yaml"},
         ("taut.io", "write_text_atomic"): {"path": "{tmp}/out.txt", "text": "x"},
         ("taut.io", "load_sheet_scenario"): {"path": str(ROOT / "examples/sheet/example1.yaml")},

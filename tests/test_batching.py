@@ -60,6 +60,8 @@ EXEMPT = {
     "place_bases": "takes base poses, returns a robot",
     "evaluate_deployment": "scores one placement over a set of sample points",
     "plan_base_drive": "one platform pose held along a base drive (a time series of bases)",
+    "to_robot_frame": "one pose of the coupled bases; its points broadcast over any leading axes",
+    "to_world_frame": "one pose of the coupled bases; its points broadcast over any leading axes",
 }
 
 

@@ -371,6 +371,8 @@ def probe_light(port, token, rounds, busy=lambda: True, pause=0.02):
     return out
 
 
+# A latency bound under load (timing: slow target; bench/bench_app_latency.py measures it).
+@pytest.mark.slow
 def test_light_requests_answer_while_a_heavy_one_runs(app, tmp_path):
     """Heavy requests at once -- FK of 1000 robots, a 15,000-step simulation whose body is
     6 MB and a 1 MB YAML upload, from a client process of their own, so both workers
@@ -544,6 +546,9 @@ def peak_kib(pid):
     return 0
 
 
+# A memory measurement on the heaviest bodies (slow target); the fast suite keeps their
+# refusals (oversized, 100k-deep, alias bomb) and the per-worker cap (507).
+@pytest.mark.slow
 def test_worst_requests_stay_near_1_gib(app):
     """The worst bodies within the 8 MiB limit -- 4 million numbers as one drag path,
     JSON nested 100,000 deep, an alias bomb upload, FK of the most robots -- are refused

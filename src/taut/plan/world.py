@@ -22,6 +22,7 @@ from ..errors import InvalidInputError, PlanningError
 from ..sheet.model import Sheet
 from ..sheet.team import SheetTeam
 from ._tol import INSCRIBED_CIRCLE_RTOL
+from .._repr import CompactRepr
 
 __all__ = ["Obstacle", "World", "Team", "Scenario", "UnknownObstacleError"]
 
@@ -46,8 +47,8 @@ def _circle_polygon(centre: np.ndarray, radius: float) -> Polygon:
     return Polygon(np.column_stack([centre[0] + r_out * np.cos(t), centre[1] + r_out * np.sin(t)]))
 
 
-@dataclass(frozen=True, eq=False)
-class Obstacle:
+@dataclass(frozen=True, eq=False, repr=False)
+class Obstacle(CompactRepr):
     """An obstacle standing on the ground.
 
     Parameters
@@ -122,8 +123,8 @@ class Obstacle:
         return 2.0 * self.mec_radius
 
 
-@dataclass(frozen=True, eq=False)
-class World:
+@dataclass(frozen=True, eq=False, repr=False)
+class World(CompactRepr):
     """Free space and obstacles.
 
     Parameters
@@ -287,8 +288,8 @@ class Team:
         return self.robot_radius + self.lateral_safety
 
 
-@dataclass(frozen=True, eq=False)
-class Scenario:
+@dataclass(frozen=True, eq=False, repr=False)
+class Scenario(CompactRepr):
     """A planning problem: move the object's projection from ``start`` to ``goal``.
 
     Raises

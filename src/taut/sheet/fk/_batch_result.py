@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from ..._units import GRAVITY
@@ -41,14 +43,7 @@ def padded_batch(sheet: Sheet, formations: np.ndarray, hold_height: float,
     B, N = formations.shape[:2]
     count = np.bincount(form, minlength=B) if len(form) else np.zeros(B, dtype=np.intp)
     K = int(count.max()) if B else 0
-    starts = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.intp)
-    slot = np.arange(len(form)) - starts[form]
-
-    def pad(values: np.ndarray, fill: float | bool | int, dtype: type = np.float64
-            ) -> np.ndarray:
-        out: np.ndarray = np.full((B, K) + values.shape[1:], fill, dtype=dtype)
-        out[form, slot] = values
-        return out
+    pad = _padder(form, count, B, K)
 
     valid = pad(np.ones(len(form), dtype=bool), False, bool)
     kinds = pad(kind, -1, np.int8)
@@ -67,6 +62,31 @@ def padded_batch(sheet: Sheet, formations: np.ndarray, hold_height: float,
     status = np.where(direct & ~success, "not_strict", status)
     return BatchFKResult(*arrays, feasible, success, status, message, sheet, formations,
                          hold_height, mass, method)
+
+
+def _padder(form: np.ndarray, count: np.ndarray, B: int, K: int
+            ) -> Callable[..., np.ndarray]:
+    """``pad(values, fill, dtype=float64)``: the flat per-solution ``values`` (M, ...)
+    placed in fresh padded (B, K, ...) arrays, slot ``j`` of row ``b`` holding formation
+    ``b``'s ``j``-th solution. When every formation has ``K`` solutions (``form`` is then
+    ``0,..,0, 1,..``: the common case of a batch of similar formations) this is a
+    reshaped copy; else one flat index, computed once, places them (a fraction of the cost
+    of indexing by (formation, slot) pairs for every array)."""
+    full = len(form) == B * K
+
+    if not full:
+        starts = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.intp)
+        flat = form.astype(np.intp) * K + (np.arange(len(form)) - starts[form])
+
+    def pad(values: np.ndarray, fill: float | bool | int, dtype: type = np.float64
+            ) -> np.ndarray:
+        shape = (B, K) + values.shape[1:]
+        if full:
+            return np.array(values, dtype=dtype).reshape(shape)
+        out: np.ndarray = np.full((B * K,) + values.shape[1:], fill, dtype=dtype)
+        out[flat] = values
+        return out.reshape(shape)
+    return pad
 
 
 def _row_states(sheet: Sheet, taut: np.ndarray, obj: np.ndarray, contact: np.ndarray,
