@@ -7,16 +7,11 @@ import pytest
 
 from json_compare import assert_same_document
 from taut.cli import main
+from cli_calls import run
 from progress_lines import without_progress
 
 EXAMPLES = sorted((__import__("pathlib").Path(__file__).parents[2] / "examples" / "sheet")
                   .glob("*.yaml"))
-
-
-def run(capsys, *args):
-    code = main(list(map(str, args)))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])

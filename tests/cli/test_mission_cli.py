@@ -6,23 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from taut.cli import main
+from cli_calls import run, one_line_error
 from progress_lines import without_progress
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "cdpr" / "warehouse.yaml"
-
-
-def run(capsys, *args):
-    code = main(list(map(str, args)))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_error(code, out, err, *words):
-    assert code == 2 and out == ""
-    assert err.startswith("taut: error: ") and err.count("\n") == 1, err
-    for w in words:
-        assert w in err, err
 
 
 @pytest.mark.slow

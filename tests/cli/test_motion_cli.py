@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from taut.cli import main
+from cli_calls import run, one_line_error
 from taut.errors import InvalidTrajectoryError, ScenarioError
 from taut.io.trajectory import load_trajectory, parse_trajectory, save_trajectory
 from taut.sheet import Sheet, forward_kinematics
@@ -16,19 +16,6 @@ from progress_lines import without_progress
 TRAJ = Path(__file__).parents[2] / "examples" / "sheet" / "trajectories"
 SCENARIO = TRAJ / "square4.yaml"
 JUMP = TRAJ / "square4_jump.csv"
-
-
-def run(capsys, *args):
-    code = main(list(map(str, args)))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_error(code, out, err, *words):
-    assert code == 2 and out == ""
-    assert err.startswith("taut: error: ") and err.count("\n") == 1, err
-    for w in words:
-        assert w in err, err
 
 
 def test_ik_json_round_trips_through_fk(capsys):

@@ -17,17 +17,12 @@ import yaml
 
 import taut.cli as cli
 from taut.cli import main
+from cli_calls import run
 from taut.errors import InvalidInputError, TautError
 from progress_lines import without_progress
 
 ROOT = Path(__file__).parents[2]
 EX1 = ROOT / "examples" / "sheet" / "example1.yaml"
-
-
-def run(capsys, *args):
-    code = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def one_error_line(err, *words):

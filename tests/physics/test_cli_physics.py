@@ -5,13 +5,7 @@ import json
 import pytest
 import yaml
 
-from taut.cli import main
-
-
-def run(capsys, *args):
-    code = main(list(map(str, args)))
-    out, err = capsys.readouterr()
-    return code, out, err
+from cli_calls import run
 
 
 @pytest.fixture

@@ -2,7 +2,7 @@
 
 import pytest
 
-from taut.cli import main
+from cli_calls import run
 
 SPEC = """task: fk_stability_map
 base: {base}
@@ -19,12 +19,6 @@ def spec_file(tmp_path, examples_dir):
     path = tmp_path / "sweep.yaml"
     path.write_text(SPEC.format(base=examples_dir / "sheet" / "example2_r2_r4_353mm.yaml"))
     return path
-
-
-def run(capsys, *args):
-    code = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_run_then_plot(capsys, spec_file, tmp_path):
