@@ -58,8 +58,8 @@ def test_serial_sweep_interrupted_keeps_its_chunks(tmp_path):
 
 @pytest.mark.parametrize("args", [
     ["cdpr", "workspace", "fastkit", "--grid", "301", "1", "301"],
-    ["cdpr", "simulate", "fastkit", "--waypoints",
-     "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 20)],
+    ["cdpr", "simulate", "fastkit", "--stabilisers", "--waypoints",    # ~10 s idle
+     "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 100)],
 ], ids=lambda a: " ".join(a[:2]))
 def test_cable_robot_commands_interrupted(args):
     """A workspace grid (a loop of solver calls) and a control simulation (a compiled
