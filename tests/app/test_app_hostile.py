@@ -16,6 +16,7 @@ import subprocess
 import sys
 import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from urllib.parse import parse_qs, urlparse
 
@@ -88,6 +89,39 @@ def api(port, token, path, body=None, method="POST", **kw):
         headers["Content-Type"] = "application/json"
     headers.update(kw.pop("headers", {}))
     return request(port, method, path, body, headers, **kw)
+
+
+def post_head(port, token, path, length=None):
+    """Head of a raw JSON POST to ``path`` (with ``Content-Length`` when given; the blank
+    line ends the head only then), for tests that send bodies by hand."""
+    head = (f"POST {path} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
+            f"X-Taut-Token: {token}\r\nContent-Type: application/json\r\n")
+    return head if length is None else head + f"Content-Length: {length}\r\n\r\n"
+
+
+@contextmanager
+def one_worker_app(**kw):
+    """An in-process app with one worker process (``create_app(workers=1, **kw)``),
+    served on loopback: yields ``(app, port, token)``."""
+    from taut.app import server
+    from taut.app.browser import served
+    from taut.app.catalog import Catalog
+
+    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1, **kw)
+    with served(app) as url:
+        yield app, urlparse(url).port, app.state.token
+
+
+def simulate_in_background(app, port, token, body, replies):
+    """Start the simulation ``body`` in a thread (its reply appended to ``replies``) and
+    wait until the app's one worker has taken it; returns the thread."""
+    t = threading.Thread(target=lambda: replies.append(
+        api(port, token, "/api/sheet/simulate", body, timeout=300)))
+    t.start()
+    deadline = time.monotonic() + 30
+    while app.state.pool.pids() and time.monotonic() < deadline:   # worker taken
+        time.sleep(0.02)
+    return t
 
 
 # --- who may drive it ---------------------------------------------------------------
@@ -191,8 +225,7 @@ def rss_kib(pid):
 def test_oversized_bodies_are_refused_while_streaming(app):
     proc, port, token = app
     before = rss_kib(proc.pid)
-    head = (f"POST /api/sheet/load HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-            f"X-Taut-Token: {token}\r\nContent-Type: application/json\r\n")
+    head = post_head(port, token, "/api/sheet/load")
     # 1. declared 256 MiB: refused before any of it is sent
     with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
         s.sendall((head + f"Content-Length: {256 * 2**20}\r\n\r\n").encode())
@@ -227,9 +260,7 @@ def test_slow_body_times_out():
         with served(app) as url:
             port = urlparse(url).port
             with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
-                s.sendall((f"POST /api/sheet/load HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-                           f"X-Taut-Token: {app.state.token}\r\n"
-                           "Content-Type: application/json\r\nContent-Length: 100\r\n\r\n{")
+                s.sendall((post_head(port, app.state.token, "/api/sheet/load", 100) + "{")
                           .encode())
                 t0 = time.perf_counter()
                 reply = read_reply(s)
@@ -436,21 +467,13 @@ def test_a_dropped_request_frees_its_worker():
     """With one worker: a heavy simulation whose client hangs up is killed at once (its
     worker process is gone within 3 s, a fresh one replaces it) and the next request is
     served; without cancellation the worker would compute on for the whole simulation."""
-    from taut.app import server
-    from taut.app.browser import served
-    from taut.app.catalog import Catalog
-
-    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1)
     body = json.dumps(heavy_body(20000)).encode()
-    with served(app) as url:
-        port, token = urlparse(url).port, app.state.token
+    with one_worker_app() as (app, port, token):
         assert api(port, token, "/api/sheet/load", {"regular": 4}, timeout=120)[0] == 200
         [first] = app.state.pool.pids()
         st, _, _, full = api(port, token, "/api/sheet/simulate", body, timeout=300)
         assert st == 200                           # compiled, and its full duration
-        head = (f"POST /api/sheet/simulate HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-                f"X-Taut-Token: {token}\r\nContent-Type: application/json\r\n"
-                f"Content-Length: {len(body)}\r\n\r\n").encode()
+        head = post_head(port, token, "/api/sheet/simulate", len(body)).encode()
         with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
             s.sendall(head + body)
             time.sleep(min(1.0, full / 4))        # the worker is computing it now
@@ -472,35 +495,22 @@ def test_a_request_dropped_while_queued_never_reaches_a_worker():
     it waits for the worker leaves the queue (the worker is not killed and restarted for
     it once free, as it would be if the request were handed over first), and the next
     request is served by the same worker."""
-    from taut.app import server
-    from taut.app.browser import served
-    from taut.app.catalog import Catalog
-
-    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1)
     body = json.dumps(heavy_body(20000)).encode()
-    with served(app) as url:
-        port, token = urlparse(url).port, app.state.token
+    with one_worker_app() as (app, port, token):
         assert api(port, token, "/api/sheet/load", {"regular": 4}, timeout=120)[0] == 200
         [first] = app.state.pool.pids()
-        busy = []
-        t = threading.Thread(target=lambda: busy.append(
-            api(port, token, "/api/sheet/simulate", body, timeout=300)[0]))
-        t.start()
-        deadline = time.monotonic() + 30
-        while app.state.pool.pids() and time.monotonic() < deadline:   # worker taken
-            time.sleep(0.02)
+        replies = []
+        t = simulate_in_background(app, port, token, body, replies)
         light = json.dumps({"regular": 4}).encode()
         with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
-            s.sendall((f"POST /api/sheet/load HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-                       f"X-Taut-Token: {token}\r\nContent-Type: application/json\r\n"
-                       f"Content-Length: {len(light)}\r\n\r\n").encode() + light)
+            s.sendall(post_head(port, token, "/api/sheet/load", len(light)).encode() + light)
             time.sleep(0.3)                               # queued behind the simulation
         still_busy = t.is_alive()
         t.join(300)
         st, _, out, _ = api(port, token, "/api/sheet/load", {"regular": 4}, timeout=120)
         after = worker_pids(os.getpid())
     assert still_busy, "the simulation finished before the queued client left"
-    assert busy == [200] and st == 200 and "scenario" in out
+    assert [r[0] for r in replies] == [200] and st == 200 and "scenario" in out
     assert after == [first], "the worker was killed for a request nobody waited for"
 
 
@@ -508,23 +518,12 @@ def test_a_worker_that_dies_is_a_json_500_and_replaced():
     """A worker process killed in the middle of a request (a crash in compiled code, the
     kernel's OOM killer): the request gets a one-line JSON 500, a fresh worker takes its
     place and the next request is served."""
-    from taut.app import server
-    from taut.app.browser import served
-    from taut.app.catalog import Catalog
-
-    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1)
     body = json.dumps(heavy_body(20000)).encode()
-    with served(app) as url:
-        port, token = urlparse(url).port, app.state.token
+    with one_worker_app() as (app, port, token):
         assert api(port, token, "/api/sheet/load", {"regular": 4}, timeout=120)[0] == 200
         [first] = app.state.pool.pids()
         reply = []
-        t = threading.Thread(target=lambda: reply.append(
-            api(port, token, "/api/sheet/simulate", body, timeout=300)))
-        t.start()
-        deadline = time.monotonic() + 30
-        while app.state.pool.pids() and time.monotonic() < deadline:   # worker taken
-            time.sleep(0.02)
+        t = simulate_in_background(app, port, token, body, reply)
         os.kill(first, signal.SIGKILL)
         t.join(60)
         st, _, out, _ = api(port, token, "/api/sheet/load", {"regular": 4}, timeout=120)
@@ -581,15 +580,9 @@ def test_worst_requests_stay_near_1_gib(app):
 def test_a_request_past_its_budget_is_stopped():
     """A 1 MB YAML upload (PyYAML parses it for many seconds) with a 2 s budget: HTTP
     503 after about 2 s, its worker killed and replaced, the next request served."""
-    from taut.app import server
-    from taut.app.browser import served
-    from taut.app.catalog import Catalog
-
-    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1, budget_s=2.0)
     text = "formation: [" + ", ".join(f"[{k}.5, {k}.25]" for k in range(70000)) + "]\n"
     assert len(text) > 1_000_000
-    with served(app) as url:
-        port, token = urlparse(url).port, app.state.token
+    with one_worker_app(budget_s=2.0) as (app, port, token):
         assert api(port, token, "/api/sheet/load", {"regular": 4}, timeout=60)[0] in (200, 503)
         deadline = time.monotonic() + 60
         while not app.state.pool.pids() and time.monotonic() < deadline:
@@ -642,13 +635,7 @@ def test_a_planning_step_past_its_budget_ends_the_job_not_the_app():
     ends its job with the budget's message; its worker is replaced and the app goes on
     answering. The planner's own ``time_budget`` caps each search only, so the budget of
     the pool is what bounds a whole step."""
-    from taut.app import server
-    from taut.app.browser import served
-    from taut.app.catalog import Catalog
-
-    app = server.create_app(catalog=Catalog(ROOT / "examples"), workers=1, budget_s=0.3)
-    with served(app) as url:
-        port, token = urlparse(url).port, app.state.token
+    with one_worker_app(budget_s=0.3) as (app, port, token):
         deadline = time.monotonic() + 90
         st, out = 503, {}
         while st == 503 and time.monotonic() < deadline:      # the worker starts

@@ -100,6 +100,21 @@ def _profile(d: float, speed: float, acceleration: float, profile: str,
     return s, sd, sdd
 
 
+
+def waypoint_segments(wp: np.ndarray) -> list[tuple[float, np.ndarray]]:
+    """Length (m) and unit direction (3,) of each straight segment between consecutive
+    waypoints ``wp`` (W, 3); a waypoint within ``WAYPOINT_SAME`` of the previous one is an
+    input error naming it."""
+    out = []
+    for k in range(len(wp) - 1):
+        seg = wp[k + 1] - wp[k]
+        d = float(np.linalg.norm(seg))
+        if d <= WAYPOINT_SAME:
+            raise InvalidInputError(f"waypoints[{k + 1}]", "repeats the previous waypoint")
+        out.append((d, seg / d))
+    return out
+
+
 def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, *,
                    profile: Profile = "quintic", acceleration: float = 3.0,
                    dwell: float = 0.3, rate: float = 1000.0) -> Reference:
@@ -154,12 +169,7 @@ def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, 
     n_dwell = int(round(dwell * rate))
     pos, vel, acc = [np.repeat(wp[:1], n_dwell + 1, axis=0)], [np.zeros((n_dwell + 1, 3))], \
         [np.zeros((n_dwell + 1, 3))]
-    for k in range(len(wp) - 1):
-        seg = wp[k + 1] - wp[k]
-        d = float(np.linalg.norm(seg))
-        if d <= WAYPOINT_SAME:
-            raise InvalidInputError(f"waypoints[{k + 1}]", "repeats the previous waypoint")
-        e = seg / d
+    for k, (d, e) in enumerate(waypoint_segments(wp)):
         s, sd, sdd = _profile(d, speed, acceleration, profile, rate)
         pos.append(wp[k] + s[1:, None] * e)
         vel.append(sd[1:, None] * e)

@@ -55,12 +55,11 @@ from ..._validate import (MAX_MASS_KG, MAX_RATE_HZ, MAX_SPEED, as_array, as_boun
                          require_instance)
 from ...errors import InvalidInputError
 from ..control.dynamics import DynamicsModel
-from ..control.references import Reference
+from ..control.references import Reference, waypoint_segments
 from ..kinematics.cables import as_poses, cable_state, gravity_wrench, tipping_matrix
 from ..model.parts import Payload
 from ..model.robot import CableRobot
 from ..statics.sliding import sliding_rows
-from .._tol import WAYPOINT_SAME
 
 __all__ = ["TimedPath", "time_optimal_path", "with_box"]
 
@@ -346,12 +345,7 @@ def _plan(robot: CableRobot, wp: np.ndarray, lim: _Limits, grid: int | None, rat
     out: list[list[np.ndarray]] = [[], [], [], []]
     gp, gs, gl, gb, seg_t = [], [], [], [], []
     t0 = 0.0
-    for k in range(len(wp) - 1):
-        seg = wp[k + 1] - wp[k]
-        length = float(np.linalg.norm(seg))
-        if length <= WAYPOINT_SAME:
-            raise InvalidInputError(f"waypoints[{k + 1}]", "repeats the previous waypoint")
-        e = seg / length
+    for k, (length, e) in enumerate(waypoint_segments(wp)):
         N = grid or max(MIN_GRID, int(np.ceil(GRID_PER_M * length)))
         pts = wp[k] + np.linspace(0.0, length, N + 1)[:, None] * e
         vmax, ub = _grid_bounds(robot, pts, e, lim)
