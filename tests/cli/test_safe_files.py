@@ -127,6 +127,28 @@ def _preset(name):
     return read_mapping(preset_path(name))
 
 
+@pytest.mark.parametrize("spell", ["plan.json", "./plan.json"])
+def test_two_outputs_of_one_command_cannot_share_a_file(scenario_json, capsys, spell):
+    """``--out`` and ``--trajectories`` naming one new file would have the second write
+    replace the first: refused before planning, naming the option and the other one."""
+    t0 = time.perf_counter()
+    assert main(["plan", "sc.json", "--out", "plan.json", "--trajectories", spell,
+                 "--max-speed-mps", "0.2", "--max-accel-mps2", "0.5",
+                 "--max-yaw-rate-radps", "1"]) == 2
+    assert time.perf_counter() - t0 < 5
+    err = capsys.readouterr().err
+    assert err == (f"taut: error: --trajectories: {str(Path(spell))!r} is also the file of --out; "
+                   "give each output its own file\n")
+    assert not (scenario_json.parent / "plan.json").exists()
+
+
+def test_a_bad_trajectories_file_is_named_once(scenario_json, capsys):
+    assert main(["plan", "sc.json", "--trajectories", "t.txt", "--max-speed-mps", "0.2",
+                 "--max-accel-mps2", "0.5", "--max-yaw-rate-radps", "1"]) == 2
+    assert capsys.readouterr().err.startswith("taut: error: --trajectories: unsupported "
+                                              "extension '.txt'")
+
+
 def test_an_unrelated_existing_output_is_still_replaced(scenario_json, capsys):
     (scenario_json.parent / "old.json").write_text("{}")
     code = main(["plan", "sc.json", "--out", "old.json"])

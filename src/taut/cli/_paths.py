@@ -30,11 +30,14 @@ JSON_SUFFIXES = (".json",)
 
 #: The words of the running command's line (set by :func:`set_command_line`).
 _ARGV: list[str] = []
+#: The outputs this command line has claimed so far: resolved path -> option.
+_CLAIMED: dict[str, str] = {}
 
 
 def set_command_line(argv: list[str]) -> None:
     """Remember the command line whose files :func:`output_path` protects."""
     _ARGV[:] = [str(a) for a in argv]
+    _CLAIMED.clear()
 
 
 def _identity(text: str) -> tuple[int, int] | None:
@@ -80,7 +83,8 @@ def output_path(value: str | os.PathLike[str] | None, field: str,
     InvalidInputError
         An empty name, a name without or with an unsupported extension, an existing
         directory, a parent that is not a directory, a directory that is not writable,
-        or a file that is also one of the command's inputs.
+        a file that is also one of the command's inputs, or a file another option of the
+        command already writes.
 
     Examples
     --------
@@ -120,6 +124,11 @@ def output_path(value: str | os.PathLike[str] | None, field: str,
         raise InvalidInputError(field, f"{text!r} is also an input of this command; "
                                        "writing it would destroy that input (choose "
                                        "another file)")
+    key = os.path.realpath(text)
+    other = _CLAIMED.setdefault(key, field)
+    if other != field:
+        raise InvalidInputError(field, f"{text!r} is also the file of {other}; give each "
+                                       "output its own file")
     _probe(path, field)
     return path
 

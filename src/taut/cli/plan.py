@@ -196,6 +196,8 @@ def _named_as_options() -> Iterator[None]:
     try:
         yield
     except InvalidInputError as exc:
+        if exc.field.startswith("--"):            # already named as an option
+            raise
         name = _OPTION_OF.get(exc.field, "--" + exc.field.replace("_", "-"))
         raise InvalidInputError(name, exc.problem) from None
 
