@@ -14,6 +14,7 @@ import typer
 
 from ..errors import InvalidInputError, ScenarioError
 from ._paths import output_path
+from ._progress import working
 
 __all__ = ["MCAP_HELP", "RERUN_HELP", "recording_paths", "write_recordings", "sheet_unit"]
 
@@ -64,11 +65,13 @@ def write_recordings(result: Any, mcap: Optional[Path], rerun: Optional[Path], *
     :func:`taut.io.write_mcap` needs besides the result) and say where."""
     if mcap is not None:
         from ..io.mcap import write_mcap
-        write_mcap(result, mcap, **context)
+        with working("MCAP recording"):
+            write_mcap(result, mcap, **context)
         if not quiet:
             typer.echo(f"ROS 2 recording written to {mcap}")
     if rerun is not None:
         from ..io.rerun import write_rerun
-        write_rerun(result, rerun, **context)
+        with working("Rerun recording"):
+            write_rerun(result, rerun, **context)
         if not quiet:
             typer.echo(f"Rerun recording written to {rerun}")
