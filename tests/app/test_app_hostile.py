@@ -553,8 +553,9 @@ def test_worst_requests_stay_near_1_gib(app):
     JSON nested 100,000 deep, an alias bomb upload, FK of the most robots -- are refused
     or answered, and the app -- the server and its workers together -- never held more
     than the issue's "about 1 GB": the sum of each process's peak resident memory (which
-    bounds their total) stays under 1.25 GiB. Measured 0.86-1.05 GiB depending on which
-    worker serves which request; the 1 GiB per-worker cap is what makes it bounded at all."""
+    bounds their total) stays under 1.1 GiB. Measured 0.74 GiB after the latency test's
+    heavy requests (1.27 GiB when the payload walk queued one tuple per number, see
+    test_app_payload.py); the 1 GiB per-worker cap is what makes it bounded at all."""
     proc, port, token = app
     m = regular_team(4)
     flat = b'{"sheet": %s, "hold_height": 1000, "formations": [[' % json.dumps(
@@ -574,7 +575,7 @@ def test_worst_requests_stay_near_1_gib(app):
     pids = [proc.pid, *worker_pids(proc.pid)]
     assert len(pids) >= 2
     peaks = {pid: peak_kib(pid) / 2**20 for pid in pids}
-    assert sum(peaks.values()) < 1.25, f"peak resident memory, GiB: {peaks}"
+    assert sum(peaks.values()) < 1.1, f"peak resident memory, GiB: {peaks}"
 
 
 def test_a_request_past_its_budget_is_stopped():

@@ -69,20 +69,22 @@ def check_json(raw: bytes) -> dict[str, Any]:
         raise InvalidInputError("request", "is not valid JSON") from None
     if not isinstance(body, dict):
         raise InvalidInputError("request", "must be a JSON object")
+    # The stack holds containers only (never one entry per number), so a body of
+    # millions of numbers is walked in the memory json.loads already took.
     stack: list[tuple[Any, str, int]] = [(body, "request", 0)]
     while stack:
         value, top, depth = stack.pop()
-        if depth > MAX_DEPTH:
+        if depth >= MAX_DEPTH:
             raise InvalidInputError("request", f"nested deeper than {MAX_DEPTH} levels")
-        if isinstance(value, dict):
-            for k, v in value.items():
-                where = k if depth == 0 else top
-                _unicode(k, where)
+        entries = (((k, k if depth == 0 else top, v) for k, v in value.items())
+                   if isinstance(value, dict) else ((None, top, v) for v in value))
+        for key, where, v in entries:
+            if key is not None:
+                _unicode(key, where)
+            if isinstance(v, (dict, list)):
                 stack.append((v, where, depth + 1))
-        elif isinstance(value, list):
-            stack.extend((v, top, depth + 1) for v in value)
-        elif isinstance(value, str):
-            _unicode(value, top)
+            elif isinstance(v, str):
+                _unicode(v, where)
     return body
 
 
@@ -141,15 +143,21 @@ def numbers(value: Any, name: str, ndim: int, *, length: int | None = None) -> n
     """
     what = ("a list of numbers" if ndim == 1 else
             f"a list of {'lists of ' * (ndim - 1)}numbers")
-    stack: list[tuple[Any, int]] = [(value, 0)]
-    while stack:
-        v, depth = stack.pop()
-        if depth < ndim:
+    # Depth-first with one iterator per level, never one entry per number, so millions
+    # of numbers are checked in no memory beyond the parsed JSON's.
+    levels = [iter((value,))]
+    while levels:
+        depth = len(levels) - 1                # of the items levels[-1] yields
+        for v in levels[-1]:
             if not isinstance(v, list):
                 raise InvalidInputError(name, f"must be {what}")
-            stack.extend((x, depth + 1) for x in v)
-        elif isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise InvalidInputError(name, f"must be {what}")
+            if depth + 1 < ndim:
+                levels.append(iter(v))
+                break
+            if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+                raise InvalidInputError(name, f"must be {what}")
+        else:
+            levels.pop()
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
