@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 from taut.cdpr import cable_state, distribute_tensions
+from taut.cdpr.model.footprint import convex_hull_2d
 from taut.errors import InfeasibleFormationError
 from taut.io import load_cdpr_model, load_plan_scenario, load_sheet_scenario, \
     sheet_scenario_from_mapping
@@ -281,6 +282,12 @@ def test_cable_robot_out_of_the_workspace_is_flagged(page):
     assert len(pts) == 2 * robot.m
     for p in pts:
         assert np.min(np.linalg.norm(ends - p, axis=1)) < 1e-9
+    # the 2D views draw the platform as the library's hull of its attachment points
+    for view, k in (("cdpr-side", 2), ("cdpr-top", 1)):
+        hull = convex_hull_2d(ends[robot.m:][:, [0, k]])
+        drawn = trace(d, view, "platform (drag it)")
+        np.testing.assert_allclose(np.column_stack([drawn["x"], drawn["y"]]),
+                                   np.vstack([hull, hull[:1]]), atol=1e-9)
     # the tension chart shows the reply's tensions against the library's limits
     limits = trace(d, "cdpr-bars", "limits [t_min, t_max]")
     np.testing.assert_allclose([v for v in limits["x"] if v is not None],

@@ -44,6 +44,7 @@ def run_job(client, sc, timeout=600.0):
     return s, seen
 
 
+@pytest.mark.slow  # ~4 s of CPU: the slow target (CI runs it)
 def test_planner_job_reports_progress_and_the_library_plan():
     pytest.importorskip("starlette.testclient", reason="needs the app-test extra")
     from starlette.testclient import TestClient
@@ -178,3 +179,23 @@ def test_tipping_verdict_and_margins_are_the_library_s(cdpr):
     tip = tipping_moments(robot, pose, limits.tensions)
     assert [m["margin"] for m in got["margins"]] == pytest.approx(-tip.base_moment)
     assert [m["stable"] for m in got["margins"]] == tip.base_stable.tolist() == [False, False]
+
+
+@pytest.mark.parametrize("pose", [[0.3, 0.0, 0.8, 0.0, 0.0, 0.0], [0.1, -0.2, 1.1, 0.4, -0.3, 1.2]])
+def test_platform_outline_is_the_hull_of_the_library_s_attachments(cdpr, pose):
+    """The app draws the platform from the reply (no hull in the JS): each view's outline
+    is the convex hull of the library's attachment points projected on that view,
+    checked against shapely's hull."""
+    from shapely.geometry import MultiPoint, Polygon
+    from taut.cdpr import cable_state
+    api, model = cdpr
+    robot = load_cdpr_model("fastkit")
+    got = api.state({"model": model, "pose": pose})
+    attach = np.asarray(pose[:3]) + cable_state(robot, np.asarray(pose)[None]).r[0]
+    np.testing.assert_allclose(got["attachments"], attach, atol=1e-12)
+    for view, k in (("xz", 2), ("xy", 1)):
+        ring = np.asarray(got["outline_m"][view])
+        want = MultiPoint(attach[:, [0, k]]).convex_hull
+        assert Polygon(ring).is_valid and Polygon(ring).exterior.is_ccw
+        assert Polygon(ring).symmetric_difference(want).area < 1e-12 * max(want.area, 1.0)
+        assert len(ring) == len(want.exterior.coords) - 1        # no repeated or collinear

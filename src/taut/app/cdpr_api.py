@@ -1,7 +1,7 @@
 """JSON endpoints of the cable-robot explorer: load a preset or model file, evaluate a
 platform pose (tensions against their limits, tipping margins of the mobile bases,
-wrench feasibility with and without tipping) and a slice of the wrench-feasible
-workspace.
+wrench feasibility with and without tipping, the platform's outline in the side and top
+views) and a slice of the wrench-feasible workspace.
 
 Every verdict and message is a library result's: :func:`taut.cdpr.distribute_tensions`
 with the library's defaults (``feasible``, ``binding``, ``message``) and with the tension
@@ -20,6 +20,7 @@ import yaml
 from ..cdpr import (CableRobot, cable_state, distribute_tensions, grid_points,
                     tipping_moments, wrench_feasible_workspace, with_stabilisers)
 from ..cdpr import METHODS as TENSION_METHODS
+from ..cdpr.model.footprint import convex_hull_2d
 from .._validate import as_choice
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ..io import cdpr_model_from_mapping
@@ -64,6 +65,21 @@ def _pose(body: dict[str, Any]) -> np.ndarray:
         raise InvalidInputError("pose", "must be 6 finite numbers x y z roll pitch yaw "
                                         "(m, rad)")
     return pose
+
+
+def outline(attachments: np.ndarray) -> dict[str, list[list[float]]]:
+    """The platform as the 2D views draw it: the convex hull (counter-clockwise, the
+    library's :func:`~taut.cdpr.model.footprint.convex_hull_2d`) of the attachment
+    points (m, world frame, shape (m, 3)) projected on the x-z plane (``"xz"``, the side
+    view) and on the x-y plane (``"xy"``, the top view); rows are (horizontal, vertical)
+    points in m. Attachments that meet in one point (a point-mass platform) give that
+    point."""
+    out = {}
+    for name, k in (("xz", 2), ("xy", 1)):
+        pts = attachments[:, [0, k]]
+        hull = convex_hull_2d(pts)
+        out[name] = (hull if len(hull) else pts[:1]).tolist()
+    return out
 
 
 class CdprAPI:
@@ -111,15 +127,16 @@ class CdprAPI:
 
     def state(self, body: dict[str, Any]) -> dict[str, Any]:
         """Statics at ``pose`` [x, y, z, roll, pitch, yaw]: tensions, limits, tipping
-        margins, feasibility; a pose outside the frame box is flagged, not an error.
+        margins, feasibility, the platform's outline in the views (``outline_m``, see
+        :func:`outline`); a pose outside the frame box is flagged, not an error.
         ``method`` (optional) is passed on; omitted, the library's default is used."""
         robot = self._robot(body)
         pose = _pose(body)
         method = field(body, "method", str, default=None)
         st = cable_state(robot, pose[None], validated=True)
-        attach = (pose[:3] + st.r[0]).tolist()
-        out: dict[str, Any] = {"pose": pose.tolist(), "attachments": attach,
-                               "in_frame": True}
+        attach = pose[:3] + st.r[0]
+        out: dict[str, Any] = {"pose": pose.tolist(), "attachments": attach.tolist(),
+                               "outline_m": outline(attach), "in_frame": True}
         try:
             res = distribute_tensions(robot, pose, **({} if method is None else
                                                       {"method": method}))

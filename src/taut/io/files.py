@@ -223,15 +223,21 @@ def _location(loc: tuple[Any, ...]) -> str:
     return out or "(top level)"
 
 
-def _booleans(data: Any, loc: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
-    """Locations of every boolean value in parsed file data."""
-    if isinstance(data, bool):
-        return [loc]
-    if isinstance(data, dict):
-        return [p for k, v in data.items() for p in _booleans(v, loc + (k,))]
-    if isinstance(data, list):
-        return [p for k, v in enumerate(data) for p in _booleans(v, loc + (k,))]
-    return []
+def _booleans(data: Any) -> Iterator[tuple[Any, ...]]:
+    """Locations of the boolean values in parsed file data, in file order.
+
+    A loop over an explicit stack, not a recursion: a model with a free-form field (an
+    ``Any``) accepts data nested as deep as the parser allows (about 1,000 levels),
+    deeper than a recursive walk (two frames a level on Python 3.11) could follow."""
+    stack: list[tuple[Any, tuple[Any, ...]]] = [(data, ())]
+    while stack:
+        value, loc = stack.pop()
+        if isinstance(value, bool):
+            yield loc
+        elif isinstance(value, (dict, list)):
+            items = value.items() if isinstance(value, dict) else enumerate(value)
+            stack.extend((v, loc + (k,)) for k, v in reversed(list(items))
+                         if isinstance(v, (bool, dict, list)))
 
 
 def _at(obj: Any, loc: tuple[Any, ...]) -> Any:
@@ -272,7 +278,9 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
     :class:`ScenarioError` whose field is the dotted path (``sheet[2]``, ``cables[0].max``).
 
     A boolean in the file that the model turned into a number is an error too (pydantic's
-    lax mode accepts ``true`` for a float); booleans kept as booleans are fine."""
+    lax mode accepts ``true`` for a float); booleans kept as booleans are fine. This check
+    is needed while a model has lax floats (the sheet, plan, cable-robot, dynamics and
+    warehouse files); the sweep file's strict numbers refuse a boolean themselves."""
     if not (isinstance(model, type) and issubclass(model, BaseModel)):
         raise ScenarioError("model", "must be a pydantic model class")
     require_instance(data, dict, "data")

@@ -132,9 +132,15 @@ class Store:
         lock = self.root / ".lock"
         me = {"pid": os.getpid(), "host": socket.gethostname(),
               "started": time.strftime("%Y-%m-%d %H:%M:%S %Z")}
+        # The lock appears with its holder already written (a complete temporary file
+        # hard-linked into place, which fails if the lock exists): a lock created empty and
+        # filled afterwards could be read empty by a second sweep, taken for a dead one's,
+        # and taken over -- two writers in one folder.
+        mine = self.root / f".lock.{os.getpid()}.tmp"
         for _ in range(3):
             try:
-                fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+                mine.write_text(json.dumps(me), encoding="utf-8")
+                os.link(mine, lock)
             except FileExistsError:
                 try:
                     holder = json.loads(lock.read_text(encoding="utf-8"))
@@ -151,8 +157,8 @@ class Store:
             except OSError as exc:
                 raise SweepError("out", f"cannot write to {self.root} ({exc.strerror})"
                                  ) from None
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                json.dump(me, fh)
+            finally:
+                mine.unlink(missing_ok=True)
             self._locked = True
             return
         raise SweepError("out", f"cannot take the lock {lock}")

@@ -140,8 +140,8 @@ const CdprView = {
     }
     traces.push({type: "scatter", mode: "markers", x: g.exits.map(e => e[a]), y: g.exits.map(e => e[b]),
                  name: "cable exits", marker: {color: "#333", size: 6}});
-    const hull = convexHull(A.map(p => [p[a], p[b]]));
-    traces.push(polygon(hull, "platform (drag it)", st.feasible ? "#3a7" : "#d33", "#222", {hoverinfo: "name"}));
+    // The platform's outline is the library's hull of the attachment points (cdpr_api.outline).
+    traces.push(polygon(st.outline_m[b === 2 ? "xz" : "xy"], "platform (drag it)", st.feasible ? "#3a7" : "#d33", "#222", {hoverinfo: "name"}));
     const names = ["x [m]", "y [m]", "z [m]"], pad = b === 1 ? 0.8 : 0.15;
     // Fixed ranges: the map does not rescale while the platform is dragged.
     chart2d(div, traces, names[a], names[b], {equal: true, drag: false,
@@ -235,15 +235,3 @@ const CdprView = {
     }
   },
 };
-
-function convexHull(P) {
-  const pts = P.slice().sort((p, q) => p[0] - q[0] || p[1] - q[1]);
-  const cross = (o, a, b) => (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-  const half = list => {
-    const h = [];
-    for (const p of list) { while (h.length >= 2 && cross(h[h.length - 2], h[h.length - 1], p) <= 0) h.pop(); h.push(p); }
-    return h;
-  };
-  const lower = half(pts), upper = half(pts.slice().reverse());
-  return lower.slice(0, -1).concat(upper.slice(0, -1));
-}
