@@ -63,13 +63,15 @@ def _plan_kernels() -> None:
 
 
 def _cdpr_kernels() -> None:
-    from .cdpr import TorqueController, VelocityController, pick_and_place, simulate
+    from .cdpr import (ComputedTorqueController, TorqueController, VelocityController,
+                       pick_and_place, simulate)
     from .cdpr import with_stabilisers
     from .io.cdpr_model import load_cdpr_model
 
     robot = with_stabilisers(load_cdpr_model("fastkit"))
     ref = pick_and_place(robot, [[-0.2, 0.0, 1.0], [0.2, 0.0, 1.0]], dwell=0.05)
-    for controller in (VelocityController(), TorqueController()):
+    # the compiled loop (velocity, torque) and the compiled plant under a Python controller
+    for controller in (VelocityController(), TorqueController(), ComputedTorqueController()):
         simulate(robot, ref, controller, backend="numba")
 
 

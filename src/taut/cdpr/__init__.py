@@ -138,7 +138,7 @@ Control
    Reference -- a platform trajectory
    pick_and_place -- straight moves between waypoints
    reference_from_samples -- a trajectory from sampled poses
-   Controller -- base class of the controllers
+   Controller -- base of the controllers (optional: name, mode, command() make one)
    VelocityController -- cable-length control
    TorqueController -- task-space PD on the reference tension distribution
    ComputedTorqueController -- computed-torque control (inverse dynamics at the estimated state)

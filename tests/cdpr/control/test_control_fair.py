@@ -56,6 +56,7 @@ def test_gear_loss_follows_the_direction_of_power_flow():
         DynamicsModel(backdrive_efficiency=1.2)
 
 
+@pytest.mark.slow  # ~2.5 s of CPU: the slow target (CI runs it)
 def test_backdriven_torque_is_eta_b_kl_t_in_steady_lowering(fk_stab):
     """Independent check: the velocity law's drive finds whatever torque the plant needs; in
     the constant-speed part of a slow lowering, cables paying out hold eta_b kl T and cables

@@ -116,6 +116,7 @@ def test_deployment_short_base_move_holds_the_platform(fk_stab):
     assert run.tracking_error.max() < 2e-3
 
 
+@pytest.mark.slow  # ~4 s of CPU: the slow target (CI runs it)
 def test_monte_carlo_batch_equals_single_runs(fk_stab):
     ref = pick_and_place(fk_stab, [[-0.3, 0, 1.0], [0.3, 0, 1.0]], dwell=0.1)
     errs = [ModelErrors(exit_offset=0.003, seed=s) for s in (1, 2)]

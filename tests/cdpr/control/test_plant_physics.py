@@ -200,6 +200,7 @@ def test_energy_books_close_with_every_loss_on(fastkit):
 
 # -- reference integrator -----------------------------------------------------------------------
 
+@pytest.mark.slow  # ~12 s of CPU: the slow target (CI runs it)
 def test_plant_step_converges_to_the_rk4_reference(fastkit):
     """Open loop (held torques), a kicked platform with stiction, damping and gear losses:
     the semi-implicit Euler plant approaches the RK4 reference at first order."""

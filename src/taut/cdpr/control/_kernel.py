@@ -3,10 +3,13 @@
 It performs exactly the arithmetic of the numpy backend (:mod:`taut.cdpr.control.plant`,
 :mod:`taut.cdpr.control.controllers`, the ``_loop`` of :mod:`taut.cdpr.control.simulate`)
 with explicit loops, so one control step costs microseconds instead of ~100 numpy calls; the
-tests run both backends on the same problems and require them to agree. Only the two
-built-in controllers are compiled (``mode`` 0: velocity, 1: torque); other controllers run
-on the numpy backend. The pose estimate of :class:`taut.cdpr.Sensing` is compiled too
-(:func:`_estimate`).
+tests run both backends on the same problems and require them to agree. The built-in
+velocity and torque laws are compiled into the loop (:func:`run`; ``mode`` 0: velocity, 1:
+torque); every other controller (computed torque, custom ones) runs in Python once per
+control step between two compiled calls, :func:`measure` (the sensing, with the pose
+estimate of :class:`taut.cdpr.Sensing`, :func:`_estimate`) and :func:`plant_steps` (the
+plant's sub-steps). :func:`run` calls the same :func:`_measure_plant` and
+:func:`_plant_step`, so both paths compute the same numbers.
 
 Compiled by :func:`taut._jit.jit`, the package's one numba set-up (on-disk cache, numpy
 error model); without numba the functions stay plain Python and the simulation picks the
@@ -44,10 +47,10 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
         speed_last: np.ndarray, T_est: np.ndarray, dt: float) -> None:
     """Run every plant through every control step (arrays as in the numpy backend).
 
-    Longer than 80 lines on purpose: measurement, both control laws and the monitors are
-    one compiled loop nest over (step, plant) that mirrors the numpy backend line by line;
-    the plant step and the pose estimate are split out (:func:`_plant_step`,
-    :func:`_estimate`).
+    Longer than 80 lines on purpose: both control laws and the monitors are one compiled
+    loop nest over (step, plant) that mirrors the numpy backend line by line; the
+    measurement and the plant step are split out (:func:`_measure_plant`,
+    :func:`_plant_step`) and shared with the path of controllers that run in Python.
 
     ``com_local`` (B, 3) and ``attach_c`` (B, 3, m) are per plant (payload mass errors move
     the centre of mass). ``winch`` (5, B, m) holds the plant's forward and back-drive efficiencies, friction
@@ -64,8 +67,7 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
     EA, damp, kl, eta, tlim, wlim, J = dyn[0], dyn[1], dyn[2], dyn[3], dyn[4], dyn[5], dyn[6]
     fs, fc, fv, wst, weps, Kw, Ki = dyn[7], dyn[8], dyn[9], dyn[10], dyn[11], dyn[12], dyn[13]
     eta_b = dyn[14]
-    ideal, quantum, tsrc, fgain = sens[0] > 0.5, sens[1], int(sens[2]), sens[3]
-    delay, it_step, it_first = int(sens[4]), int(sens[5]), int(sens[6])
+    delay = int(sens[4])
     nb = delay + 1
     cmd = np.zeros(m)
     tau = np.zeros(m)
@@ -79,66 +81,22 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
     A6 = np.zeros((6, 6))
     g6 = np.zeros(6)
     x6 = np.zeros(6)
+    p = np.zeros(3)
+    vP = np.zeros(3)
+    w = np.zeros(3)
+    Rm = np.empty((3, 3))
     for k in range(n):
         for b in range(B):
             if diverged[b] >= 0:
                 continue
             # -- measurement: true pose (tracking error), encoders, tension ----------------
-            p = np.zeros(3)
-            vP = np.zeros(3)
-            w = np.zeros(3)
-            for i in range(3):
-                s = 0.0
-                for j in range(3):
-                    s += R[b, i, j] * com_local[b, j]
-                p[i] = xc[b, i] - s
-            c0, c1, c2 = com_local[b, 0], com_local[b, 1], com_local[b, 2]
-            cxw = np.array([c1 * wb[b, 2] - c2 * wb[b, 1], c2 * wb[b, 0] - c0 * wb[b, 2],
-                            c0 * wb[b, 1] - c1 * wb[b, 0]])
-            for i in range(3):
-                for j in range(3):
-                    vP[i] += R[b, i, j] * cxw[j]
-                    w[i] += R[b, i, j] * wb[b, j]
-                vP[i] += vc[b, i]
-            e2 = 0.0
-            for i in range(3):
-                e2 += (p[i] - ref_p[k, i]) ** 2
+            e2 = _measure_plant(b, k, sens, dyn, xc, vc, R, wb, com_local, L0, len_off, speed,
+                                noise, ref_p, ref_v, t_ref, exits, exit_vel, attach_P, T_last,
+                                tau_last, speed_last, T_est, est_p, est_R, est_v, est_w, dt,
+                                p, vP, w, Rm, Lm, Tm, Jr, res, A6, g6, x6)
             if k >= k_start:
                 summ[b, 0] = max(summ[b, 0], np.sqrt(e2))
                 summ[b, 1] += e2
-            kn = k % noise.shape[0]
-            bn = b % noise.shape[1]
-            for c in range(m):
-                x = L0[b, c] + len_off[b, c]
-                Lm[c] = x if quantum == 0.0 else np.round(x / quantum) * quantum
-                if tsrc == 2:
-                    Tm[c] = T_last[b, c] + noise[kn, bn, c]
-                elif tsrc == 1:
-                    acc = (speed[b, c] - speed_last[b, c]) / dt if k > 0 else 0.0
-                    raw = _current_tension(tau_last[b, c], speed[b, c], acc, kl, J, eta,
-                                           eta_b, fs, fc, fv, wst, weps)
-                    T_est[b, c] += (1.0 if k == 0 else fgain) * (raw - T_est[b, c])
-                    Tm[c] = T_est[b, c] + noise[kn, bn, c]
-                else:
-                    Tm[c] = np.nan
-            for c in range(m):
-                speed_last[b, c] = speed[b, c]
-            Rm = np.empty((3, 3))
-            if ideal:
-                for i in range(3):
-                    for j in range(3):
-                        Rm[i, j] = R[b, i, j]
-            else:
-                _estimate(b, k, it_first if k == 0 else it_step, 1.0 if k == 0 else fgain,
-                          Lm, Tm, tsrc == 2, t_ref[k], EA, dyn[15:], kl, speed, exits[k],
-                          exit_vel[k], attach_P, ref_v[k], est_p, est_R, est_v, est_w,
-                          Jr, res, A6, g6, x6)
-                for i in range(3):
-                    p[i] = est_p[b, i]
-                    vP[i] = ref_v[k, i] + est_v[b, i]
-                    w[i] = ref_v[k, 3 + i] + est_w[b, i]
-                    for j in range(3):
-                        Rm[i, j] = est_R[b, i, j]
             # -- controller ----------------------------------------------------------------
             if mode == 0:
                 for c in range(m):
@@ -219,6 +177,149 @@ def run(mode: int, gains: np.ndarray, dyn: np.ndarray, ctx_L0: np.ndarray,
                         ok = False
                 if not ok:
                     diverged[b] = k
+
+
+@jit
+def _measure_plant(b: int, k: int, sens: np.ndarray, dyn: np.ndarray, xc: np.ndarray,
+                   vc: np.ndarray, R: np.ndarray, wb: np.ndarray, com_local: np.ndarray,
+                   L0: np.ndarray, len_off: np.ndarray, speed: np.ndarray, noise: np.ndarray,
+                   ref_p: np.ndarray, ref_v: np.ndarray, t_ref: np.ndarray, exits: np.ndarray,
+                   exit_vel: np.ndarray, attach_P: np.ndarray, T_last: np.ndarray,
+                   tau_last: np.ndarray, speed_last: np.ndarray, T_est: np.ndarray,
+                   est_p: np.ndarray, est_R: np.ndarray, est_v: np.ndarray, est_w: np.ndarray,
+                   dt: float, p: np.ndarray, vP: np.ndarray, w: np.ndarray, Rm: np.ndarray,
+                   Lm: np.ndarray, Tm: np.ndarray, Jr: np.ndarray, res: np.ndarray,
+                   A6: np.ndarray, g6: np.ndarray, x6: np.ndarray) -> float:
+    """What the controller of plant ``b`` sees at step ``k`` (see ``_measure`` of
+    :mod:`taut.cdpr.control.simulate`): writes ``p``, ``vP``, ``w`` (3,), ``Rm`` (3, 3),
+    ``Lm``, ``Tm`` (m,) and updates the sensing state (``speed_last``, ``T_est``,
+    ``est_*``); returns the squared distance of the *true* P from the reference, m^2.
+    ``sens`` and ``dyn`` as in :func:`run`."""
+    m = L0.shape[1]
+    EA, kl, eta, J, eta_b = dyn[0], dyn[2], dyn[3], dyn[6], dyn[14]
+    fs, fc, fv, wst, weps = dyn[7], dyn[8], dyn[9], dyn[10], dyn[11]
+    ideal, quantum, tsrc, fgain = sens[0] > 0.5, sens[1], int(sens[2]), sens[3]
+    it_step, it_first = int(sens[5]), int(sens[6])
+    for i in range(3):
+        vP[i] = 0.0
+        w[i] = 0.0
+    for i in range(3):
+        s = 0.0
+        for j in range(3):
+            s += R[b, i, j] * com_local[b, j]
+        p[i] = xc[b, i] - s
+    c0, c1, c2 = com_local[b, 0], com_local[b, 1], com_local[b, 2]
+    cxw = np.array([c1 * wb[b, 2] - c2 * wb[b, 1], c2 * wb[b, 0] - c0 * wb[b, 2],
+                    c0 * wb[b, 1] - c1 * wb[b, 0]])
+    for i in range(3):
+        for j in range(3):
+            vP[i] += R[b, i, j] * cxw[j]
+            w[i] += R[b, i, j] * wb[b, j]
+        vP[i] += vc[b, i]
+    e2 = 0.0
+    for i in range(3):
+        e2 += (p[i] - ref_p[k, i]) ** 2
+    kn = k % noise.shape[0]
+    bn = b % noise.shape[1]
+    for c in range(m):
+        x = L0[b, c] + len_off[b, c]
+        Lm[c] = x if quantum == 0.0 else np.round(x / quantum) * quantum
+        if tsrc == 2:
+            Tm[c] = T_last[b, c] + noise[kn, bn, c]
+        elif tsrc == 1:
+            acc = (speed[b, c] - speed_last[b, c]) / dt if k > 0 else 0.0
+            raw = _current_tension(tau_last[b, c], speed[b, c], acc, kl, J, eta,
+                                   eta_b, fs, fc, fv, wst, weps)
+            T_est[b, c] += (1.0 if k == 0 else fgain) * (raw - T_est[b, c])
+            Tm[c] = T_est[b, c] + noise[kn, bn, c]
+        else:
+            Tm[c] = np.nan
+    for c in range(m):
+        speed_last[b, c] = speed[b, c]
+    if ideal:
+        for i in range(3):
+            for j in range(3):
+                Rm[i, j] = R[b, i, j]
+    else:
+        _estimate(b, k, it_first if k == 0 else it_step, 1.0 if k == 0 else fgain,
+                  Lm, Tm, tsrc == 2, t_ref[k], EA, dyn[15:], kl, speed, exits[k],
+                  exit_vel[k], attach_P, ref_v[k], est_p, est_R, est_v, est_w,
+                  Jr, res, A6, g6, x6)
+        for i in range(3):
+            p[i] = est_p[b, i]
+            vP[i] = ref_v[k, i] + est_v[b, i]
+            w[i] = ref_v[k, 3 + i] + est_w[b, i]
+            for j in range(3):
+                Rm[i, j] = est_R[b, i, j]
+    return e2
+
+
+@jit
+def measure(k: int, sens: np.ndarray, dyn: np.ndarray, xc: np.ndarray, vc: np.ndarray,
+            R: np.ndarray, wb: np.ndarray, com_local: np.ndarray, L0: np.ndarray,
+            len_off: np.ndarray, speed: np.ndarray, noise: np.ndarray, ref_p: np.ndarray,
+            ref_v: np.ndarray, t_ref: np.ndarray, exits: np.ndarray, exit_vel: np.ndarray,
+            attach_P: np.ndarray, T_last: np.ndarray, tau_last: np.ndarray,
+            speed_last: np.ndarray, T_est: np.ndarray, est_p: np.ndarray, est_R: np.ndarray,
+            est_v: np.ndarray, est_w: np.ndarray, dt: float, P: np.ndarray, Rm: np.ndarray,
+            V: np.ndarray, W: np.ndarray, Lm: np.ndarray, Tm: np.ndarray) -> None:
+    """The measurements of every plant at step ``k`` for a controller that runs in Python
+    (the hybrid engine): :func:`_measure_plant` per plant into ``P``, ``V``, ``W`` (B, 3),
+    ``Rm`` (B, 3, 3), ``Lm``, ``Tm`` (B, m)."""
+    B, m = L0.shape
+    Jr = np.zeros((m, 6))
+    res = np.zeros(m)
+    A6 = np.zeros((6, 6))
+    g6 = np.zeros(6)
+    x6 = np.zeros(6)
+    for b in range(B):
+        _measure_plant(b, k, sens, dyn, xc, vc, R, wb, com_local, L0, len_off, speed, noise,
+                       ref_p, ref_v, t_ref, exits, exit_vel, attach_P, T_last, tau_last,
+                       speed_last, T_est, est_p, est_R, est_v, est_w, dt, P[b], V[b], W[b],
+                       Rm[b], Lm[b], Tm[b], Jr, res, A6, g6, x6)
+
+
+@jit
+def plant_steps(mode: int, cmd: np.ndarray, dyn: np.ndarray, exits: np.ndarray,
+                exit_vel: np.ndarray, exit_off: np.ndarray, winch: np.ndarray,
+                mass: np.ndarray, inertia: np.ndarray, inertia_inv: np.ndarray,
+                attach_c: np.ndarray, grav: np.ndarray, ext: np.ndarray, xc: np.ndarray,
+                vc: np.ndarray, R: np.ndarray, wb: np.ndarray, L0: np.ndarray,
+                speed: np.ndarray, integ: np.ndarray, h: float, substeps: int,
+                T_first: np.ndarray, tau_first: np.ndarray, T_last: np.ndarray,
+                tau_last: np.ndarray) -> None:
+    """One control period of every plant under the commands ``cmd`` (B, m) of a controller
+    that runs in Python (the compiled plant of the hybrid engine, see
+    :func:`taut.cdpr.simulate`): ``substeps`` calls of :func:`_plant_step` per plant.
+
+    ``mode`` 1: ``cmd`` are motor torques, N m; 0: motor speed set-points, rad/s. ``dyn`` and
+    ``winch`` as in :func:`run`; ``exits``, ``exit_vel`` (3, m) at this step. Writes the
+    tensions (N) and motor torques (N m) of the first sub-step into ``T_first``,
+    ``tau_first`` and of the last into ``T_last``, ``tau_last`` (each (B, m))."""
+    B, m = L0.shape
+    EA, damp, kl, tlim, wlim = dyn[0], dyn[1], dyn[2], dyn[4], dyn[5]
+    fs, fc, fv, wst, weps, Kw, Ki = dyn[7], dyn[8], dyn[9], dyn[10], dyn[11], dyn[12], dyn[13]
+    c_b = np.zeros(m)
+    tau = np.zeros(m)
+    T = np.zeros(m)
+    u = np.zeros((3, m))
+    r = np.zeros((3, m))
+    rec = np.zeros((1, 1, 12 + 3 * m))
+    for b in range(B):
+        for c in range(m):
+            c_b[c] = cmd[b, c]
+        for sub in range(substeps):
+            _plant_step(b, mode, c_b, tau, T, u, r, exits, exit_vel, exit_off, damp,
+                        EA, kl, tlim, wlim, fs, fc, fv, wst, weps, Kw, Ki,
+                        winch, mass, inertia, inertia_inv, attach_c, grav, ext,
+                        xc, vc, R, wb, L0, speed, integ, h, rec, 0, False)
+            if sub == 0:
+                for c in range(m):
+                    T_first[b, c] = T[c]
+                    tau_first[b, c] = tau[c]
+        for c in range(m):
+            T_last[b, c] = T[c]
+            tau_last[b, c] = tau[c]
 
 
 @jit

@@ -16,6 +16,59 @@ Measurements are set by :class:`taut.cdpr.Sensing`: by default quantised encoder
 seeded encoder offsets), the drives' torques, and a pose and twist *estimated* from the
 encoders on the nominal model (FASTKIT has no exteroceptive sensor; the paper's ongoing work
 adds cameras); ``Sensing(ideal_pose=True)`` gives the true pose and twist.
+
+The controller protocol
+-----------------------
+Any object with these three members is a controller for :func:`taut.cdpr.simulate`,
+:func:`taut.cdpr.monte_carlo` and ``reference_simulate``, on every ``backend``:
+
+``name`` : str
+    Shown in results (``ControlResult.controller["name"]``, ``MonteCarloResult.controller``).
+``mode`` : "torque" or "speed"
+    What ``command`` returns: motor torques, N m (saturated at the peak torque by the
+    plant), or motor speed set-points, rad/s (tracked by the drives' PI speed loop).
+``command(ctx, k, meas)`` -> (B, m) array
+    The command at control step ``k`` (0-based, the settling pre-roll included) from the
+    nominal :class:`ControlContext` ``ctx`` (arrays indexed by ``k``) and the
+    :class:`Measurement` ``meas`` of the ``B`` plants run together (one in
+    :func:`~taut.cdpr.simulate`; one per model-error draw in
+    :func:`~taut.cdpr.monte_carlo`), so a law written with array operations over the
+    leading axis batches for free. It must not keep state between calls that depends on
+    the plant count.
+
+``describe()`` -> dict is optional: subclasses of :class:`Controller` inherit one giving
+the name, mode and gains (dataclass fields, or the public attributes of any other object);
+an object that is not a subclass gets the same. It appears as ``ControlResult.controller``
+and in the result's JSON. On ``backend="numba"`` the built-in :class:`VelocityController`
+and :class:`TorqueController` run compiled with the plant; every other controller runs in
+Python once per control step while the plant (its sub-steps) runs compiled; on
+``backend="numpy"`` both run in numpy. The engines compute the same model
+(tests/cdpr/control/test_control_laws.py checks a custom re-implementation of the velocity
+law against the built-in on each).
+
+Examples
+--------
+A joint-space PD on the encoder lengths in torque mode, with the holding torque of the
+reference tensions as feed-forward:
+
+>>> import numpy as np
+>>> from taut.cdpr import pick_and_place, simulate, with_stabilisers
+>>> from taut.io.cdpr_model import load_cdpr_model
+>>> class LengthPD:
+...     name, mode = "length_pd", "torque"
+...     def __init__(self, stiffness=4.0e3):
+...         self.stiffness = stiffness                      # N per m of cable
+...     def command(self, ctx, k, meas):
+...         d = ctx.dynamics
+...         t = ctx.tensions[k] + self.stiffness * (meas.L0 - ctx.L0[k])
+...         return d.length_per_rad * t / d.efficiency
+>>> robot = with_stabilisers(load_cdpr_model("fastkit"))
+>>> ref = pick_and_place(robot, [[-0.1, 0, 1.0], [0.1, 0, 1.0]], 0.3, dwell=0.05)
+>>> run = simulate(robot, ref, LengthPD(), settle=0.2)
+>>> run.controller
+{'name': 'length_pd', 'mode': 'torque', 'stiffness': 4000.0}
+>>> bool(np.all(np.isfinite(run.tensions)))
+True
 """
 
 from __future__ import annotations
@@ -129,7 +182,9 @@ class Measurement:
 
 
 class Controller(ABC):
-    """Interface: ``mode`` ("torque" or "speed") and ``command(ctx, k, meas)`` -> (B, m)."""
+    """Base of the controllers: ``name``, ``mode`` ("torque" or "speed") and
+    ``command(ctx, k, meas)`` -> (B, m), plus :meth:`describe` (see the module docstring
+    for the protocol; subclassing is optional)."""
 
     name: ClassVar[str] = "controller"
     mode: ClassVar[CommandMode] = "torque"
@@ -144,11 +199,40 @@ class Controller(ABC):
         if is_dataclass(self):
             gains = {f.name: getattr(self, f.name) for f in fields(self)}
         else:
-            gains = {k: v for k, v in vars(self).items() if not k.startswith("_")}
+            gains = {k: v for k, v in getattr(self, "__dict__", {}).items()
+                     if not k.startswith("_")}
         out: dict[str, Any] = {"name": self.name, "mode": self.mode}
         for k, v in gains.items():
-            out[k] = v.tolist() if isinstance(v, np.ndarray) else v
+            out[k] = v.tolist() if isinstance(v, (np.ndarray, np.generic)) else v
         return out
+
+
+_MODES = ("torque", "speed")
+
+
+def check_controller(controller: Any) -> None:
+    """Raise :class:`InvalidInputError` unless ``controller`` follows the protocol of the
+    module docstring (its ``describe()``, if any, returning a dict)."""
+    if isinstance(controller, type):
+        raise InvalidInputError("controller", f"got the class {controller.__name__}; pass an "
+                                              f"instance, e.g. {controller.__name__}()")
+    if not callable(getattr(controller, "command", None)):
+        raise InvalidInputError("controller", "needs a method command(ctx, k, meas), e.g. "
+                                              "VelocityController() or TorqueController()")
+    mode = getattr(controller, "mode", None)
+    if not isinstance(mode, str) or mode not in _MODES:
+        raise InvalidInputError("controller.mode", f"must be 'torque' or 'speed', got "
+                                                   f"{mode!r}")
+    if not isinstance(getattr(controller, "name", None), str):
+        raise InvalidInputError("controller.name", "must be a str")
+    if not isinstance(describe_controller(controller), dict):
+        raise InvalidInputError("controller.describe", "must return a dict")
+
+
+def describe_controller(controller: Any) -> Any:
+    """``controller.describe()``, or :meth:`Controller.describe` of it when it has none."""
+    own = getattr(controller, "describe", None)
+    return own() if callable(own) else Controller.describe(controller)
 
 
 #: Control rate the default gains of the built-in controllers are designed for (and the

@@ -182,7 +182,7 @@ def reference_simulate(robot: Any, reference: Reference, controller: Controller,
     """:func:`taut.cdpr.simulate` (numpy loop, same options) with the plant integrated by
     :class:`RK4Plant` at ``inner`` RK4 sub-steps per integrator step: the reference the
     fast engines are checked against (tests/cdpr/control/test_plant_physics.py)."""
-    from .simulate import DEFAULT_SETTLE, _prepare, _run_numpy
+    from .simulate import DEFAULT_SETTLE, _prepare, _run_python
     names = ("model_errors", "base_motion", "control_rate", "duration", "dynamics",
              "substeps", "external_wrench", "settle", "sensing")
     unknown = set(options) - set(names)
@@ -195,4 +195,4 @@ def reference_simulate(robot: Any, reference: Reference, controller: Controller,
                      kw["control_rate"], kw["duration"], kw["dynamics"], kw["substeps"],
                      kw["external_wrench"], kw["settle"], kw["sensing"])
     setup.plant = RK4Plant(setup.plant, inner)
-    return _run_numpy(setup, controller, None)
+    return _run_python(setup, controller, None, False)

@@ -11,7 +11,7 @@ import numpy as np
 from ..._outcome import check_status
 from .._tol import EVENT_TENSION_TOL, SATURATION_REL
 from ..kinematics.forward import rpy_from_matrices
-from .controllers import Controller
+from .controllers import Controller, describe_controller
 from .monitors import ControlEvent, episodes, tipping_margins
 from ..._repr import CompactRepr
 
@@ -196,7 +196,7 @@ def assemble_result(setup: Any, controller: Controller, rec: dict[str, np.ndarra
     del n
     return ControlResult(times, poses, ref, err, ang, T, tau, speed, tips, base_poses,
                          tuple(ev), robot.t_min, robot.t_max, tuple(names), enames,
-                         controller.describe(), slack_time, over, under, status == "ok",
+                         describe_controller(controller), slack_time, over, under, status == "ok",
                          status, msg)
 
 

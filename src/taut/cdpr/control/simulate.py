@@ -10,6 +10,7 @@ with different seeded model errors, batched through one plant, summary numbers p
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Callable, Literal, Sequence, get_args
 
 import numpy as np
@@ -22,7 +23,7 @@ from ...errors import InvalidInputError
 from .._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
 from ..kinematics.forward import rpy_from_matrices
 from .controllers import (DESIGN_CONTROL_RATE, ControlContext, Controller, Measurement,
-    TorqueController, VelocityController)
+    TorqueController, VelocityController, check_controller)
 from .dynamics import DynamicsModel
 from ..model.robot import CableRobot
 from .model_errors import ModelErrors, stack_perturbations
@@ -84,9 +85,7 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
     if not isinstance(reference, Reference):
         raise InvalidInputError("reference", "must be a taut.cdpr.Reference (see "
                                              "pick_and_place, reference_from_samples)")
-    if not isinstance(controller, Controller):
-        raise InvalidInputError("controller", "must be a taut.cdpr controller, e.g. "
-                                              "VelocityController() or TorqueController()")
+    check_controller(controller)
     if robot.dof != 6:
         raise InvalidInputError("robot", "the dynamics need a 6-DoF platform")
     sens = Sensing() if sensing is None else sensing
@@ -203,31 +202,36 @@ def _measure_at(setup: _Setup, k: int, pl: Plant, s: PlantState, sens: Sensing,
                        s.speed, tension)
 
 
+#: Advances every plant by one control period under a command: ``(cmd, k)`` -> tensions and
+#: motor torques (B, m) of the first sub-step (recorded) and of the last (the sensors').
+Advance = Callable[[np.ndarray, int], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+
+
 def _loop(setup: _Setup, controller: Controller,
           record: Callable[..., None],
-          progress: Callable[[int, int], None] | None) -> np.ndarray:
-    """Run the control loop; returns the first diverged step per plant (-1 if none)."""
-    pl, s, ctx, geo = setup.plant, setup.state, setup.ctx, setup.geo
+          progress: Callable[[int, int], None] | None,
+          compiled: bool = False) -> np.ndarray:
+    """Run the control loop with the controller in Python, the sensing and the plant in
+    numpy or (``compiled``) numba; returns the first diverged step per plant (-1 if none)."""
+    pl, s = setup.plant, setup.state
+    if compiled:
+        step, measure = _compiled_advance(setup, controller.mode), _compiled_measure(setup)
+    else:
+        step, measure = _numpy_advance(setup, controller.mode), partial(_measure, setup)
     n = len(setup.times)
     lo, hi = setup.robot.bounds[0] - DIVERGENCE_MARGIN, setup.robot.bounds[1] + DIVERGENCE_MARGIN
     diverged = np.full(pl.B, -1)
-    exits_T = np.swapaxes(geo.exits, 1, 2)
-    vel_T = np.swapaxes(geo.exit_vel, 1, 2)
     with np.errstate(all="ignore"):
         buf: list[np.ndarray] = []
         for k in range(n):
-            buf.append(np.asarray(controller.command(ctx, k, _measure(setup, k)), dtype=float))
+            buf.append(np.asarray(controller.command(setup.ctx, k, measure(k)), dtype=float))
             if k == 0:
+                _check_command(buf[0], (pl.B, setup.robot.m))
                 buf = buf * (setup.delay + 1)
             cmd = buf.pop(0)                   # computed setup.delay control periods ago
-            ex, ev = exits_T[k], vel_T[k]
             snap = (s.xc.copy(), s.R.copy(), s.speed.copy())
-            for j in range(setup.substeps):
-                tau = pl.motor_torque(s, controller.mode, cmd, setup.h)
-                T = pl.step(s, setup.h, ex, ev, tau)
-                if j == 0:
-                    record(k, T, tau, snap)
-            setup.T_last, setup.tau_last = T, tau
+            T0, tau0, setup.T_last, setup.tau_last = step(cmd, k)
+            record(k, T0, tau0, snap)
             if k % _CHECK_EVERY == _CHECK_EVERY - 1 or k == n - 1:
                 bad = ~np.all(np.isfinite(s.xc) & (s.xc > lo) & (s.xc < hi), axis=1) \
                     | ~np.all(np.isfinite(s.L0), axis=1)
@@ -242,19 +246,111 @@ def _loop(setup: _Setup, controller: Controller,
     return diverged
 
 
+def _check_command(cmd: np.ndarray, shape: tuple[int, int]) -> None:
+    """A controller's first command must broadcast to (B, m) (plants, cables)."""
+    try:
+        np.broadcast_to(cmd, shape)
+    except ValueError:
+        raise InvalidInputError("controller.command", f"returned shape {cmd.shape}; expected "
+                                f"(B, m) = {shape} (plants, cables)") from None
+
+
+def _numpy_advance(setup: _Setup, mode: str) -> Advance:
+    """The numpy plant: ``substeps`` of :meth:`Plant.step` per control period."""
+    pl, s, h = setup.plant, setup.state, setup.h
+    exits_T = np.swapaxes(setup.geo.exits, 1, 2)
+    vel_T = np.swapaxes(setup.geo.exit_vel, 1, 2)
+
+    def advance(cmd: np.ndarray, k: int) -> tuple[np.ndarray, ...]:
+        for j in range(setup.substeps):
+            tau = pl.motor_torque(s, mode, cmd, h)
+            T = pl.step(s, h, exits_T[k], vel_T[k], tau)
+            if j == 0:
+                T0, tau0 = T, tau
+        return T0, tau0, T, tau
+    return advance  # type: ignore[return-value]
+
+
+def _compiled_advance(setup: _Setup, mode: str) -> Advance:
+    """The compiled plant (:func:`taut.cdpr.control._kernel.plant_steps`): the same model as
+    :func:`_numpy_advance`, for controllers that run in Python on the numba backend."""
+    from ._kernel import plant_steps
+    pl, s, C = setup.plant, setup.state, np.ascontiguousarray
+    dyn, winch = _kernel_plant_arrays(setup)
+    exits_T = C(np.swapaxes(setup.geo.exits, 1, 2))
+    vel_T = C(np.swapaxes(setup.geo.exit_vel, 1, 2))
+    body = (C(pl.exit_offsets), C(winch), C(pl.mass), C(pl.inertia), C(pl.inertia_inv),
+            C(pl.attach_c), C(pl.g), C(np.r_[pl.f_ext, pl.m_ext]))
+    code, shape = (1 if mode == "torque" else 0), (pl.B, setup.robot.m)
+
+    def advance(cmd: np.ndarray, k: int) -> tuple[np.ndarray, ...]:
+        out = [np.empty(shape) for _ in range(4)]
+        plant_steps(code, C(np.broadcast_to(cmd, shape), dtype=float), dyn, exits_T[k],
+                    vel_T[k], *body, s.xc, s.vc, s.R, s.wb, s.L0, s.speed, s.integ,
+                    float(setup.h), int(setup.substeps), *out)
+        return tuple(out)
+    return advance  # type: ignore[return-value]
+
+
+def _compiled_measure(setup: _Setup) -> Callable[[int], Measurement]:
+    """The compiled sensing (:func:`taut.cdpr.control._kernel.measure`): the same as
+    :func:`_measure`, for controllers that run in Python on the numba backend."""
+    from ._kernel import measure
+    pl, s, ctx, C = setup.plant, setup.state, setup.ctx, np.ascontiguousarray
+    dyn, sv = _kernel_plant_arrays(setup)[0], _sensing_array(setup)
+    B, m = pl.B, setup.robot.m
+    fixed = (C(pl.com_local), s.L0, C(pl.length_offsets), s.speed, C(setup.noise),
+             C(ctx.ref_poses), C(ctx.ref_vel), C(ctx.tensions),
+             C(np.swapaxes(setup.geo.exits, 1, 2)), C(np.swapaxes(setup.geo.exit_vel, 1, 2)),
+             C(ctx.attach.T))
+
+    def measured(k: int) -> Measurement:
+        P, V, W, Rm = np.empty((B, 3)), np.empty((B, 3)), np.empty((B, 3)), np.empty((B, 3, 3))
+        L0m, T = np.empty((B, m)), np.empty((B, m))
+        measure(k, sv, dyn, s.xc, s.vc, s.R, s.wb, *fixed, setup.T_last,
+                setup.tau_last, setup.speed_last, setup.T_est, setup.est_p, setup.est_R,
+                setup.est_v, setup.est_w, float(ctx.dt), P, Rm, V, W, L0m, T)
+        return Measurement(P, Rm, V, W, L0m, s.speed, T)
+    return measured
+
+
+def _sensing_array(setup: _Setup) -> np.ndarray:
+    """:class:`Sensing` in the layout of :func:`taut.cdpr.control._kernel.run` (``sens``)."""
+    from .._tol import SENSING_FK_FIRST_ITERATIONS, SENSING_FK_ITERATIONS
+    sens = setup.sensing
+    return np.array([float(sens.ideal_pose), setup.quantum,
+                     {"none": 0.0, "current": 1.0, "load_cell": 2.0}[sens.tension],
+                     setup.filter_gain, float(setup.delay), float(SENSING_FK_ITERATIONS),
+                     float(SENSING_FK_FIRST_ITERATIONS)])
+
+
+def _kernel_plant_arrays(setup: _Setup) -> tuple[np.ndarray, np.ndarray]:
+    """The nominal drive and cable constants ``dyn`` and the per-plant winch values
+    ``winch`` (5, B, m) in the layout of :func:`taut.cdpr.control._kernel.run`."""
+    from .._tol import FRICTION_SPEED_WIDTH
+    d, pl, m = setup.dyn, setup.plant, setup.robot.m
+    eta_b = d.efficiency if d.backdrive_efficiency is None else d.backdrive_efficiency
+    dyn = np.array([d.cable_stiffness, d.cable_damping, d.length_per_rad, d.efficiency,
+                    d.peak_torque, d.motor_speed_limit, d.rotor_inertia,
+                    d.friction_static, d.friction_coulomb, d.friction_viscous,
+                    d.stribeck_speed, FRICTION_SPEED_WIDTH, d.drive_speed_gain,
+                    d.drive_integral_gain, eta_b, *d.routing(m)])
+    winch = np.stack([pl.eta, pl.eta_b, pl.friction_scale * np.ones_like(pl.eta),
+                      pl.rotor_inertia, pl.routing])
+    return dyn, winch
+
+
 def _backend(backend: str, controller: Controller) -> str:
-    """Resolve ``backend`` to "numba" or "numpy" (numba as set up by :mod:`taut._jit`)."""
+    """Resolve ``backend`` to "numba" (the compiled loop: built-in velocity and torque laws),
+    "numba_plant" (the controller in Python, the plant compiled: any other controller) or
+    "numpy" (numba as set up by :mod:`taut._jit`)."""
     as_choice(backend, get_args(Backend), "backend")
-    compiled = type(controller) in (VelocityController, TorqueController)
-    if backend == "numpy" or (backend == "auto" and not (compiled and HAVE_NUMBA)):
+    if backend == "numpy" or (backend == "auto" and not HAVE_NUMBA):
         return "numpy"
-    if not compiled:
-        raise InvalidInputError("backend", f"the numba backend compiles VelocityController and "
-                                           f"TorqueController only; {type(controller).__name__} "
-                                           "runs on backend='numpy' (or 'auto')")
     if not HAVE_NUMBA:
         raise InvalidInputError("backend", not_compiled_reason())
-    return "numba"
+    return "numba" if type(controller) in (VelocityController, TorqueController) \
+        else "numba_plant"
 
 
 def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_plants: int
@@ -262,9 +358,7 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
     """Run the compiled loop; returns records (n/rec_every, Brec, 12 + 3m), per-plant
     summaries (B, 6) and the first diverged step per plant (-1 if none)."""
     from ._kernel import run
-    from .._tol import (FRICTION_SPEED_WIDTH, SENSING_FK_FIRST_ITERATIONS,
-                        SENSING_FK_ITERATIONS)
-    pl, s, ctx, geo, d = setup.plant, setup.state, setup.ctx, setup.geo, setup.dyn
+    pl, s, ctx, geo = setup.plant, setup.state, setup.ctx, setup.geo
     n, m, B = len(setup.times), setup.robot.m, pl.B
     if isinstance(controller, VelocityController):
         mode, gains = 0, np.array([controller.length_gain, controller.tension_gain, 0, 0, 0],
@@ -274,19 +368,8 @@ def _loop_numba(setup: _Setup, controller: Controller, rec_every: int, n_rec_pla
         mode, gains = 1, np.array([c.position_stiffness, c.position_damping,  # type: ignore[attr-defined]
                                    c.rotation_stiffness, c.rotation_damping,  # type: ignore[attr-defined]
                                    c.joint_damping], float)  # type: ignore[attr-defined]
-    eta_b = d.efficiency if d.backdrive_efficiency is None else d.backdrive_efficiency
-    dyn = np.array([d.cable_stiffness, d.cable_damping, d.length_per_rad, d.efficiency,
-                    d.peak_torque, d.motor_speed_limit, d.rotor_inertia,
-                    d.friction_static, d.friction_coulomb, d.friction_viscous,
-                    d.stribeck_speed, FRICTION_SPEED_WIDTH, d.drive_speed_gain,
-                    d.drive_integral_gain, eta_b, *d.routing(m)])
-    sens = setup.sensing
-    sv = np.array([float(sens.ideal_pose), setup.quantum,
-                   {"none": 0.0, "current": 1.0, "load_cell": 2.0}[sens.tension],
-                   setup.filter_gain, float(setup.delay), float(SENSING_FK_ITERATIONS),
-                   float(SENSING_FK_FIRST_ITERATIONS)])
-    winch = np.stack([pl.eta, pl.eta_b, pl.friction_scale * np.ones_like(pl.eta),
-                      pl.rotor_inertia, pl.routing])
+    dyn, winch = _kernel_plant_arrays(setup)
+    sv = _sensing_array(setup)
     rec = np.full(((n + rec_every - 1) // rec_every, n_rec_plants, 12 + 3 * m), np.nan)
     summ = np.zeros((B, 6))
     summ[:, 2], summ[:, 3] = np.inf, -np.inf
@@ -326,7 +409,9 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
     reference : Reference
         Platform reference, e.g. :func:`taut.cdpr.pick_and_place`.
     controller : Controller
-        :class:`~taut.cdpr.VelocityController` or :class:`~taut.cdpr.TorqueController`.
+        :class:`~taut.cdpr.VelocityController`, :class:`~taut.cdpr.TorqueController`,
+        :class:`~taut.cdpr.ComputedTorqueController` or any object following the controller
+        protocol (:mod:`taut.cdpr.control.controllers`).
     model_errors : ModelErrors, optional
         Seeded errors of the plant against the nominal model (default none).
     base_motion : BaseMotion, optional
@@ -348,14 +433,17 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
         controller and plant rather than from the switch-on transient. The plant starts the
         pre-roll at rest in elastic equilibrium with the nominal unstretched lengths.
     backend : {"auto", "numba", "numpy"}
-        The compiled loop (built-in controllers, needs numba) or the numpy one (any
-        controller); "auto" picks numba when it can. Both compute the same model.
+        "numba" (needs numba): the compiled loop for the built-in velocity and torque laws;
+        any other controller runs in Python once per control step with the plant compiled.
+        "numpy": everything in numpy. "auto" picks numba when it can. Every controller runs
+        on both and they compute the same model.
     sensing : Sensing, optional
         What the controller measures (default ``Sensing()``: encoders and drive torques,
         pose estimated from the encoders on the nominal model; ``Sensing(ideal_pose=True)``
         for the true pose).
     progress : callable(done, total), optional
-        Called during the run (numpy backend) or at its end (numba backend).
+        Called during the run (controllers running in Python) or at its end (the compiled
+        loop).
 
     Returns
     -------
@@ -394,12 +482,13 @@ def simulate(robot: CableRobot, reference: Reference, controller: Controller, *,
         if progress is not None:
             progress(n, n)
         return assemble_result(setup, controller, hist, int(div_n[0]))
-    return _run_numpy(setup, controller, progress)
+    return _run_python(setup, controller, progress, used == "numba_plant")
 
 
-def _run_numpy(setup: _Setup, controller: Controller,
-               progress: Callable[[int, int], None] | None) -> ControlResult:
-    """One run of the numpy loop on a prepared set-up (plant 0 recorded)."""
+def _run_python(setup: _Setup, controller: Controller,
+                progress: Callable[[int, int], None] | None, compiled: bool) -> ControlResult:
+    """One run of the control loop with the controller in Python on a prepared set-up
+    (plant 0 recorded), sensing and plant compiled or in numpy."""
     n, m = len(setup.times), setup.robot.m
     rec = {"xc": np.empty((n, 3)), "R": np.empty((n, 3, 3)), "T": np.empty((n, m)),
            "tau": np.empty((n, m)), "speed": np.empty((n, m))}
@@ -408,7 +497,7 @@ def _run_numpy(setup: _Setup, controller: Controller,
         rec["xc"][k], rec["R"][k], rec["T"][k] = snap[0][0], snap[1][0], T[0]
         rec["tau"][k], rec["speed"][k] = tau[0], snap[2][0]
 
-    div = int(_loop(setup, controller, record, progress)[0])
+    div = int(_loop(setup, controller, record, progress, compiled)[0])
     return assemble_result(setup, controller, rec, div)
 
 
@@ -440,6 +529,6 @@ def monte_carlo(robot: CableRobot, reference: Reference, controller: Controller,
         if progress is not None:
             progress(len(setup.times), len(setup.times))
     else:
-        div = _loop(setup, controller, acc.record, progress)
+        div = _loop(setup, controller, acc.record, progress, used == "numba_plant")
     return acc.result(div, controller.name)
 
