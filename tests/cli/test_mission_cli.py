@@ -24,6 +24,7 @@ def test_example_mission_json(capsys, tmp_path):
     assert len(doc["served"]) == 7
     for p in doc["phases"]:
         assert p["min_tension_margin_N"] >= 0 and p["min_tipping_margin_Nm"] >= 0, p
+        assert p["min_cable_clearance_m"] > 0 and p["min_footprint_clearance_m"] > 0, p
     assert doc["total_time_s"] < doc["baseline_total_time_s"]
     assert png.stat().st_size > 0 and gif.stat().st_size > 0
     assert "Traceback" not in without_progress(err)
@@ -48,3 +49,10 @@ def test_not_a_mapping(capsys, tmp_path):
 @pytest.mark.parametrize("opt,name", [("--plot", "m.txt"), ("--animate", "m.png")])
 def test_bad_output_suffix(capsys, tmp_path, opt, name):
     one_line_error(*run(capsys, "cdpr", "mission", EXAMPLE, opt, tmp_path / name), opt)
+
+
+@pytest.mark.parametrize("value,field", [("1,x", "--active-base-offsets"),
+                                         ("0.3,nan", "active_base_offsets")])
+def test_bad_active_base_offsets(capsys, value, field):
+    one_line_error(*run(capsys, "cdpr", "mission", EXAMPLE, "--active-base-offsets", value),
+                   field)

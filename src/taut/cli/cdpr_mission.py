@@ -30,11 +30,18 @@ def _margin(v: float, digits: int = 1) -> str:
 def _report(res: Any) -> None:
     """The phase table and the totals of a :class:`taut.cdpr.MissionResult`."""
     typer.echo(f"{'phase':>8}  {'task':>6}  {'site':>4}  {'start [s]':>9}  {'end [s]':>8}  "
-               f"{'tension margin [N]':>18}  {'tipping margin [N m]':>20}")
+               f"{'tension margin [N]':>18}  {'tipping margin [N m]':>20}  "
+               f"{'cables-shelves [m]':>18}  {'bases-shelves [m]':>17}")
     for p in res.phases:
         typer.echo(f"{p.kind:>8}  {p.task or '-':>6}  {p.site + 1:>4}  {p.start:9.2f}  "
                    f"{p.end:8.2f}  {_margin(p.min_tension_margin):>18}  "
-                   f"{_margin(p.min_tipping_margin):>20}" + ("" if p.success else "  !"))
+                   f"{_margin(p.min_tipping_margin):>20}  "
+                   f"{_margin(p.min_cable_clearance, 3):>18}  "
+                   f"{_margin(p.min_footprint_clearance, 3):>17}"
+                   + ("" if p.success else "  !"))
+    for r in res.repositions:
+        typer.echo(f"active base before {r.task}: offset {r.offset:+.2f} m, best saving "
+                   f"{r.best_saving:.3f} s, move {r.move_time:.2f} s")
     typer.echo(f"total time: {res.total_time:.2f} s   baseline (1 m/s profile): "
                f"{res.baseline_total_time:.2f} s   ratio {1 / res.speedup:.3f}")
     typer.echo(f"platform motions: {res.motion_time:.2f} s   baseline: "
@@ -42,6 +49,18 @@ def _report(res: Any) -> None:
     for u in res.unserved:
         typer.echo(f"unserved: {u.name}: {u.reason}")
     typer.echo(res.message)
+
+
+def _offsets(text: Optional[str]) -> list[float]:
+    """The ``--active-base-offsets`` list, m."""
+    if not text:
+        return []
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        from ..errors import InvalidInputError
+        raise InvalidInputError("--active-base-offsets",
+                                f"must be comma-separated numbers (m), got {text!r}") from None
 
 
 def add_mission(sub: typer.Typer) -> None:
@@ -58,6 +77,10 @@ def add_mission(sub: typer.Typer) -> None:
         mcap: Optional[Path] = typer.Option(None, "--mcap", help=MCAP_HELP + " The "
                                             "platform and the coupled bases' track."),
         rerun: Optional[Path] = typer.Option(None, "--rerun", help=RERUN_HELP),
+        offsets: Optional[str] = typer.Option(
+            None, "--active-base-offsets", help="Comma-separated offsets (m) the active "
+            "base may move to along the shelf face between tasks, e.g. '-0.6,-0.3,0.3,0.6' "
+            "(taken only when the motion time saved beats the move's cost)."),
     ) -> None:
         """Exit 0 when every served task is done with every monitor clean."""
         output_path(plot, "--plot", FIGURE_SUFFIXES)
@@ -68,8 +91,9 @@ def add_mission(sub: typer.Typer) -> None:
         from ..io.serialize import mission_to_dict, to_json
 
         wh = load_warehouse(warehouse)
+        moves = _offsets(offsets)
         with working(f"cdpr mission ({len(wh.tasks)} tasks)") as update:
-            res = plan_mission(wh, progress=update)
+            res = plan_mission(wh, progress=update, active_base_offsets=moves)
         if as_json:
             typer.echo(to_json(mission_to_dict(res)))
         else:

@@ -4,7 +4,8 @@ Top-level keys (unknown keys are errors; SI units: m, kg, rad, s):
 
 ``name`` (str), ``robot`` (a preset name such as ``fastkit``, or a model file path,
 relative to the warehouse file), ``floor`` ([[x, y], ...] m, the free floor polygon),
-``shelves`` (list of {``name``, ``footprint``: [[x, y], ...] m}), ``start``
+``shelves`` (list of {``name``, ``footprint``: [[x, y], ...] m, optional ``height_m``:
+the top above the floor, default 2.5 m}), ``start``
 ([x, y, yaw] m, m, rad: the coupled bases), ``tasks`` (list of {``name``, ``pick``:
 [x, y, z] m, ``place``: [x, y, z] m, ``mass``: kg}), and the assumptions, each optional
 with the default of :class:`taut.cdpr.Warehouse`: ``gripper_reach_m``, ``standoff_m``,
@@ -23,7 +24,7 @@ from typing import Any, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from ..cdpr.mission.warehouse import Shelf, Task, Warehouse
+from ..cdpr.mission.warehouse import SHELF_HEIGHT, Shelf, Task, Warehouse
 from ..errors import ScenarioError, TautError
 from .cdpr_model import load_cdpr_model
 from .files import read_mapping, validate_mapping
@@ -42,6 +43,7 @@ class _Strict(BaseModel):
 class _Shelf(_Strict):
     name: str = Field(min_length=1)
     footprint: list[Vec2] = Field(min_length=3)
+    height_m: float = SHELF_HEIGHT
 
 
 class _Task(_Strict):
@@ -105,8 +107,8 @@ def warehouse_from_mapping(data: dict[str, Any], base_dir: str | Path | None = N
     try:
         shelves = []
         for k, s in enumerate(raw.shelves):
-            shelves.append(_named(lambda s=s: Shelf(s.name, s.footprint), "shelves", k,
-                                  s.name))
+            shelves.append(_named(lambda s=s: Shelf(s.name, s.footprint, s.height_m),
+                                  "shelves", k, s.name))
         tasks = []
         for k, t in enumerate(raw.tasks):
             tasks.append(_named(lambda t=t: Task(t.name, t.pick, t.place, t.mass), "tasks",
@@ -131,6 +133,7 @@ def _named(build: Any, kind: str, k: int, name: str) -> Any:
         f = exc.field
         if f.startswith(f"{kind}[{name}]"):
             f = f"{kind}[{k}]" + f[len(f"{kind}[{name}]"):]
+            f = f + "_m" if f.endswith(".height") else f
         elif f == f"{kind}.name":
             f = f"{kind}[{k}].name"
         raise type(exc)(f, exc.problem) from None

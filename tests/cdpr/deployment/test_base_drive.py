@@ -139,6 +139,7 @@ def test_plan_agrees_with_an_independent_lp(robot, x, z, dx, dtheta):
         assert plan.failed_at_s == bm.times[min(first, len(bm.times) - 1)]
 
 
+@pytest.mark.slow  # ~19 s of CPU: the slow target (CI runs it)
 def test_simulated_example_drive_keeps_every_tipping_margin_nonnegative(robot, drive):
     """The example's run (velocity law, no model error): every monitored tipping margin of
     every base >= 0 over the whole simulation; the reference tensions are the plan's."""

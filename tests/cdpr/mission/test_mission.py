@@ -36,10 +36,21 @@ def _fake_sites(wh):
                        (UnservedTask("box8", "out of reach"),))
 
 
+#: Duration of the fake route, s.
+NAV_S = 120.0
+
+
 def _fake_route(wh, start, goal, **_):
-    t = np.linspace(0.0, 10.0, 11)
-    poses = np.asarray(start) + (np.asarray(goal) - np.asarray(start)) * t[:, None] / 10
-    return NavigationResult(True, "ok", "straight", t, poses, 10.0)
+    """Round the racks' east ends (x = 19.5 m, clear of every shelf), each leg rest to rest
+    on a smooth cubic, NAV_S s in all."""
+    corners = np.array([start, [19.5, start[1], 0.0], [19.5, goal[1], 0.0], goal], float)
+    leg = NAV_S / 3
+    s = np.linspace(0.0, 1.0, 101)[:-1]
+    smooth = 3 * s ** 2 - 2 * s ** 3
+    poses = np.vstack([a + smooth[:, None] * (b - a) for a, b in zip(corners, corners[1:])]
+                      + [corners[-1:]])
+    t = np.linspace(0.0, NAV_S, len(poses))
+    return NavigationResult(True, "ok", "round the racks", t, poses, NAV_S)
 
 
 def test_phases_tile_the_mission_and_beat_the_baseline(warehouse, monkeypatch):
@@ -53,8 +64,8 @@ def test_phases_tile_the_mission_and_beat_the_baseline(warehouse, monkeypatch):
     ends = np.array([(p.start, p.end) for p in res.phases])
     assert ends[0, 0] == 0 and np.allclose(ends[1:, 0], ends[:-1, 1])
     assert res.total_time == pytest.approx(ends[-1, 1])
-    # fixed times (10 s route, 3 s + 3 s stabilisers, 4 x 0.5 s gripper) are in both totals
-    fixed = 10.0 + 2 * mission_mod.STABILISER_S + 4 * mission_mod.GRIP_S
+    # fixed times (route, 3 s + 3 s stabilisers, 4 x 0.5 s gripper) are in both totals
+    fixed = NAV_S + 2 * mission_mod.STABILISER_S + 4 * mission_mod.GRIP_S
     assert res.total_time == pytest.approx(fixed + res.motion_time)
     assert res.baseline_total_time == pytest.approx(fixed + res.baseline_motion_time)
     assert res.total_time < res.baseline_total_time
@@ -96,3 +107,33 @@ def test_example_mission_end_to_end(warehouse):
         assert p.min_tension_margin >= 0 and p.min_tipping_margin >= 0, p
         assert p.min_sliding_margin >= 0, p
     assert res.total_time < res.baseline_total_time
+
+
+def test_an_active_base_move_costs_its_stabilisers_and_drive(warehouse):
+    assert mission_mod.drive_time(0.0, 0.25, 3.0) == 0.0
+    # 0.6 m at 0.2 m/s and 0.25 m/s^2: 0.8 s ramps, 3 s cruise => 3.8 s, plus 2 x 3 s
+    assert mission_mod.drive_time(0.6, 0.25, 3.0) == pytest.approx(9.8)
+    robot = warehouse.robot
+    moved = mission_mod.shifted(robot, 0.5)
+    k = mission_mod.active_index(robot)
+    assert np.allclose(moved.bases[k].pose, robot.bases[k].pose + [0.5, 0, 0])
+    assert np.allclose(moved.bases[1 - k].pose, robot.bases[1 - k].pose)
+
+
+@pytest.mark.slow
+def test_active_base_moves_when_it_pays_and_is_monitored(warehouse, monkeypatch):
+    monkeypatch.setattr(mission_mod, "choose_sites", lambda wh, step: _fake_sites(wh))
+    monkeypatch.setattr(mission_mod, "plan_navigation", _fake_route)
+    still = plan_mission(warehouse, simulate_runs=False)
+    # with the real move cost (>= 6 s of stabilisers) the base stays put
+    kept = plan_mission(warehouse, simulate_runs=False, active_base_offsets=[-0.6, 0.6])
+    assert [r.offset for r in kept.repositions] == [0.0, 0.0]
+    assert kept.total_time == pytest.approx(still.total_time)
+    # free moves: it moves whenever that is faster, and the totals add up
+    monkeypatch.setattr(mission_mod, "drive_time", lambda d, a, s: 0.0)
+    moved = plan_mission(warehouse, simulate_runs=False, active_base_offsets=[-0.6, 0.6])
+    assert any(r.offset != 0.0 for r in moved.repositions)
+    assert moved.motion_time <= still.motion_time + 1e-9
+    assert moved.success, moved.message
+    for r in moved.repositions:
+        assert r.saved <= 1e-9 and r.best_saving >= -r.saved - 1e-9

@@ -44,6 +44,8 @@ BAD = [
     (("shelves", 1, "name"), "A", "shelves[1].name"),
     (("shelves", 0, "footprint"), [[7, 6.9], [13, 6.9], [13, 9.1], [7, 9.1]],
      "shelves[1].footprint"),                                  # K (the later) overlaps A
+    (("shelves", 0, "height_m"), 0.0, "shelves[0].height_m"),
+    (("shelves", 2, "height_m"), "tall", "shelves"),
     (("tasks", 2, "pick"), [1.0, 2.0], "tasks[2].pick"),
     (("tasks", 2, "place"), [1.0, 2.0, -0.5], "tasks[2].place"),
     (("tasks", 3, "mass"), -1.0, "tasks[3].mass"),

@@ -14,11 +14,23 @@ tipping margin ``-m_C`` of eqs. 21-23 from the actual tensions (N m), sliding ma
 above (m, the platform's reference point in the world) and the run's own limit episodes
 (slack, over-tension, torque and speed saturation).
 
-Phases without cable motion (navigation with the platform locked, deploy and retract of
-the stabilisers) are static for the cables: their margins come from the tension
-distribution that holds the locked platform (:func:`taut.cdpr.distribute_tensions`,
-minimum-norm QP with tipping and sliding) with the stabilisers in each state the phase
-passes through (quasi-static: the bases' own accelerations are not in the moments).
+Every phase also monitors collisions: each cable (exit point to attachment point) against
+each shelf's solid ``footprint x [0, height]`` (:func:`~._monitors.cable_clearance`, m) and
+the coupled bases' footprint against the walls and shelves (m; with the stabiliser feet
+while they are down).
+
+Phases without cable motion hold the locked platform; their margins come from the tension
+distribution that holds it (:func:`taut.cdpr.distribute_tensions`, minimum-norm QP with
+tipping and sliding), evaluated along the phase's time line:
+
+``navigate``
+    at every sample of the verified route (0.1 s apart): the rigid footprint's gap to walls
+    and shelves, the cables' gap to the shelves, and the tensions, tipping and sliding with
+    the platform's inertial load ``-m a`` of the bases' acceleration ``a`` (stabilisers up;
+    quasi-static otherwise: the bases' own inertia is not in the tipping moments);
+``deploy`` / ``retract``
+    the stabilisers switch base by base (:func:`~._monitors.stabiliser_sequence`), each
+    state held for an equal share of the phase, monitored in each.
 """
 
 from __future__ import annotations
@@ -35,10 +47,15 @@ from ..kinematics.cables import cable_state
 from ..model.robot import CableRobot
 from ..statics.sliding import sliding_rows
 from ..statics.tension import distribute_tensions
+from ..deployment.moving_base import _stabilisers
+from ._monitors import (cable_clearance, cable_segments, segments_clearance,
+                        stabiliser_sequence)
+from ._navigate import footprint_slack
+from .navigation import NavigationResult
 from .timing import TimedPath
-from .warehouse import Warehouse, to_world_frame
+from .warehouse import Warehouse, coupled_footprint, to_world_frame
 
-__all__ = ["PhaseRun", "run_motion", "hold_margins"]
+__all__ = ["PhaseRun", "run_motion", "hold_margins", "footprint_gap", "switch_stabilisers", "navigate_run"]
 
 #: Recorded instants kept in a run's track (every RECORD_EVERY-th control step).
 RECORD_EVERY = 50
@@ -65,6 +82,10 @@ class PhaseRun:
         m, platform to the nearest shelf seen from above (``inf`` for static phases).
     max_tracking_error : float
         m (0 for static phases).
+    min_cable_clearance : float
+        m, any cable to the nearest shelf (solid to its height).
+    min_footprint_clearance : float
+        m, the coupled bases' footprint to the nearest wall or shelf.
     times : (T,)
         s from the phase's start, every RECORD_EVERY-th step.
     platform : (T, 3)
@@ -79,6 +100,8 @@ class PhaseRun:
     min_sliding_margin: float
     min_clearance: float
     max_tracking_error: float
+    min_cable_clearance: float
+    min_footprint_clearance: float
     times: np.ndarray
     platform: np.ndarray
 
@@ -97,6 +120,15 @@ def _clearance(warehouse: Warehouse, pose: np.ndarray, points: np.ndarray) -> fl
                      default=np.inf))
 
 
+def footprint_gap(warehouse: Warehouse, robot: CableRobot, poses: np.ndarray) -> float:
+    """Least gap between the coupled bases (stabiliser feet included when any is down) at
+    ``poses`` (P, 3) and the walls and shelves, m."""
+    down = any(b.stabilisers_deployed for b in robot.bases)
+    gap, _ = footprint_slack(warehouse, coupled_footprint(robot, deployed=down),
+                             np.atleast_2d(poses))
+    return float(gap.min())
+
+
 def run_motion(warehouse: Warehouse, site_pose: np.ndarray, robot: CableRobot,
                law: TimedPath, dynamics: DynamicsModel) -> PhaseRun:
     """Simulate one platform motion ``law`` of the deployed ``robot`` (payload = the box
@@ -109,34 +141,108 @@ def run_motion(warehouse: Warehouse, site_pose: np.ndarray, robot: CableRobot,
     idx = np.r_[np.arange(len(run.times))[sel], len(run.times) - 1]
     slide = _sliding_margin(robot, run.poses[idx], T[idx])
     clear = _clearance(warehouse, site_pose, run.poses[idx, :3])
-    ok = bool(run.success and ten >= 0 and tip >= 0 and slide >= 0 and clear >= 0)
+    cab = cable_clearance(warehouse, robot, site_pose, run.poses[idx])
+    foot = footprint_gap(warehouse, robot, site_pose)
+    ok = bool(run.success and min(ten, tip, slide, clear, cab, foot) >= 0)
     msg = run.message if ok or not run.success else (
         f"margins: tension {ten:.2f} N, tipping {tip:.2f} N m, sliding {slide:.2f} N, "
-        f"clearance {clear:.3f} m")
+        f"clearance {clear:.3f} m, cables to shelves {cab:.3f} m, bases to shelves and "
+        f"walls {foot:.3f} m")
     return PhaseRun(ok, msg, float(law.duration), ten, tip, slide, clear,
-                    float(run.tracking_error.max()), run.times[idx],
+                    float(run.tracking_error.max()), cab, foot, run.times[idx],
                     to_world_frame(site_pose, run.poses[idx, :3]))
+
+
+def _held(robot: CableRobot, position: np.ndarray, wrench: np.ndarray | None
+          ) -> tuple[float, float, float, str]:
+    """Tension (N), tipping (N m) and sliding (N) margins of the platform held at
+    ``position`` (3,) (robot frame) under the extra ``wrench`` (B, 6) (or none), and why
+    it is not held ("" when it is)."""
+    B = 1 if wrench is None else len(wrench)
+    poses = np.tile(np.r_[position, 0.0, 0.0, 0.0], (B, 1))
+    res = distribute_tensions(robot, poses, "qp_min_norm", external_wrench=wrench,
+                              tipping=True, sliding=True)
+    t = res.tensions
+    ten = float(np.nan_to_num(np.minimum(t - robot.t_min, robot.t_max - t).min(),
+                              nan=-np.inf))
+    if not np.all(res.success):
+        return ten, -np.inf, -np.inf, res.message
+    tip = float(-res.tipping_moments.max()) if res.tipping_moments.size else float("inf")
+    return ten, tip, _sliding_margin(robot, poses, t), ""
+
+
+def _static_run(checks: list[tuple[float, float, float, str]], duration: float, cab: float,
+                foot: float, times: np.ndarray, platform: np.ndarray) -> PhaseRun:
+    why = next((c[3] for c in checks if c[3]), "")
+    ten, tip, slide = (min(c[0] for c in checks), min(c[1] for c in checks),
+                       min(c[2] for c in checks))
+    ok = not why and min(ten, tip, slide, cab, foot) >= 0
+    msg = why or ("platform held within every limit" if ok else
+                  f"margins: tension {ten:.2f} N, tipping {tip:.2f} N m, sliding "
+                  f"{slide:.2f} N, cables to shelves {cab:.3f} m, bases to shelves and "
+                  f"walls {foot:.3f} m")
+    return PhaseRun(bool(ok), msg, float(duration), ten, tip, slide, float("inf"), 0.0, cab,
+                    foot, times, platform)
 
 
 def hold_margins(robots: tuple[CableRobot, ...], position: np.ndarray, duration: float,
                  warehouse: Warehouse, site_pose: np.ndarray) -> PhaseRun:
     """Margins of the platform held at ``position`` (robot frame) by each of ``robots``
-    (the stabiliser states a static phase passes through) for ``duration`` s."""
-    pose = np.r_[position, 0.0, 0.0, 0.0]
-    ten, tip, slide, ok, why = np.inf, np.inf, np.inf, True, ""
-    for r in robots:
-        res = distribute_tensions(r, pose, "qp_min_norm", tipping=True, sliding=True)
-        if not res.success:
-            ok, why = False, res.message
-            ten = min(ten, float(np.nan_to_num(np.minimum(res.tensions - r.t_min,
-                                                          r.t_max - res.tensions).min(),
-                                               nan=-np.inf)))
-            continue
-        ten = min(ten, float(np.minimum(res.tensions - r.t_min, r.t_max - res.tensions).min()))
-        if res.tipping_moments.size:
-            tip = min(tip, float(-res.tipping_moments.max()))
-        slide = min(slide, _sliding_margin(r, pose[None], res.tensions[None]))
+    (the stabiliser states a static phase passes through, in order, each for an equal
+    share of ``duration`` s)."""
+    checks = [_held(r, position, None) for r in robots]
+    pose6 = np.r_[position, 0.0, 0.0, 0.0][None]
+    cab = min(cable_clearance(warehouse, r, site_pose, pose6) for r in robots)
+    foot = min(footprint_gap(warehouse, r, site_pose) for r in robots)
+    k = len(robots)
+    times = np.linspace(0.0, duration, k + 1)
     world = to_world_frame(site_pose, position[None])
-    return PhaseRun(ok, why or "platform held within every limit", float(duration), ten, tip,
-                    slide, float("inf"), 0.0, np.array([0.0, duration]),
-                    np.repeat(world, 2, axis=0))
+    return _static_run(checks, duration, cab, foot, times, np.repeat(world, k + 1, axis=0))
+
+
+def switch_stabilisers(robot: CableRobot, deploy: bool, position: np.ndarray,
+                       duration: float, warehouse: Warehouse, site_pose: np.ndarray
+                       ) -> PhaseRun:
+    """A deploy (``deploy``) or retract of ``robot``'s stabilisers in ``duration`` s, the
+    platform held at ``position`` (robot frame), monitored in every state it passes
+    through (module docstring)."""
+    states = stabiliser_sequence(robot, deploy)
+    return hold_margins(tuple(_stabilisers(robot, s) for s in states), position, duration,
+                        warehouse, site_pose)
+
+
+def _base_accel(nav: NavigationResult) -> np.ndarray:
+    """Acceleration (T, 2) of the coupled bases' origin along ``nav``, robot frame,
+    m/s^2 (finite differences of the sampled route)."""
+    t, p = nav.times, nav.poses
+    if len(t) < 3:
+        return np.zeros((len(t), 2))
+    a = np.column_stack([np.gradient(np.gradient(p[:, j], t), t) for j in range(2)])
+    c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
+    return np.column_stack([c * a[:, 0] + s * a[:, 1], -s * a[:, 0] + c * a[:, 1]])
+
+
+def navigate_run(warehouse: Warehouse, robot: CableRobot, position: np.ndarray,
+                 nav: NavigationResult) -> PhaseRun:
+    """The locked platform (at ``position``, robot frame) of ``robot`` (stabilisers up)
+    carried along the verified route ``nav``, monitored at every sample (module
+    docstring)."""
+    acc = np.round(_base_accel(nav), 3)
+    distinct = np.unique(acc, axis=0)
+    wrench = np.zeros((len(distinct), 6))
+    wrench[:, :2] = -robot.total_mass * distinct
+    checks = [_held(robot, position, wrench)]
+    pose6 = np.r_[position, 0.0, 0.0, 0.0][None]
+    ex, at = cable_segments(robot, np.zeros(3), pose6)          # robot frame, (1, m, 3)
+    c, s = np.cos(nav.poses[:, 2]), np.sin(nav.poses[:, 2])
+    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)   # (P, 2, 2)
+
+    def world(q: np.ndarray) -> np.ndarray:
+        out = np.broadcast_to(q, (len(rot),) + q.shape[1:]).copy()
+        out[..., :2] = np.einsum("pij,pmj->pmi", rot, q[..., :2]) + nav.poses[:, None, :2]
+        return out
+
+    cab = segments_clearance(warehouse, world(ex), world(at))
+    foot = footprint_gap(warehouse, robot, nav.poses)
+    platform = np.array([to_world_frame(q, position) for q in nav.poses])
+    return _static_run(checks, nav.duration, cab, foot, nav.times - nav.times[0], platform)

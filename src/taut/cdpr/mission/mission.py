@@ -20,7 +20,10 @@ Before the first task the stabilisers deploy (``STABILISER_S``); after the last 
 returns empty to the park position and they retract (the ``retract`` phase holds both).
 Every motion follows :func:`~taut.cdpr.mission.timing.time_optimal_path` and runs in the
 control simulation (:mod:`taut.cdpr.mission._execute`); ``navigate``, ``deploy`` and
-``retract`` hold the platform statically.
+``retract`` hold the locked platform, monitored along their time line: every sample of the
+verified route with the bases' acceleration as an inertial load, every stabiliser state a
+deploy or retract passes through. Every phase monitors the cables against the shelves
+(solid to their height) and the bases' footprint against walls and shelves.
 
 Baseline (``baseline_total_time``): the same sites, routes, dwells and stabiliser times,
 every platform motion on a fixed trapezoidal profile through the same waypoints: cruise
@@ -40,17 +43,22 @@ shelf. Units: SI (m, s, N, N m).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
 from ..._outcome import check_status
-from ..._validate import MAX_CDPR_LENGTH_M, as_bounded, as_flag, require_instance
+from ..._validate import (MAX_CDPR_LENGTH_M, as_array, as_bounded, as_flag, check_range,
+                          require_instance)
 from ...errors import InvalidInputError
 from ..control.dynamics import DynamicsModel
 from ..model.robot import CableRobot, with_friction, with_stabilisers
 from ..statics.tension import distribute_tensions
-from ._execute import PhaseRun, hold_margins, run_motion
+from .._tol import NAV_TOL
+from ..deployment.moving_base import _stabilisers
+from ._execute import (PhaseRun, footprint_gap, hold_margins, navigate_run, run_motion,
+                       switch_stabilisers)
+from ._reposition import Reposition, active_index, drive_time, shifted
 from .navigation import NavigationResult, plan_navigation
 from .sites import Site, SitesResult, UnservedTask, choose_sites
 from .timing import fixed_profile_duration, time_optimal_path, with_box
@@ -90,6 +98,10 @@ class Phase:
         N m, ``-m_C`` (eqs. 21-23) over base edges and time.
     min_sliding_margin : float
         N, friction pyramid (inf without friction).
+    min_cable_clearance : float
+        m, least gap between any cable and any shelf (solid to its height).
+    min_footprint_clearance : float
+        m, least gap between the coupled bases' footprint and any wall or shelf.
     success : bool
     message : str
     """
@@ -102,6 +114,8 @@ class Phase:
     min_tension_margin: float
     min_tipping_margin: float
     min_sliding_margin: float
+    min_cable_clearance: float
+    min_footprint_clearance: float
     success: bool
     message: str
 
@@ -137,6 +151,9 @@ class MissionResult:
         Pose ``(x, y, yaw)`` of the coupled bases, m and rad.
     track_platform : (T, 3)
         Platform reference point in the world, m.
+    repositions : tuple of Reposition
+        Per task, the active base's offset chosen and what it saves and costs (empty
+        unless ``active_base_offsets`` were given).
     """
 
     success: bool
@@ -154,6 +171,7 @@ class MissionResult:
     track_times: np.ndarray
     track_bases: np.ndarray
     track_platform: np.ndarray
+    repositions: tuple[Reposition, ...] = ()
 
     def __post_init__(self) -> None:
         check_status(self.status)
@@ -182,16 +200,23 @@ class _Log:
         dur = run.duration + extra
         self.phases.append(Phase(kind, task, site, self.t, self.t + dur,
                                  run.min_tension_margin, run.min_tipping_margin,
-                                 run.min_sliding_margin, run.success, run.message))
+                                 run.min_sliding_margin, run.min_cable_clearance,
+                                 run.min_footprint_clearance, run.success, run.message))
         self.times.append(self.t + np.r_[run.times, dur])
         self.platform.append(np.vstack([run.platform, run.platform[-1:]]))
         self.bases.append(np.broadcast_to(bases, (len(run.times) + 1, 3))
                           if bases.ndim == 1 else bases)
         self.t += dur
         self.baseline += baseline + extra
-        if kind != "navigate":
+        if kind not in ("navigate", "deploy"):
             self.motion += run.duration
             self.baseline_motion += baseline
+
+
+#: The monitors of a :class:`~._execute.PhaseRun`, in its field order.
+_MONITORS = ("min_tension_margin", "min_tipping_margin", "min_sliding_margin",
+             "min_clearance", "max_tracking_error", "min_cable_clearance",
+             "min_footprint_clearance")
 
 
 def _park(robot: CableRobot) -> np.ndarray:
@@ -222,47 +247,120 @@ def _motion(wh: Warehouse, site: Site, robot: CableRobot, points: list[np.ndarra
     base = fixed_profile_duration(law, BASELINE_SPEED)
     if not law.success:
         return PhaseRun(False, law.message, 0.0, np.nan, np.nan, np.nan, np.nan, np.nan,
-                        np.array([0.0]), to_world_frame(site.pose, wp[:1])), base
+                        np.nan, np.nan, np.array([0.0]),
+                        to_world_frame(site.pose, wp[:1])), base
     if not simulate_runs:
         return PhaseRun(True, law.message, law.duration, np.nan, np.nan, np.nan, np.inf,
-                        0.0, law.times[::50],
+                        0.0, np.nan, np.nan, law.times[::50],
                         to_world_frame(site.pose, law.positions[::50])), base
     return run_motion(wh, site.pose, robot, law, dyn), base
 
 
-def _site_tasks(wh: Warehouse, site: Site, k: int, park: np.ndarray, log: _Log,
-                dyn: DynamicsModel, simulate_runs: bool, tick: Callable[[], None]) -> None:
-    """Deploy, every task of the site, retract."""
-    down = site.robot
-    up = with_stabilisers(down, deployed=False)
-    log.add("deploy", "", k, hold_margins((with_box(up, 0.0), with_box(down, 0.0)), park,
-                                          0.0, wh, site.pose), STABILISER_S, 0.0, site.pose)
-    here = park
-    masses = {t.name: t.mass for t in wh.tasks}
+def _worst(a: PhaseRun, b: PhaseRun) -> PhaseRun:
+    """The monitors of motion ``a`` and static hold ``b`` combined (``a``'s track)."""
+    worst = {f: (max if f == "max_tracking_error" else min)(getattr(a, f), getattr(b, f))
+             for f in _MONITORS}
+    return replace(a, success=a.success and b.success,
+                   message=a.message if not a.success else b.message, **worst)
+
+
+def _task_motions(down: CableRobot, mass: float, here: np.ndarray, pick: np.ndarray,
+                  place: np.ndarray) -> list[tuple[str, CableRobot, list[np.ndarray], float]]:
+    """The pick, carry and place motions of one task: kind, robot, waypoints, dwell s."""
     lift = np.array([0.0, 0.0, LIFT_M])
+    empty, loaded = with_box(down, 0.0), with_box(down, mass)
+    return [("pick", empty, [here, pick], GRIP_S),
+            ("carry", loaded, [pick, pick + lift, place + lift], 0.0),
+            ("place", loaded, [place + lift, place], GRIP_S)]
+
+
+def _plan_time(motions: list[tuple[str, CableRobot, list[np.ndarray], float]],
+               dyn: DynamicsModel) -> float:
+    """Time-optimal duration of ``motions`` (inf when one is infeasible), s."""
+    total = 0.0
+    for _, robot, pts, _ in motions:
+        wp = _waypoints(pts)
+        if len(wp) > 1:
+            law = time_optimal_path(robot, wp, dynamics=dyn)
+            if not law.success:
+                return float("inf")
+            total += law.duration
+    return total
+
+
+def _choose_offset(wh: Warehouse, site: Site, offsets: tuple[float, ...], current: float,
+                   name: str, motions: Callable[[CableRobot], list[Any]],
+                   dyn: DynamicsModel) -> Reposition:
+    """The active-base offset for one task (:mod:`._reposition`)."""
+    times = {}
+    for d in sorted(set(offsets) | {current}):
+        robot = shifted(site.robot, d)
+        if d != current and footprint_gap(wh, robot, site.pose) < wh.clearance - NAV_TOL:
+            continue
+        times[d] = _plan_time(motions(robot), dyn)
+    cost = {d: t + drive_time(abs(d - current), wh.max_accel, STABILISER_S)
+            for d, t in times.items()}
+    best = min(cost, key=lambda d: (cost[d], abs(d - current)))
+    fastest = min(times.values())
+    return Reposition(name, best, times[best] - times[current],
+                      cost[best] - times[best],
+                      max(0.0, times[current] - fastest) if np.isfinite(fastest) else 0.0)
+
+
+def _drive(wh: Warehouse, site: Site, a: float, b: float, here: np.ndarray) -> PhaseRun:
+    """Monitors of a move of the active base from offset ``a`` to ``b`` (m) with the
+    platform held empty at ``here``: on its wheels at both ends, then every stabiliser
+    down."""
+    k = active_index(site.robot)
+    flags = [bb.stabilisers_deployed and j != k for j, bb in enumerate(site.robot.bases)]
+    robots = (_stabilisers(shifted(site.robot, a), flags),
+              _stabilisers(shifted(site.robot, b), flags), shifted(site.robot, b))
+    return hold_margins(tuple(with_box(r, 0.0) for r in robots), here, 0.0, wh, site.pose)
+
+
+def _site_tasks(wh: Warehouse, site: Site, k: int, park: np.ndarray, log: _Log,
+                dyn: DynamicsModel, simulate_runs: bool, tick: Callable[[], None],
+                offsets: tuple[float, ...] = (), repos: list[Reposition] | None = None
+                ) -> None:
+    """Deploy, every task of the site (moving the active base between tasks when that
+    pays off, :mod:`._reposition`), retract."""
+    down = site.robot
+    log.add("deploy", "", k, switch_stabilisers(with_box(down, 0.0), True, park,
+                                                STABILISER_S, wh, site.pose),
+            0.0, STABILISER_S, site.pose)
+    here, offset = park, 0.0
+    masses = {t.name: t.mass for t in wh.tasks}
     for name, pick, place in zip(site.task_names, site.picks, site.places):
-        empty, loaded = with_box(down, 0.0), with_box(down, masses[name])
-        for kind, robot, pts, extra in (
-                ("pick", empty, [here, pick], GRIP_S),
-                ("carry", loaded, [pick, pick + lift, place + lift], 0.0),
-                ("place", loaded, [place + lift, place], GRIP_S)):
+        def motions(robot: CableRobot, m: float = masses[name], h: np.ndarray = here,
+                    p: np.ndarray = pick, q: np.ndarray = place) -> list[Any]:
+            return _task_motions(robot, m, h, p, q)
+        move, drive = 0.0, None
+        if offsets:
+            choice = _choose_offset(wh, site, offsets, offset, name, motions, dyn)
+            if repos is not None:
+                repos.append(choice)
+            if choice.offset != offset:
+                move, drive = choice.move_time, _drive(wh, site, offset, choice.offset, here)
+                offset = choice.offset
+        for kind, robot, pts, extra in motions(shifted(down, offset)):
             run, base = _motion(wh, site, robot, pts, dyn, simulate_runs)
+            if kind == "pick" and drive is not None:
+                run, extra = _worst(run, drive), extra + move
             log.add(kind, name, k, run, extra, base, site.pose)
             tick()
         here = place
-    run, base = _motion(wh, site, with_box(down, 0.0), [here, park], dyn, simulate_runs)
-    held = hold_margins((with_box(down, 0.0), with_box(up, 0.0)), park, 0.0, wh, site.pose)
-    worst = PhaseRun(run.success and held.success, run.message if not run.success else
-                     held.message, run.duration,
-                     min(run.min_tension_margin, held.min_tension_margin),
-                     min(run.min_tipping_margin, held.min_tipping_margin),
-                     min(run.min_sliding_margin, held.min_sliding_margin),
-                     run.min_clearance, run.max_tracking_error, run.times, run.platform)
-    log.add("retract", "", k, worst, STABILISER_S, base, site.pose)
+    run, base = _motion(wh, site, with_box(shifted(down, offset), 0.0), [here, park], dyn,
+                        simulate_runs)
+    held = switch_stabilisers(with_box(down, 0.0), False, park, STABILISER_S, wh, site.pose)
+    back = drive_time(abs(offset), wh.max_accel, STABILISER_S)
+    if offset != 0.0:
+        held = _worst(held, _drive(wh, site, offset, 0.0, park))
+    log.add("retract", "", k, _worst(run, held), STABILISER_S + back, base, site.pose)
 
 
 def plan_mission(warehouse: Warehouse, *, dynamics: DynamicsModel | None = None,
                  simulate_runs: bool = True, site_step: float = 0.25,
+                 active_base_offsets: Any = (),
                  progress: Callable[[int, int], None] | None = None) -> MissionResult:
     """Plan and simulate the warehouse's kitting mission (module docstring).
 
@@ -277,6 +375,9 @@ def plan_mission(warehouse: Warehouse, *, dynamics: DynamicsModel | None = None,
     site_step : float
         Spacing of the candidate sites along the shelf faces, m
         (:func:`~taut.cdpr.mission.sites.choose_sites`).
+    active_base_offsets : array_like (k,), default ()
+        Offsets the active base may move to along the shelf face between tasks, m
+        (:mod:`taut.cdpr.mission._reposition`); empty: it stays at the site's placement.
     progress : callable(done, total), optional
         Called after each site search, route and motion phase.
 
@@ -298,6 +399,10 @@ def plan_mission(warehouse: Warehouse, *, dynamics: DynamicsModel | None = None,
     if progress is not None and not callable(progress):
         raise InvalidInputError("progress", "must be a callable(done, total) or None")
     site_step = as_bounded(site_step, "site_step", MAX_CDPR_LENGTH_M, "m")
+    offsets = tuple(float(v) for v in check_range(
+        as_array(active_base_offsets, "active_base_offsets", shape=(None,)),
+        "active_base_offsets", MAX_CDPR_LENGTH_M, "m"))
+    repos: list[Reposition] = []
     chosen: SitesResult = choose_sites(warehouse, step=site_step)
     ntasks = sum(len(s.task_names) for s in chosen.sites)
     total, done = 1 + len(chosen.sites) + 3 * ntasks, [1]
@@ -322,15 +427,15 @@ def plan_mission(warehouse: Warehouse, *, dynamics: DynamicsModel | None = None,
             unserved += [UnservedTask(n, f"site {k + 1} not reached: {nav.message}")
                          for n in site.task_names]
             continue
-        held = hold_margins((with_box(free, 0.0),), park, nav.duration, warehouse, pose)
-        platform = np.array([to_world_frame(p, park) for p in nav.poses])
-        held = replace(held, times=nav.times[:-1] - nav.times[0], platform=platform[:-1])
+        held = navigate_run(warehouse, with_box(free, 0.0), park, nav)
+        held = replace(held, times=held.times[:-1], platform=held.platform[:-1])
         log.add("navigate", "", k, held, 0.0, nav.duration, nav.poses)
         tick()
-        _site_tasks(warehouse, site, k, park, log, dyn, simulate_runs, tick)
+        _site_tasks(warehouse, site, k, park, log, dyn, simulate_runs, tick, offsets, repos)
         served += list(site.task_names)
         pose = site.pose
-    return _result(log, status, chosen, tuple(routes), tuple(served), tuple(unserved))
+    return replace(_result(log, status, chosen, tuple(routes), tuple(served),
+                           tuple(unserved)), repositions=tuple(repos))
 
 
 def _result(log: _Log, status: str, chosen: SitesResult, routes: tuple[NavigationResult, ...],

@@ -31,6 +31,9 @@ from ...errors import InvalidInputError, InvalidModelError
 from ..model.footprint import convex_hull_2d
 from ..model.robot import CableRobot
 
+#: Default shelf height (:class:`Shelf`), m.
+SHELF_HEIGHT = 2.5
+
 __all__ = ["Shelf", "Task", "Warehouse", "coupled_footprint", "to_robot_frame",
            "to_world_frame"]
 
@@ -59,19 +62,26 @@ class Shelf:
     ----------
     name : str
     footprint : shapely.Polygon or array_like (k, 2)
-        Ground footprint, m (simple polygon). Shelves are taller than the cables, so the
-        coupled bases' whole footprint (cables and locked platform between the bases
-        included) keeps off them.
+        Ground footprint, m (simple polygon). The coupled bases' whole footprint (cables
+        and locked platform between the bases included) keeps off it while navigating.
+    height : float, default :data:`SHELF_HEIGHT`
+        Height of the shelf's top above the floor, m: the solid ``footprint x [0, height]``
+        the cables must not touch at a site (ASSUMPTION when the file gives none: a 2.5 m
+        rack).
     """
 
     name: str
     footprint: Any
+    height: float = SHELF_HEIGHT
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise InvalidInputError("shelves.name", "must be a non-empty string")
         object.__setattr__(self, "footprint",
                            _polygon(self.footprint, f"shelves[{self.name}].footprint"))
+        object.__setattr__(self, "height", as_bounded(self.height,
+                                                      f"shelves[{self.name}].height",
+                                                      MAX_CDPR_LENGTH_M, "m"))
 
 
 @dataclass(frozen=True, eq=False)
