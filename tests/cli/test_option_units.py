@@ -30,10 +30,11 @@ LIBRARY = {
     ("plan", "--sheet-margin"): ("taut.plan:plan", "sheet_margin"),
     ("plan", "--spacing"): ("taut.plan:plan", "spacing"),
     ("plan", "--robustness"): ("taut.plan:plan_robustness", "sigma"),
-    ("plan", "--max-speed-mps"): ("taut.plan:robot_trajectories", "max_speed"),
-    ("plan", "--max-accel-mps2"): ("taut.plan:robot_trajectories", "max_accel"),
-    ("plan", "--max-yaw-rate-radps"): ("taut.plan:robot_trajectories", "max_yaw_rate"),
-    ("plan", "--reform-speed-mps"): ("taut.plan:robot_trajectories", "reform_speed"),
+    ("plan", "--max-speed"): ("taut.plan:robot_trajectories", "max_speed"),
+    ("plan", "--max-accel"): ("taut.plan:robot_trajectories", "max_accel"),
+    ("plan", "--max-yaw-rate"): ("taut.plan:robot_trajectories", "max_yaw_rate"),
+    ("plan", "--max-yaw-accel"): ("taut.plan:robot_trajectories", "max_yaw_accel"),
+    ("plan", "--reform-speed"): ("taut.plan:robot_trajectories", "reform_speed"),
     ("cdpr tensions", "--pose"): ("taut.cdpr:distribute_tensions", "poses"),
     ("cdpr tensions", "--rpy"): ("taut.cdpr:distribute_tensions", "poses"),
     ("cdpr wrench-set", "--pose"): ("taut.cdpr:available_wrench_set", "poses"),
@@ -63,7 +64,7 @@ NO_UNIT = {"--seed", "--iterations", "--trials", "--grid", "--mesh", "--port", "
            "--workers", "--limit"}
 
 #: Unit words, longest first; each maps to its canonical spelling.
-_UNITS = {"m/s^2": "m/s^2", "rad/s": "rad/s", "m/s": "m/s", "N m": "N m", "1/s": "1/s",
+_UNITS = {"m/s^2": "m/s^2", "rad/s^2": "rad/s^2", "rad/s": "rad/s", "m/s": "m/s", "N m": "N m", "1/s": "1/s",
           "mm": "mm", "ms": "ms", "Hz": "Hz", "kg": "kg", "degrees": "deg", "deg": "deg",
           "radians": "rad", "rad": "rad", "m": "m", "s": "s", "N": "N",
           "sheet units": "sheet units", "scenario units": "sheet units",
@@ -136,6 +137,19 @@ def test_every_numeric_option_is_registered():
 def test_registered_options_exist():
     have = {(cmd, p.opts[0]) for cmd, p in OPTIONS}
     assert not set(LIBRARY) - have
+
+
+#: Option-name endings that would be a unit (``--max-speed-mps``, ``--latency-ms``).
+_UNIT_ENDINGS = re.compile(r"-(m|mm|cm|s|ms|rad|deg|degrees|n|nm|kg|hz|mps|mps2|radps|"
+                           r"m-s|rad-s|sheet-units|units)$")
+
+
+def test_option_names_carry_no_unit():
+    """One rule for every command (docs/conventions.md, Units): the name says what, the
+    help says the unit, so ``--max-speed 0.2`` (m/s) like ``--latency 0.002`` (s)."""
+    named = sorted({o for _, p in OPTIONS for o in p.opts if _UNIT_ENDINGS.search(o.lower())})
+    assert not named, f"options naming a unit (say it in the help instead): {named}"
+    assert _UNIT_ENDINGS.search("--max-speed-mps") and not _UNIT_ENDINGS.search("--max-speed")
 
 
 @pytest.mark.parametrize("key", sorted(LIBRARY), ids=[" ".join(k) for k in sorted(LIBRARY)])

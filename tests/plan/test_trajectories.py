@@ -23,7 +23,8 @@ RTOL = 1e-9
 
 def measure(times, poses):
     """Largest robot speed, acceleration (velocity change over the mean duration of the
-    two intervals, from and to rest) and yaw rate, from the samples alone."""
+    two intervals, from and to rest), yaw rate and yaw acceleration (the same definition),
+    from the samples alone."""
     dt = np.diff(times)
     assert np.all(dt > 0)
     v = np.diff(poses[..., :2], axis=0) / dt[:, None, None]
@@ -32,14 +33,18 @@ def measure(times, poses):
     mid = np.concatenate([[0.0], dt, [0.0]])
     mid = (mid[:-1] + mid[1:]) / 2
     acc = np.linalg.norm(np.diff(vel, axis=0), axis=2) / mid[:, None]
-    return np.linalg.norm(v, axis=2).max(), acc.max(), yaw.max()
+    om = np.diff(poses[..., 2], axis=0) / dt[:, None]
+    om = np.concatenate([np.zeros((1, om.shape[1])), om, np.zeros((1, om.shape[1]))])
+    yaw_acc = np.abs(np.diff(om, axis=0)) / mid[:, None]
+    return np.linalg.norm(v, axis=2).max(), acc.max(), yaw.max(), yaw_acc.max()
 
 
-def violations(tr, limits=LIMITS):
-    speed, acc, yaw = measure(tr.times, tr.poses)
+def violations(tr, limits=LIMITS, yaw_accel=2.0):
+    speed, acc, yaw, yaw_acc = measure(tr.times, tr.poses)
     return [name for name, got, lim in (("speed", speed, limits["max_speed"]),
                                         ("accel", acc, limits["max_accel"]),
-                                        ("yaw", yaw, limits["max_yaw_rate"]))
+                                        ("yaw", yaw, limits["max_yaw_rate"]),
+                                        ("yaw_accel", yaw_acc, yaw_accel))
             if got > lim * (1 + RTOL)]
 
 
@@ -106,6 +111,11 @@ def test_tighter_limits_take_longer_and_are_respected(paper_corridor_plan):
     assert tr.success and violations(tr, slow) == []
     fast = robot_trajectories(result, drive="differential", **LIMITS)
     assert tr.duration > fast.duration
+    # the default yaw acceleration limit (2 rad/s^2) binds on the turns in place
+    turn = robot_trajectories(result, drive="differential", max_yaw_accel=0.2, **LIMITS)
+    assert turn.success and violations(turn, yaw_accel=0.2) == []
+    assert turn.duration > fast.duration and turn.peak_yaw_accel <= 0.2 * (1 + RTOL)
+    assert fast.peak_yaw_accel <= 2.0 * (1 + RTOL) and fast.max_yaw_accel == 2.0
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".json"])
@@ -136,8 +146,8 @@ def _paths(draw_n=st.integers(2, 5)):
 
 @settings(max_examples=40, deadline=None)
 @given(_paths(), st.sampled_from(["holonomic", "differential"]),
-       st.floats(0.05, 2.0), st.floats(0.05, 3.0), st.floats(0.1, 5.0))
-def test_timing_respects_every_limit_on_random_paths(shape, drive, vmax, amax, wmax):
+       st.floats(0.05, 2.0), st.floats(0.05, 3.0), st.floats(0.1, 5.0), st.floats(0.05, 5.0))
+def test_timing_respects_every_limit_on_random_paths(shape, drive, vmax, amax, wmax, alpha):
     n, T, seed = shape
     rng = np.random.default_rng(seed)
     robots = np.cumsum(rng.normal(0, 0.02, (T, n, 2)), axis=0)
@@ -145,10 +155,12 @@ def test_timing_respects_every_limit_on_random_paths(shape, drive, vmax, amax, w
     reform = rng.random(T - 1) < 0.3
     path = drive_path(robots, heading, np.zeros((T, 3)), reform, drive)
     times = time_path(path.robots, path.heading, path.reform, max_speed=vmax,
-                      max_accel=amax, max_yaw_rate=wmax, reform_speed=0.05)
+                      max_accel=amax, max_yaw_rate=wmax, reform_speed=0.05,
+                      max_yaw_accel=alpha)
     poses = np.concatenate([path.robots, path.heading[..., None]], axis=2)
-    speed, acc, yaw = measure(times, poses)
+    speed, acc, yaw, yaw_acc = measure(times, poses)
     assert speed <= vmax * (1 + RTOL) and acc <= amax * (1 + RTOL) and yaw <= wmax * (1 + RTOL)
+    assert yaw_acc <= alpha * (1 + RTOL)
     step = np.linalg.norm(np.diff(path.robots, axis=0), axis=2).max(axis=1)
     v = step / np.diff(times)
     assert np.all(v[path.reform] <= 0.05 * (1 + RTOL))            # quasi-static changes
@@ -161,13 +173,18 @@ def test_cli_writes_the_trajectories_the_library_gives(paper_corridor_plan, exec
     from .conftest import EXAMPLES
     out = tmp_path / "t.csv"
     code = main(["plan", str(EXAMPLES / "paper_corridor.yaml"), "--drive", "differential",
-                 "--trajectories", str(out), "--max-speed-mps", "0.2", "--max-accel-mps2",
-                 "0.5", "--max-yaw-rate-radps", "1"])
+                 "--trajectories", str(out), "--max-speed", "0.2", "--max-accel",
+                 "0.5", "--max-yaw-rate", "1"])
     assert code == 0
     back = load_robot_trajectories(out)
     np.testing.assert_array_equal(back.poses, executed["differential"].poses)
     capsys.readouterr()
     code = main(["plan", str(EXAMPLES / "paper_corridor.yaml"), "--trajectories", str(out),
-                 "--max-speed-mps", "0.2"])
+                 "--max-speed", "0.2"])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "--max-accel-mps2" in err[0]
+    assert code == 2 and len(err) == 1 and "--max-accel" in err[0]
+    code = main(["plan", str(EXAMPLES / "paper_corridor.yaml"), "--trajectories", str(out),
+                 "--max-speed", "0.2", "--max-accel", "0.5", "--max-yaw-rate", "1",
+                 "--max-yaw-accel", "-1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--max-yaw-accel" in err[0]

@@ -19,9 +19,7 @@ __all__ = ["register", "plan_command"]
 
 #: The command-line option of each library keyword whose name differs (the others are
 #: ``--`` and the keyword with dashes).
-_OPTION_OF = {"time_budget": "--budget", "sigma": "--robustness",
-              "max_speed": "--max-speed-mps", "max_accel": "--max-accel-mps2",
-              "max_yaw_rate": "--max-yaw-rate-radps", "reform_speed": "--reform-speed-mps"}
+_OPTION_OF = {"time_budget": "--budget", "sigma": "--robustness"}
 
 
 def plan_command(
@@ -70,19 +68,23 @@ def plan_command(
     trajectories: Optional[Path] = typer.Option(
         None, "--trajectories", help="Also write one trajectory per robot (time s, x m, y "
         "m, heading rad; the object m), re-verified on the executed motion (.csv or "
-        ".json); needs --max-speed-mps, --max-accel-mps2 and --max-yaw-rate-radps."),
+        ".json); needs --max-speed, --max-accel and --max-yaw-rate."),
     drive: str = typer.Option("holonomic", "--drive", help="Robot drive of --trajectories: "
                               "holonomic or differential (faces its motion, turns in "
                               "place)."),
-    max_speed: Optional[float] = typer.Option(None, "--max-speed-mps", help="Largest robot "
+    max_speed: Optional[float] = typer.Option(None, "--max-speed", help="Largest robot "
                                               "speed of --trajectories, m/s."),
-    max_accel: Optional[float] = typer.Option(None, "--max-accel-mps2", help="Largest "
+    max_accel: Optional[float] = typer.Option(None, "--max-accel", help="Largest "
                                               "robot acceleration of --trajectories, "
                                               "m/s^2."),
-    max_yaw_rate: Optional[float] = typer.Option(None, "--max-yaw-rate-radps",
+    max_yaw_rate: Optional[float] = typer.Option(None, "--max-yaw-rate",
                                                  help="Largest robot turn rate of "
                                                       "--trajectories, rad/s."),
-    reform_speed: Optional[float] = typer.Option(None, "--reform-speed-mps",
+    max_yaw_accel: Optional[float] = typer.Option(None, "--max-yaw-accel",
+                                                  help="Largest robot yaw acceleration of "
+                                                       "--trajectories, rad/s^2 (default "
+                                                       "the library's 2)."),
+    reform_speed: Optional[float] = typer.Option(None, "--reform-speed",
                                                  help="Largest robot speed during "
                                                       "formation changes, m/s (default "
                                                       "the library's 0.05: quasi-static)."),
@@ -111,7 +113,7 @@ def plan_command(
         replays = robustness_options(0.0 if robustness is None else robustness, trials,
                                      seed=seed)
         executed = _trajectory_options(trajectories, drive, max_speed, max_accel,
-                                       max_yaw_rate, reform_speed)
+                                       max_yaw_rate, reform_speed, max_yaw_accel)
     sc = load_plan_scenario(scenario)
     with working("plan"):
         result = run_plan(sc, options)
@@ -163,7 +165,7 @@ def _write_outputs(sc, result, traj, doc: dict, out: Optional[Path], plot: Optio
 
 def _trajectory_options(path: Optional[Path], drive: str, max_speed: Optional[float],
                         max_accel: Optional[float], max_yaw_rate: Optional[float],
-                        reform_speed: Optional[float]):
+                        reform_speed: Optional[float], max_yaw_accel: Optional[float] = None):
     """The validated options of ``--trajectories`` (None without it): the library's
     validation, the limits it needs named as options."""
     if path is None:
@@ -174,7 +176,8 @@ def _trajectory_options(path: Optional[Path], drive: str, max_speed: Optional[fl
         name = ("max_speed" if max_speed is None else "max_accel" if max_accel is None
                 else "max_yaw_rate")                          # named as options below
         raise InvalidInputError(name, "needed with --trajectories")
-    extra = {} if reform_speed is None else {"reform_speed": reform_speed}
+    extra = {k: v for k, v in (("reform_speed", reform_speed),
+                               ("max_yaw_accel", max_yaw_accel)) if v is not None}
     return trajectory_options(drive, max_speed, max_accel, max_yaw_rate, **extra)
 
 
@@ -183,7 +186,7 @@ def _write_trajectories(path, traj, doc: dict) -> None:
     from ..io.robot_trajectories import robot_trajectories_to_dict, save_robot_trajectories
     save_robot_trajectories(path, traj)
     summary = robot_trajectories_to_dict(traj)
-    for key in ("times_s", "poses", "object_m"):
+    for key in ("times_s", "poses_m_rad", "object_m"):
         summary.pop(key)
     doc["trajectories"] = summary
     typer.echo(f"trajectories: {traj.message}", err=True)

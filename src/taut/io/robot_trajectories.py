@@ -2,7 +2,7 @@
 
 CSV: a header row and one row per sample, every column named with its unit:
 ``t_s, x_1_m, y_1_m, heading_1_rad, ..., x_N_m, y_N_m, heading_N_rad, object_x_m,
-object_y_m, object_z_m`` (robots 1-based). JSON: ``times_s`` (T,), ``poses`` (T, N, 3:
+object_y_m, object_z_m`` (robots 1-based). JSON: ``times_s`` (T,), ``poses_m_rad`` (T, N, 3:
 x m, y m, heading rad), ``object_m`` (T, 3) and the outcome (``success``, ``status``,
 ``message``, ``drive``, durations, limits and measured peaks, each key with its unit).
 Numbers are written with 17 significant digits, so both read back exactly
@@ -52,7 +52,7 @@ def robot_trajectories_to_dict(tr: RobotTrajectories) -> dict[str, Any]:
         "peaks": {"speed_mps": tr.peak_speed, "accel_mps2": tr.peak_accel,
                   "yaw_rate_radps": tr.peak_yaw_rate},
         "times_s": np.asarray(tr.times, float).tolist(),
-        "poses": np.asarray(tr.poses, float).tolist(),
+        "poses_m_rad": np.asarray(tr.poses, float).tolist(),
         "object_m": np.asarray(tr.object, float).tolist(),
     }
 
@@ -95,7 +95,7 @@ def load_robot_trajectories(path: str | Path) -> ExecutedTrajectories:
         try:
             doc = json.loads(text)
             times = np.asarray(doc["times_s"], float).reshape(-1)
-            poses = np.asarray(doc["poses"], float).reshape(len(times), -1, 3)
+            poses = np.asarray(doc["poses_m_rad"], float).reshape(len(times), -1, 3)
             obj = np.asarray(doc["object_m"], float).reshape(len(times), 3)
         except (ValueError, KeyError, TypeError) as exc:
             raise InvalidTrajectoryError(Path(path).name, f"not a trajectories file: {exc}"

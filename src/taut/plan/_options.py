@@ -28,7 +28,7 @@ from .se2._ompl import SEARCHES, Search, engine
 from .se2._search import SearchBudget
 
 __all__ = ["PlanOptions", "RobustnessOptions", "plan_options", "robustness_options",
-           "METHODS", "BASELINES", "NOISES"]
+           "METHODS", "BASELINES", "NOISES", "LinearScreen", "LINEAR_SCREEN"]
 
 #: Planning methods of :func:`taut.plan.plan` (its ``method``).
 METHODS: tuple[str, ...] = ("se2", "roadmap", "algorithm2")
@@ -143,3 +143,31 @@ def robustness_options(sigma: Any = _tol.POSITION_ACCURACY, trials: Any = 200, *
         as_count(seed, "seed", minimum=0),
         as_bounded(correlation, "correlation", MAX_CORRELATION_S, "s"))
 
+
+
+@dataclass(frozen=True)
+class LinearScreen:
+    """The linearised robustness screen of the planner's formation admission (issue 28):
+    before the seeded Monte Carlo of a formation's rest state under robot position error
+    (:func:`~taut.plan.formations._squeeze_robust.tolerates`), the first-order prediction
+    through the state's ``jacobian`` (:func:`taut.sheet.object_covariance`) rejects a
+    state whose object height above its least height, or whose allowed shift, is below
+    ``sigmas`` predicted standard deviations. It only rejects (what passes is sampled: the
+    sampling decides), and is sized so that it rejects only what the sampling rejects too
+    (measured: ``bench/bench_plan_screen.py``).
+
+    Attributes
+    ----------
+    enabled : bool
+        False: every candidate is sampled.
+    sigmas : float
+        Predicted standard deviations (dimensionless) a margin must exceed.
+    """
+
+    enabled: bool = True
+    sigmas: float = 1.0
+
+
+#: The screen the planner uses (the one place it is set; benchmarks replace it to measure
+#: the planner without it).
+LINEAR_SCREEN = LinearScreen()

@@ -184,11 +184,19 @@ REFORM_MAX_SPEED = 0.05
 #: steered while moving (the heading changes linearly over the sample interval, so it is
 #: never further than this from the direction of motion).
 TURN_IN_PLACE = 0.1
+#: Default largest yaw acceleration of a robot's trajectory, rad/s^2
+#: (:func:`~taut.plan.execution.trajectories.robot_trajectories`' ``max_yaw_accel``): a
+#: turn in place of pi/2 then takes at least sqrt(2 (pi/2) / 2) = 1.25 s, about what a
+#: small differential-drive base (wheel torque, the sheet's pull) turns in.
+MAX_YAW_ACCEL = 2.0
+#: Rounds of :func:`~taut.plan.execution._timing.time_path`'s tightening (speeds of the
+#: intervals next to a sample whose acceleration exceeds a limit are lowered each round).
+TIMING_ROUNDS = 200
 #: A robot moving less than this over a sample interval is standing still (its heading is
 #: kept), m: a differential drive then slips sideways by at most this much.
 STANDING_STILL = 1e-6
-#: Largest accepted ``max_speed`` (m/s), ``max_yaw_rate`` (rad/s), ``max_accel`` (m/s^2) and
-#: ``reform_speed`` (m/s) of a robot: far beyond any mobile robot's.
+#: Largest accepted ``max_speed`` (m/s), ``max_yaw_rate`` (rad/s), ``max_accel`` (m/s^2),
+#: ``max_yaw_accel`` (rad/s^2) and ``reform_speed`` (m/s) of a robot: far beyond any mobile robot's.
 MAX_ROBOT_LIMIT = 100.0
 
 # ---------------------------------------------------------------- feedback on the object

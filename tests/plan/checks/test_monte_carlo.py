@@ -36,6 +36,7 @@ def test_a_robot_pushed_into_a_wall_is_a_collision_and_a_pair_pulled_apart_a_tea
     assert t.torn and t.failed and t.extension > 9.0
 
 
+@pytest.mark.slow  # ~2.3 s of CPU: the slow target (CI runs it)
 def test_probabilities_follow_the_margins(paper_corridor_plan):
     sc, r = paper_corridor_plan
     small = plan_robustness(r, 0.005, 10, seed=2)       # the default 5 mm position accuracy

@@ -175,6 +175,7 @@ def test_paper_corridor_plan(paper, paper_plan):
     assert not verify_motion(paper, r.robots, r.object, sheet_margin=0.5).success
 
 
+@pytest.mark.slow  # ~40 s of CPU: the slow target (CI runs it)
 def test_margin_protects_against_position_error(paper, paper_plan):
     r = paper_plan
     slack = r.verification.min_sheet_slack

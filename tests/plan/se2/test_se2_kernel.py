@@ -137,6 +137,7 @@ def test_motion_check_is_a_proof_for_the_continuous_motion(form, kind, seed):
         assert out.min() < _tol.STATE_CLEARANCE + step
 
 
+@pytest.mark.slow  # ~12 s of CPU: the slow target (CI runs it)
 def test_morph_check_is_a_proof_for_the_continuous_change():
     rng = np.random.default_rng(11)
     walls, _, verts, _ = _world(rng, 1)

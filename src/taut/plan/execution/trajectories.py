@@ -10,7 +10,7 @@ and gives it the robots' headings and timing:
    the formation; differential-drive robots face their direction of motion and stop to
    turn in place where it turns sharply;
 2. timing under the limits of every robot (:mod:`taut.plan.execution._timing`): speed,
-   acceleration (from rest to rest) and yaw rate, and during formation changes a speed
+   acceleration (from rest to rest), yaw rate and yaw acceleration, and during formation changes a speed
    of at most ``reform_speed`` (default ``taut.plan._tol.REFORM_MAX_SPEED``, 5 cm/s) so
    that the object settles as the quasi-static model assumes;
 3. re-verification of the executed motion by the plan's own verifier
@@ -66,12 +66,15 @@ class RobotTrajectories(CompactRepr):
         The rigid plan's duration at the team's speed, s (for comparison).
     turns : int
         Turns in place (differential drives).
-    peak_speed, peak_accel, peak_yaw_rate : float
-        The largest robot speed (m/s), acceleration (m/s^2) and yaw rate (rad/s) of the
-        trajectories (:func:`taut.plan.execution._timing.measured_limits`).
+    peak_speed, peak_accel, peak_yaw_rate, peak_yaw_accel : float
+        The largest robot speed (m/s), acceleration (m/s^2), yaw rate (rad/s) and yaw
+        acceleration (rad/s^2) of the trajectories
+        (:func:`taut.plan.execution._timing.measured_limits`).
     limits : tuple of float
         The limits asked for: max speed (m/s), max acceleration (m/s^2), max yaw rate
         (rad/s), max speed during formation changes (m/s).
+    max_yaw_accel : float
+        The yaw acceleration limit asked for, rad/s^2.
     verification : Verification or None
         The re-verification of the executed motion.
     """
@@ -91,6 +94,8 @@ class RobotTrajectories(CompactRepr):
     peak_yaw_rate: float = 0.0
     limits: tuple[float, float, float, float] = (np.inf, np.inf, np.inf, np.inf)
     verification: Verification | None = None
+    peak_yaw_accel: float = 0.0
+    max_yaw_accel: float = _tol.MAX_YAW_ACCEL
 
     def __post_init__(self) -> None:
         check_status(self.status)
@@ -98,7 +103,8 @@ class RobotTrajectories(CompactRepr):
 
 def robot_trajectories(result: PlanResult, *, drive: str = "holonomic", max_speed: float,
                        max_accel: float, max_yaw_rate: float,
-                       reform_speed: float = _tol.REFORM_MAX_SPEED) -> RobotTrajectories:
+                       reform_speed: float = _tol.REFORM_MAX_SPEED,
+                       max_yaw_accel: float = _tol.MAX_YAW_ACCEL) -> RobotTrajectories:
     """One time-parameterised trajectory per robot executing ``result`` (module docstring).
 
     Parameters
@@ -118,6 +124,9 @@ def robot_trajectories(result: PlanResult, *, drive: str = "holonomic", max_spee
     reform_speed : float
         Largest robot speed during a formation change, m/s, in (0, 100] (default 0.05:
         quasi-static, the object settles).
+    max_yaw_accel : float
+        Largest yaw acceleration of every robot, rad/s^2, in (0, 100] (default
+        ``taut.plan._tol.MAX_YAW_ACCEL``, 2 rad/s^2).
 
     Returns
     -------
@@ -142,50 +151,56 @@ def robot_trajectories(result: PlanResult, *, drive: str = "holonomic", max_spee
     """
     require_instance(result, PlanResult, "result")
     return _robot_trajectories(result, *trajectory_options(
-        drive, max_speed, max_accel, max_yaw_rate, reform_speed))
+        drive, max_speed, max_accel, max_yaw_rate, reform_speed, max_yaw_accel))
 
 
 def trajectory_options(drive: str, max_speed: float, max_accel: float, max_yaw_rate: float,
-                       reform_speed: float = _tol.REFORM_MAX_SPEED
-                       ) -> tuple[str, tuple[float, float, float, float]]:
+                       reform_speed: float = _tol.REFORM_MAX_SPEED,
+                       max_yaw_accel: float = _tol.MAX_YAW_ACCEL
+                       ) -> tuple[str, tuple[float, float, float, float], float]:
     """The one validation of :func:`robot_trajectories`' options (also what ``taut plan``
-    validates before planning): the drive and the limits (m/s, m/s^2, rad/s, m/s)."""
+    validates before planning): the drive, the limits (m/s, m/s^2, rad/s, m/s) and the
+    yaw acceleration limit (rad/s^2)."""
     lim = _tol.MAX_ROBOT_LIMIT
     return as_choice(drive, DRIVES, "drive"), (
         as_bounded(max_speed, "max_speed", lim, "m/s"),
         as_bounded(max_accel, "max_accel", lim, "m/s^2"),
         as_bounded(max_yaw_rate, "max_yaw_rate", lim, "rad/s"),
-        as_bounded(reform_speed, "reform_speed", lim, "m/s"))
+        as_bounded(reform_speed, "reform_speed", lim, "m/s")), as_bounded(
+        max_yaw_accel, "max_yaw_accel", lim, "rad/s^2")
 
 
 def _robot_trajectories(result: PlanResult, drive: str,
-                        limits: tuple[float, float, float, float]) -> RobotTrajectories:
+                        limits: tuple[float, float, float, float],
+                        max_yaw_accel: float = _tol.MAX_YAW_ACCEL) -> RobotTrajectories:
     """:func:`robot_trajectories` on validated inputs."""
     n = result.robots.shape[1]
     if not result.success or result.scenario is None or len(result.times) < 1:
         return RobotTrajectories(False, result.status, f"no plan to execute: "
                                  f"{result.message}", np.zeros(0), np.zeros((0, n, 3)),
                                  np.zeros((0, 3)), drive, float("nan"), result.duration,
-                                 limits=limits)
+                                 limits=limits, max_yaw_accel=max_yaw_accel)
     robots, heading, obj = _distinct(result)
     sc = result.scenario
     reform = ~_rigid_mask(robots, _tol.RIGID_RTOL * sc.team.sheet.size * 10)
     path = drive_path(robots, heading, obj, reform, drive)
     vmax, amax, wmax, vref = limits
     times = time_path(path.robots, path.heading, path.reform, max_speed=vmax,
-                      max_accel=amax, max_yaw_rate=wmax, reform_speed=vref)
+                      max_accel=amax, max_yaw_rate=wmax, reform_speed=vref,
+                      max_yaw_accel=max_yaw_accel)
     poses = np.concatenate([path.robots, path.heading[..., None]], axis=2)
     check = _verify_motion(sc, path.robots, path.object, result.sheet_margin)
-    speed, accel, yaw = measured_limits(times, path.robots, path.heading)
+    speed, accel, yaw, yaw_acc = measured_limits(times, path.robots, path.heading)
     ok = check.success
     msg = (f"{drive} trajectories: {times[-1]:.2f} s ({times[-1] / result.duration:.2f}x "
            f"the rigid plan's {result.duration:.2f} s), {path.turns} turn(s) in place; "
            f"peak speed {speed:.3g} m/s, acceleration {accel:.3g} m/s^2, yaw rate "
-           f"{yaw:.3g} rad/s; re-verified at {len(times)} samples" if ok else
+           f"{yaw:.3g} rad/s, yaw acceleration {yaw_acc:.3g} rad/s^2; re-verified at {len(times)} samples" if ok else
            f"executed motion failed re-verification: {check.message}")
     return RobotTrajectories(ok, "ok" if ok else "unverified", msg, times, poses,
                              check.object, drive, float(times[-1]), result.duration,
-                             path.turns, speed, accel, yaw, limits, check)
+                             path.turns, speed, accel, yaw, limits, check, yaw_acc,
+                             max_yaw_accel)
 
 
 def _distinct(result: PlanResult) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -21,11 +21,11 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from ...errors import TautError
-from ...sheet import Equilibrium, FKSolver
-from .. import _tol
+from ...sheet import Equilibrium, FKSolver, object_covariance
+from .. import _options, _tol
 from ..checks.robustness import _noise
 
-__all__ = ["tolerates", "convex_hull", "hull_inset"]
+__all__ = ["tolerates", "linear_rejects", "convex_hull", "hull_inset"]
 
 #: Perturbations drawn per check: a formation that loses its state under one error in
 #: twenty passes 12 draws half the time, 100 draws 0.6 % of it.
@@ -52,12 +52,33 @@ def hull_inset(P: np.ndarray, q: np.ndarray) -> float:
     return float(np.min((E[:, 0] * Q[:, 1] - E[:, 1] * Q[:, 0]) / np.linalg.norm(E, axis=1)))
 
 
+def linear_rejects(state: Equilibrium, z_min: float, max_shift: float, sigmas: float,
+                   accuracy: float = _tol.POSITION_ACCURACY) -> bool:
+    """The linearised screen (:class:`~taut.plan._options.LinearScreen`): does the
+    first-order prediction already fail :func:`tolerates`? Robot errors uniform in a disc
+    of radius ``accuracy`` (m) have variance ``accuracy**2 / 4`` per axis; through the
+    state's ``jacobian`` (:func:`taut.sheet.object_covariance`) the object height has the
+    predicted standard deviation ``s_z`` and the object shift the root mean square
+    ``s = sqrt(trace)``. Rejects when ``height - z_min < sigmas * s_z`` or
+    ``max_shift < sigmas * s`` (with ``LIBRARY_DRAWS`` draws the sampling sees a
+    deviation beyond one standard deviation all but surely). A state whose jacobian is not
+    finite (a singular taut set) is not screened."""
+    cov = object_covariance(state, accuracy ** 2 / 4.0)
+    if not np.all(np.isfinite(cov)):
+        return False
+    s_z, s = np.sqrt(max(cov[2, 2], 0.0)), np.sqrt(max(np.trace(cov), 0.0))
+    return bool(state.height - z_min < sigmas * s_z or max_shift < sigmas * s)
+
+
 def tolerates(solver: FKSolver, robots: np.ndarray, state: Equilibrium, z_min: float,
               max_shift: float = _tol.SQUEEZE_MAX_SHIFT, draws: int = LIBRARY_DRAWS) -> bool:
     """Does the rest state ``state`` of ``robots`` (N, 2, m) survive the perturbations
     (module docstring)? ``z_min``: least object height, m; ``max_shift``: farthest the
     object may move, m (the library's all-taut formations are held to inf: only a lost
     state or an object on the ground rejects them); ``draws``: perturbations tried."""
+    screen = _options.LINEAR_SCREEN
+    if screen.enabled and linear_rejects(state, z_min, max_shift, screen.sigmas):
+        return False
     rng = np.random.default_rng(SEED)
     n = robots.shape[0]
     for _ in range(draws):
