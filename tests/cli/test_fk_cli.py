@@ -28,7 +28,8 @@ def test_json_schema(capsys, examples_dir):
     code, out, _ = run(capsys, "fk", examples_dir / "sheet" / "example1.yaml", "--json",
                        "--method", "exhaustive", "--mass", "2")
     doc = json.loads(out)
-    assert set(doc) == {"method", "equilibria", "funnel"}
+    assert set(doc) == {"method", "equilibria", "funnel", "units"}
+    assert doc["units"]["equilibria.tensions"] == "N" and doc["units"]["equilibria.object"] == "mm"
     assert doc["funnel"] == {"combinations": 5, "form_closure": 5, "cqp_feasible": 3,
                              "height_feasible": 3, "force_closure": 3}
     e = doc["equilibria"][0]

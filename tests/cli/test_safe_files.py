@@ -133,8 +133,8 @@ def test_two_outputs_of_one_command_cannot_share_a_file(scenario_json, capsys, s
     replace the first: refused before planning, naming the option and the other one."""
     t0 = time.perf_counter()
     assert main(["plan", "sc.json", "--out", "plan.json", "--trajectories", spell,
-                 "--max-speed-mps", "0.2", "--max-accel-mps2", "0.5",
-                 "--max-yaw-rate-radps", "1"]) == 2
+                 "--max-speed", "0.2", "--max-accel", "0.5",
+                 "--max-yaw-rate", "1"]) == 2
     assert time.perf_counter() - t0 < 5
     err = capsys.readouterr().err
     assert err == (f"taut: error: --trajectories: {str(Path(spell))!r} is also the file of --out; "
@@ -143,8 +143,8 @@ def test_two_outputs_of_one_command_cannot_share_a_file(scenario_json, capsys, s
 
 
 def test_a_bad_trajectories_file_is_named_once(scenario_json, capsys):
-    assert main(["plan", "sc.json", "--trajectories", "t.txt", "--max-speed-mps", "0.2",
-                 "--max-accel-mps2", "0.5", "--max-yaw-rate-radps", "1"]) == 2
+    assert main(["plan", "sc.json", "--trajectories", "t.txt", "--max-speed", "0.2",
+                 "--max-accel", "0.5", "--max-yaw-rate", "1"]) == 2
     assert capsys.readouterr().err.startswith("taut: error: --trajectories: unsupported "
                                               "extension '.txt'")
 

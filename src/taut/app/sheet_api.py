@@ -132,7 +132,7 @@ class SheetAPI:
         start = field(body, "start", list, default=None)
         res = simulate(team, numbers(formations, "formations", 3),
                        start=None if start is None else numbers(start, "start", 1))
-        return {"simulation": simulation_to_dict(res, np.arange(len(res), dtype=float))}
+        return {"simulation": simulation_to_dict(res, None)}
 
     def yaml(self, body: dict[str, Any]) -> dict[str, Any]:
         """The scenario (with the current formation and mass) as a YAML file ``taut fk``

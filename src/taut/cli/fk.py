@@ -109,7 +109,7 @@ def register(app: typer.Typer) -> None:
         with working(f"fk ({method.value})"):
             result = forward_kinematics(team, sc.formation, method=method.value)
         if as_json:
-            doc = fk_result_to_dict(result)
+            doc = fk_result_to_dict(result, sc.units)
             if not result.equilibria:
                 doc["message"] = result.message
             typer.echo(to_json(doc))

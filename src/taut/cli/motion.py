@@ -95,7 +95,7 @@ def register(app: typer.Typer) -> None:
             typer.echo(f"taut: {r.status}: {r.message}", err=True)
             raise typer.Exit(1)
         if as_json:
-            typer.echo(to_json(ik_to_dict(r)))
+            typer.echo(to_json(ik_to_dict(r, sc.units)))
         else:
             typer.echo(_ik_table(r, sc.units))
 
@@ -132,7 +132,7 @@ def register(app: typer.Typer) -> None:
         with working("simulate"):
             r = simulate(team, traj.formations)
         if as_json:
-            typer.echo(to_json(simulation_to_dict(r, traj.time), indent=None))
+            typer.echo(to_json(simulation_to_dict(r, traj.time, sc.units), indent=None))
         else:
             typer.echo(_sim_table(r, traj.time, sc.units))
         if plot is not None:

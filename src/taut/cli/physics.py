@@ -95,7 +95,7 @@ def register(app: typer.Typer) -> None:
         else:
             check = replay_equilibria(sc.team, sc.formation, mesh=div, ball=sc.object_radius)
         if as_json:
-            typer.echo(to_json(equilibria_check_to_dict(check)))
+            typer.echo(to_json(equilibria_check_to_dict(check, sc.units)))
         else:
             typer.echo(format_check(check, name=sc.name, units=sc.units))
         if plot is not None:

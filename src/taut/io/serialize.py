@@ -4,7 +4,8 @@ built here, so the commands only call an analysis and one of these functions.
 Conventions: indices are 0-based; lengths in the model's unit (m for cable robots, the
 scenario's unit for sheets); forces in N; a number that is not finite becomes ``null``
 (JSON has no ``Infinity``/``NaN``), and :func:`to_json` refuses anything else non-finite,
-so the output is always valid JSON.
+so the output is always valid JSON. Every document says the unit of each of its numbers:
+a unit suffix on the key, its ``"units"`` object, or a unitless key (:mod:`taut.io._json_units`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ._json_units import units_of
 
 if TYPE_CHECKING:                                  # imported lazily: keep `taut --help` fast
     from ..cdpr.deployment.deploy import DeploymentResult
@@ -111,17 +114,20 @@ def equilibrium_to_dict(e: Equilibrium) -> dict[str, Any]:
     }
 
 
-def fk_result_to_dict(result: FKResult) -> dict[str, Any]:
-    """``{"equilibria": [...], "funnel": {...} | null, "method": ...}``."""
+def fk_result_to_dict(result: FKResult, length_unit: str | None = None) -> dict[str, Any]:
+    """``{"equilibria": [...], "funnel": {...} | null, "method": ..., "units": {...}}``
+    (``length_unit``: the scenario's ``units:``, for the ``units`` object)."""
     return {
         "method": result.method,
         "equilibria": [equilibrium_to_dict(e) for e in result.equilibria],
         "funnel": None if result.funnel is None else asdict(result.funnel),
+        "units": units_of("fk", length_unit),
     }
 
 
-def ik_to_dict(r: IKResult) -> dict[str, Any]:
-    """JSON form of an IK result (robots in order, 0-based lists)."""
+def ik_to_dict(r: IKResult, length_unit: str | None = None) -> dict[str, Any]:
+    """JSON form of an IK result (robots in order, 0-based lists; ``length_unit`` as in
+    :func:`fk_result_to_dict`)."""
     return {
         "formation": [_floats(p) for p in r.formation],
         "object": _floats(r.object),
@@ -134,6 +140,7 @@ def ik_to_dict(r: IKResult) -> dict[str, Any]:
         "spacing": float(r.spacing),
         "construction": r.construction,
         "unmet": list(r.unmet),
+        "units": units_of("ik", length_unit),
     }
 
 
@@ -141,8 +148,13 @@ def _rows(a: np.ndarray) -> list[list[float | None]]:
     return json_ready(np.asarray(a, float))
 
 
-def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
-    """JSON form of a simulation (NaN -> null; taut sets 0-based)."""
+def simulation_to_dict(r: SimulationResult, time: np.ndarray | None,
+                       length_unit: str | None = None) -> dict[str, Any]:
+    """JSON form of a simulation (NaN -> null; taut sets 0-based; ``time`` in s, or None:
+    the step index, said so in ``units``; ``length_unit`` as in :func:`fk_result_to_dict`)."""
+    units = units_of("simulation", length_unit)
+    if time is None:
+        time, units["time"] = np.arange(len(r), dtype=float), "step index (no time stamps)"
     return {
         "time": _floats(time),
         "object": _rows(r.object),
@@ -156,6 +168,7 @@ def simulation_to_dict(r: SimulationResult, time: np.ndarray) -> dict[str, Any]:
             "object_after": _floats(e.object_after),
             "drop": finite_or_none(e.drop),
         } for e in r.events],
+        "units": units,
     }
 
 
@@ -181,6 +194,7 @@ def plan_to_dict(r: PlanResult) -> dict[str, Any]:
         "sheet_margin": finite_or_none(r.sheet_margin),
         "formations": [f.kind for f in r.formations],
         "margins": _plan_margins(r),
+        "units": units_of("plan"),
     }
 
 
@@ -207,7 +221,8 @@ def robustness_to_dict(rob: Robustness) -> dict[str, Any]:
             "unsafe_probability": rob.unsafe_probability,
             "worst_extension": finite_or_none(rob.worst_extension),
             "worst_height_margin": finite_or_none(rob.worst_height_margin),
-            "worst_clearance": finite_or_none(rob.worst_clearance)}
+            "worst_clearance": finite_or_none(rob.worst_clearance),
+            "units": units_of("robustness")}
 
 
 # --- cable-driven parallel robots -----------------------------------------------------------
@@ -226,6 +241,7 @@ def tensions_to_dict(robot: CableRobot, pose: np.ndarray, res: TensionResult) ->
         "tensions": {n: finite_or_none(v) for n, v in zip(names, res.tensions)},
         "tipping_moments": None if not np.all(np.isfinite(M)) else [float(x) for x in M],
         "tipping_edge_base": [robot.bases[k].name for k in robot.edge_base],
+        "units": units_of("tensions"),
     }
 
 
@@ -236,7 +252,8 @@ def wrench_set_to_dict(robot: CableRobot, pose: np.ndarray,
     ``modes`` maps ``"tension_limits_only"`` / ``"with_tipping"`` to the analyses' outputs
     ``{"capacities": AxisCapacities, "halfspaces": (H, h), "margin": float,
     "gravity_feasible": bool}``."""
-    out: dict[str, Any] = {"model": robot.name, "pose": _floats(pose), "dof": robot.dof}
+    out: dict[str, Any] = {"model": robot.name, "pose": _floats(pose), "dof": robot.dof,
+                           "units": units_of("wrench_set")}
     for key, m in modes.items():
         cap = m["capacities"]
         H, h = m["halfspaces"]
@@ -267,7 +284,8 @@ def workspace_to_dict(robot: CableRobot, region: np.ndarray, ws: WorkspaceResult
         "coverage_inside_exits": ws.coverage_inside,
         "coverage_closure": ws.coverage_closure,
         "closure": None if ws.closure is None else ws.closure.astype(int).tolist(),
-        "binding": None if ws.binding is None else [str(b) for b in ws.binding]}
+        "binding": None if ws.binding is None else [str(b) for b in ws.binding],
+        "units": units_of("workspace")}
 
 
 def twist_set_to_dict(robot: CableRobot, pose: np.ndarray, mode: str,
@@ -284,6 +302,7 @@ def twist_set_to_dict(robot: CableRobot, pose: np.ndarray, mode: str,
         out["bases_fixed"] = {"positive": [finite_or_none(v, 4) for v in fixed.positive],
                               "negative": [finite_or_none(v, 4) for v in fixed.negative]}
     out["facets"] = int(facets)
+    out["units"] = units_of("twist_set")
     return out
 
 
@@ -304,15 +323,16 @@ def deployment_to_dict(robot: CableRobot, res: DeploymentResult) -> dict[str, An
         "lift_bound": None if lb is None else {
             "height": r4(lb.height), "bound": r4(lb.bound), "required": r4(lb.required),
             "weight": r4(lb.weight), "refutes": lb.refutes,
-            "per_cable": {c.name: r4(v) for c, v in zip(robot.cables, lb.per_cable)}}}
+            "per_cable": {c.name: r4(v) for c, v in zip(robot.cables, lb.per_cable)}},
+        "units": units_of("deployment")}
 
 
-def equilibria_check_to_dict(check: Any) -> dict[str, Any]:
+def equilibria_check_to_dict(check: Any, length_unit: str | None = None) -> dict[str, Any]:
     """JSON-ready form of an :class:`~taut.physics.EquilibriaCheck` (0-based taut sets,
     lengths in scenario units, ``time_s`` in s, ``sliding`` and ``hold_tolerance`` as
     fractions of the object's weight; per state ``kind`` is taut's verdict and
     ``status``/``message`` the simulation's outcome, with ``settled``, ``difference`` and
-    ``moved`` null when it failed)."""
+    ``moved`` null when it failed; ``length_unit`` as in :func:`fk_result_to_dict`)."""
     def f(a: np.ndarray) -> list[float]:
         return [float(x) for x in np.asarray(a).ravel()]
 
@@ -330,6 +350,7 @@ def equilibria_check_to_dict(check: Any) -> dict[str, Any]:
                     "basin": float(s.basin),
                     "moved": float(s.moved), "time_s": float(s.time)}
                    for s in check.states],
+        "units": units_of("physics", length_unit),
     }
 
 
@@ -357,6 +378,7 @@ def control_result_to_dict(r: "ControlResult") -> dict[str, Any]:
         "cable_names": list(r.cable_names), "edge_names": list(r.edge_names),
         "slack_time": r.slack_time, "worst_over_tension": r.worst_over_tension,
         "worst_under_tension": r.worst_under_tension,
+        "units": units_of("control"),
     }
 
 
@@ -368,6 +390,7 @@ def monte_carlo_to_dict(r: "MonteCarloResult") -> dict[str, Any]:
         out[name] = _rounded_list(getattr(r, name))
     out["success"] = [bool(x) for x in r.success]
     out["status"] = [str(x) for x in r.status]
+    out["units"] = units_of("monte_carlo")
     return out
 
 
@@ -391,5 +414,13 @@ def mission_to_dict(r: Any) -> dict[str, Any]:
                     "min_tension_margin_N": finite_or_none(p.min_tension_margin, 6),
                     "min_tipping_margin_Nm": finite_or_none(p.min_tipping_margin, 6),
                     "min_sliding_margin_N": finite_or_none(p.min_sliding_margin, 6),
+                    "min_cable_clearance_m": finite_or_none(p.min_cable_clearance, 6),
+                    "min_footprint_clearance_m": finite_or_none(p.min_footprint_clearance,
+                                                                6),
                     "success": bool(p.success), "message": p.message} for p in r.phases],
+        "repositions": [{"task": x.task, "offset_m": finite_or_none(x.offset, 6),
+                         "motion_time_change_s": finite_or_none(x.saved, 6),
+                         "move_time_s": finite_or_none(x.move_time, 6),
+                         "best_saving_s": finite_or_none(x.best_saving, 6)}
+                        for x in r.repositions],
     }
