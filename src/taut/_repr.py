@@ -68,7 +68,9 @@ def short_value(value: Any) -> str:
 
 
 def _fields(obj: Any) -> list[str]:
-    names = [f.name for f in dataclasses.fields(obj) if f.repr]
+    # A class whose fields are computed on first access (not a dataclass) names them.
+    names = list(getattr(obj, "REPR_FIELDS", ())) or [f.name for f in dataclasses.fields(obj)
+                                                       if f.repr]
     return [n for n in FIRST if n in names] + [n for n in names if n not in FIRST]
 
 
@@ -91,7 +93,8 @@ def compact_repr(obj: Any) -> str:
 
 
 class CompactRepr:
-    """Mixin giving a dataclass (declared with ``repr=False``) :func:`compact_repr`."""
+    """Mixin giving a dataclass (declared with ``repr=False``) :func:`compact_repr`; a
+    class that is not a dataclass lists its fields in a ``REPR_FIELDS`` tuple."""
 
     __slots__ = ()
 

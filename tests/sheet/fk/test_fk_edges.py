@@ -245,3 +245,58 @@ def test_no_unreachable_error_class():
     exception: the class the README once named does not exist."""
     import taut.errors as errors
     assert not hasattr(errors, "UnreachableTargetError")
+
+
+def _trough(c: float):
+    """The squeezed square of the flat-minimum test (not strict, no similar copy)."""
+    return np.array([[1, 1 - c], [-1, 1 - c], [-1, -1 + c], [1, -1 + c]], float)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_batch_runs_the_direct_minimisation_only_for_what_is_read(backend, monkeypatch):
+    """The batch, like the single result, minimises the height directly (formations
+    without a stable state) only when a field that depends on it is read; the values do
+    not depend on the order the fields are read in, and ``result(b)`` reuses the batch's."""
+    import taut.sheet.fk.results as fr
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return fr.lowest_by_descent.__wrapped__(*args, **kwargs)
+    counted.__wrapped__ = fr.lowest_by_descent
+    monkeypatch.setattr(fr, "lowest_by_descent", counted)
+    V = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]], float)
+    solver = FKSolver(SheetTeam(Sheet(V), 3.0, mass=2.0), backend=backend)
+    forms = np.stack([_trough(0.2), 0.8 * V, _trough(0.5), 3.0 * V])
+    lazy, eager = solver.solve_batch(forms), solver.solve_batch(forms)
+    assert len(lazy) == 4 and lazy.feasible.tolist() == [True, True, True, False]
+    assert lazy.success.tolist() == [False, True, False, False]
+    assert lazy.message.startswith("1 of 4 formation(s) hold") and not calls
+    assert lazy.result(1).success and not lazy.result(0).success and not calls
+    kind = eager.kind                                      # every missing row, once
+    assert len(calls) == 2 and eager.result(0).direct and len(calls) == 2
+    assert eager.status.tolist() == ["not_strict", "ok", "not_strict", "infeasible"]
+    assert lazy.status.tolist() == eager.status.tolist() and len(calls) == 4
+    for name in ("count", "valid", "taut", "object", "contact", "weights", "tensions"):
+        np.testing.assert_array_equal(getattr(lazy, name), getattr(eager, name), name)
+    np.testing.assert_array_equal(lazy.kind, kind)
+    assert len(calls) == 4 and "status=<(4,) str>" in repr(lazy)
+    low = lazy.result(2).lowest                            # the batch's state, not re-solved
+    assert low.kind == "saddle" and len(calls) == 4
+    np.testing.assert_array_equal(low.object, lazy.object[2, 0])
+    np.testing.assert_array_equal(low.tensions, lazy.tensions[2, 0, :4])
+    with pytest.raises(AttributeError, match="frozen"):
+        lazy.count = None
+
+
+def test_batch_next_to_a_copy_answers_success_from_the_direct_minimisation():
+    """Next to a similar copy the direct minimisation can supply a stable state (the
+    16-gon written to 6 decimals), so ``success`` runs it there, as the single call."""
+    team, R = digits_team(16)
+    b = ts.forward_kinematics_batch(team, np.stack([R, R]))
+    one = ts.forward_kinematics(team, R)
+    assert b.success.tolist() == [True, True] and b.status.tolist() == ["ok", "ok"]
+    assert b.result(1).direct and one.direct
+    assert int(b.count[0]) == len(one.equilibria)
+    np.testing.assert_allclose(b.object[0, :b.count[0]],
+                               [e.object for e in one.equilibria], atol=1e-12)

@@ -86,7 +86,8 @@ def check_team(seed: int) -> str | None:
         results["fast-numpy"] = FKSolver(team, backend="numpy").solve(R)
         if sheet.n <= 12:
             results["exhaustive"] = ts.forward_kinematics(team, R, method="exhaustive")
-        results["batch"] = ts.forward_kinematics_batch(team, R[None]).result(0)
+        batch = ts.forward_kinematics_batch(team, R[None])
+        results["batch"] = batch.result(0)
     except InfeasibleFormationError:
         return None
     except Exception as exc:                     # a crash is a failure too
@@ -121,6 +122,23 @@ def check_team(seed: int) -> str | None:
         elif len(pts) != len(ref) or (len(pts) and np.abs(pts - ref).max() > 2 * tol):
             return (f"seed {seed} ({label}): {name} stable {pts.tolist()} vs fast "
                     f"{ref.tolist()}")
+    why = _batch_arrays_failure(batch, results["batch"], tol)
+    return None if why is None else f"seed {seed} ({label}): {why}"
+
+
+def _batch_arrays_failure(batch: ts.BatchFKResult, one: ts.FKResult, tol: float
+                          ) -> str | None:
+    """Whether the batch's own arrays (its lazy direct minimisation, not ``result(0)``'s)
+    report the states of ``one`` (None when they do); ``success`` read first."""
+    if bool(batch.success[0]) != one.success or batch.status[0] != one.status:
+        return f"batch success/status {batch.success[0]}/{batch.status[0]} vs {one.status}"
+    k = int(batch.count[0])
+    if k != len(one.equilibria):
+        return f"batch has {k} states, its result(0) {len(one.equilibria)}"
+    got = np.array(sorted(batch.object[0, :k][batch.kind[0, :k] == 0].tolist()))
+    want = np.array(sorted(e.object.tolist() for e in one.stable))
+    if len(got) != len(want) or (len(got) and np.abs(got - want).max() > tol):
+        return f"batch stable {got.tolist()} vs its result(0) {want.tolist()}"
     return None
 
 
@@ -177,6 +195,10 @@ def test_stable_read_first_agrees_with_the_built_states(seed):
         built.lowest, built.message                # the states, with the descent
         assert len(fresh.stable) == len(built.stable), name
         assert solve().success == built.success, name
+    # The batch's own arrays (its direct minimisation, not result(0)'s), read first or last.
+    fresh_b, built_b = (ts.forward_kinematics_batch(team, R[None]) for _ in range(2))
+    assert int(built_b.stable.sum()) == len(built.stable)
+    assert fresh_b.success[0] == built_b.success[0] == built.success
 
 
 def test_seed_41517_says_why_it_has_no_rest_state():

@@ -10,14 +10,14 @@ is reported once (:mod:`taut.sheet.fk._merge`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Literal
+from typing import Any, Callable, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._units import GRAVITY
 from ..._validate import as_array
-from ...errors import InvalidInputError
+from ...errors import InfeasibleFormationError, InvalidInputError
 from .._lifted import KIND_NAMES, KIND_NOT_EQUILIBRIUM, KIND_STABLE
 from .._tol import MERGE_RTOL
 from ..model import Sheet, check_formation
@@ -345,14 +345,33 @@ class FKResult:
         """The states: the enumeration's (from the kernel ``rows`` when given) and, when
         none is stable, the direct minimisation's lowest (:func:`_with_lowest`)."""
         eqs = self._enum if rows is None or len(rows) == 0 else self._row_states(rows)
-        eqs, direct, why = _with_lowest(eqs, self.sheet, self.formation, self.hold_height,
-                                        self.mass)
+        return self._attach(*_with_lowest(eqs, self.sheet, self.formation,
+                                          self.hold_height, self.mass))
+
+    def _attach(self, eqs: tuple[Equilibrium, ...], direct: bool, why: str | None
+                ) -> tuple[Equilibrium, ...]:
+        """``eqs`` (an answer of :func:`_with_lowest`) as this result's states: records
+        ``direct`` and ``why`` and gives each state the formation its lazy sensitivities
+        need."""
         self.__dict__.update(_direct=direct, _why=why)
         ctx = (self.sheet.vertices, self.formation, self.hold_height, self.mass,
-               self.sheet.size)                  # for the states' lazy sensitivities
+               self.sheet.size)
         for e in eqs:
             e.__dict__["_ctx"] = ctx
         return eqs
+
+    @classmethod
+    def _settled(cls, found: tuple[tuple[Equilibrium, ...], bool, str | None],
+                 method: str, sheet: Sheet, formation: np.ndarray, hold_height: float,
+                 mass: float | None) -> "FKResult":
+        """A result whose states are ``found``, an answer of :func:`_with_lowest` already
+        worked out (by a :class:`BatchFKResult`): nothing is solved again."""
+        self = object.__new__(cls)
+        self.__dict__.update(_rows=None, _enum=found[0], _message=None, funnel=None,
+                             method=method, sheet=sheet, formation=formation,
+                             hold_height=hold_height, mass=mass)
+        self.__dict__["_equilibria"] = self._attach(*found)
+        return self
 
     def _row_states(self, rows: np.ndarray) -> tuple[Equilibrium, ...]:
         """The enumeration's states from kernel rows, states at one point merged."""
@@ -522,9 +541,20 @@ class FKResult:
                 f"equilibria={len(self)}, stable={len(self.stable)})")
 
 
-@dataclass(frozen=True, eq=False, repr=False)
+#: The padded per-solution arrays of a batch, in this order: count (B,), valid (B, K),
+#: taut (B, K, N), object (B, K, 3), contact (B, K, 2), weights (B, K, N), tensions
+#: (B, K, N) or None, kind (B, K).
+_Padded = tuple
+
+
+def _padded_field(i: int) -> Any:
+    """Property ``i`` of the padded arrays (:data:`_Padded`) of a :class:`BatchFKResult`,
+    built on first read (``BatchFKResult._final``)."""
+    return property(lambda self: self._final()[i])
+
+
 class BatchFKResult(CompactRepr):
-    """Forward kinematics of ``B`` formations of one sheet, as padded arrays.
+    """Forward kinematics of ``B`` formations of one sheet, as padded arrays. Frozen.
 
     Row ``b`` holds ``count[b]`` solutions in slots ``0..count[b]-1`` (same order as
     :class:`FKResult`); later slots are padding (``valid`` False, NaN positions). A
@@ -532,6 +562,15 @@ class BatchFKResult(CompactRepr):
     has no solutions, ``feasible`` False and ``status`` ``"infeasible"``; the other rows
     are answered as usual. The states' sensitivities (``jacobian``, ``taut_margin``, ...:
     docs/sheet_sensitivity.md) are read per state, ``result(b).equilibria[k].jacobian``.
+
+    As in :class:`FKResult`, the direct minimisation of the height (formations whose
+    enumeration found no stable state, docs/sheet_fk_solver.md "The lowest state exists")
+    runs only when a field that depends on it is first read: the per-solution arrays and
+    ``status`` run it for every such formation, ``success`` and ``message`` only for
+    those next to a similar copy of the sheet, ``result(b)`` for formation ``b`` alone
+    (and only when its states are read); ``feasible`` and the inputs never. The numbers
+    are fixed when the result is made: reading the fields in any order gives the same
+    values.
 
     Attributes
     ----------
@@ -563,23 +602,118 @@ class BatchFKResult(CompactRepr):
         The inputs (formations as a (B, N, 2) array) and the FK method used.
     """
 
-    count: np.ndarray
-    valid: np.ndarray
-    taut: np.ndarray
-    object: np.ndarray
-    contact: np.ndarray
-    weights: np.ndarray
-    tensions: np.ndarray | None
-    kind: np.ndarray
+    #: Fields in the order :class:`~taut._repr.CompactRepr` prints them.
+    REPR_FIELDS = ("count", "valid", "taut", "object", "contact", "weights", "tensions",
+                   "kind", "feasible", "success", "status", "message", "sheet",
+                   "formations", "hold_height", "mass", "method")
+
+    _enum: _Padded
+    _padded: _Padded | None
+    _missing: np.ndarray
+    _found: dict[int, tuple[tuple[Equilibrium, ...], bool, str | None]]
+    _success: np.ndarray | None
+    _status: np.ndarray | None
+    _message: str | None
     feasible: np.ndarray
-    success: np.ndarray
-    status: np.ndarray
-    message: str
     sheet: Sheet
     formations: np.ndarray
     hold_height: float
     mass: float | None
     method: str
+
+    def __init__(self, padded: _Padded, missing: np.ndarray, feasible: np.ndarray,
+                 sheet: Sheet, formations: np.ndarray, hold_height: float,
+                 mass: float | None, method: str) -> None:
+        """``padded``: the enumeration's states (:data:`_Padded`, coinciding ones already
+        merged); ``missing``: the feasible formations among them without a stable state
+        (the direct minimisation's candidates)."""
+        self.__dict__.update(_enum=padded, _padded=padded if not len(missing) else None,
+                             _missing=missing, _found={}, _success=None, _status=None,
+                             _message=None, feasible=feasible, sheet=sheet,
+                             formations=formations, hold_height=hold_height, mass=mass,
+                             method=method)
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"BatchFKResult is frozen: cannot assign to {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"BatchFKResult is frozen: cannot delete {name!r}")
+
+    # -- the padded arrays (the direct minimisation's states included) -------------------
+    count = _padded_field(0)
+    valid = _padded_field(1)
+    taut = _padded_field(2)
+    object = _padded_field(3)
+    contact = _padded_field(4)
+    weights = _padded_field(5)
+    tensions = _padded_field(6)
+    kind = _padded_field(7)
+
+    def _lowest_of(self, b: int) -> tuple[tuple[Equilibrium, ...], bool, str | None]:
+        """:func:`_with_lowest` of formation ``b`` (one of ``_missing``), worked out once."""
+        found = self._found.get(b)
+        if found is None:
+            found = _with_lowest(_row_states(self.sheet, self._enum, b), self.sheet,
+                                 self.formations[b], self.hold_height, self.mass)
+            self._found[b] = found
+        return found
+
+    def _final(self) -> _Padded:
+        """The padded arrays with the direct minimisation's lowest state in every
+        formation of ``_missing`` it supplied one for (one more slot where needed); built
+        on first call into fresh arrays, published at once."""
+        padded = self._padded
+        if padded is not None:
+            return padded
+        supplied = {}
+        for b in self._missing.tolist():
+            eqs, direct, _ = self._lowest_of(b)
+            if direct:
+                supplied[b] = eqs
+        enum = self._enum
+        K = max([enum[1].shape[1]] + [len(e) for e in supplied.values()])
+        padded = (enum[0].copy(),) + tuple(
+            None if a is None else _widen(a, K, fill)
+            for a, fill in zip(enum[1:], (False, False, np.nan, np.nan, 0.0, 0.0, -1)))
+        for b, eqs in supplied.items():
+            _write_row(b, eqs, *padded)
+        self.__dict__["_padded"] = padded
+        return padded
+
+    # -- outcome -------------------------------------------------------------------------
+    @property
+    def success(self) -> np.ndarray:
+        s = self._success
+        if s is None:
+            s = self.feasible & np.any(self._enum[7] == KIND_STABLE, axis=1)
+            size, V = self.sheet.size, self.sheet.vertices
+            for b in self._missing.tolist():
+                # Only next to a similar copy can the descent supply a stable state
+                # (_lowest.may_find_stable; as FKResult.success).
+                if may_find_stable(V, self.formations[b], size):
+                    s[b] = any(e.stable for e in self._lowest_of(b)[0])
+            self.__dict__["_success"] = s
+        return s
+
+    @property
+    def status(self) -> np.ndarray:
+        st = self._status
+        if st is None:
+            success = self.success
+            direct = np.zeros(len(success), dtype=bool)
+            for b in self._missing.tolist():
+                direct[b] = self._lowest_of(b)[1]
+            st = np.where(success, "ok", np.where(direct, "not_strict", "infeasible"))
+            self.__dict__["_status"] = st
+        return st
+
+    @property
+    def message(self) -> str:
+        msg = self._message
+        if msg is None:
+            msg = _batch_message(self.sheet, self.formations, self.success, self.feasible)
+            self.__dict__["_message"] = msg
+        return msg
 
     @property
     def stable(self) -> np.ndarray:
@@ -587,10 +721,11 @@ class BatchFKResult(CompactRepr):
         return self.kind == KIND_STABLE
 
     def __len__(self) -> int:
-        return int(self.count.shape[0])
+        return int(self.formations.shape[0])
 
     def result(self, b: int) -> FKResult:
-        """The solutions of formation ``b`` as an :class:`FKResult`.
+        """The solutions of formation ``b`` as an :class:`FKResult` (its direct
+        minimisation, when it needs one, shared with this batch's).
 
         Raises
         ------
@@ -598,22 +733,80 @@ class BatchFKResult(CompactRepr):
             Formation ``b`` is not feasible (as :func:`~taut.sheet.forward_kinematics`
             raises for it).
         """
+        b = range(len(self))[b]
         if not self.feasible[b]:
             check_formation(self.sheet, self.formations[b])        # raises with the pair
-        eqs = []
-        for k in range(int(self.count[b])):
-            idx = np.flatnonzero(self.taut[b, k])
-            kind = int(self.kind[b, k])
-            eqs.append(Equilibrium(
-                taut=tuple(int(i) for i in idx),
-                object=self.object[b, k].copy(),
-                contact=self.contact[b, k].copy(),
-                weights=self.weights[b, k, idx].copy(),
-                tensions=(None if self.tensions is None or kind == KIND_NOT_EQUILIBRIUM
-                          else self.tensions[b, k, idx].copy()),
-                cable_lengths=np.linalg.norm(self.sheet.vertices[idx] - self.contact[b, k], axis=1),
-                kind=KIND_NAMES[kind],  # type: ignore[arg-type]
-            ))
-        return FKResult(tuple(eqs), None, self.method, self.sheet, self.formations[b].copy(),
-                        self.hold_height, self.mass)
+        formation = self.formations[b].copy()
+        found = self._found.get(b)
+        if found is not None:
+            return FKResult._settled(found, self.method, self.sheet, formation,
+                                     self.hold_height, self.mass)
+        return FKResult(_row_states(self.sheet, self._enum, b), None, self.method,
+                        self.sheet, formation, self.hold_height, self.mass)
 
+
+def _row_states(sheet: Sheet, padded: _Padded, b: int) -> tuple[Equilibrium, ...]:
+    """The states of formation ``b`` in the padded arrays (:data:`_Padded`), in order."""
+    count, _, taut, obj, contact, weights, tensions, kind = padded
+    out = []
+    for k in range(int(count[b])):
+        idx = np.flatnonzero(taut[b, k])
+        code = int(kind[b, k])
+        out.append(_equilibrium(
+            tuple(int(i) for i in idx), obj[b, k].copy(), contact[b, k].copy(),
+            weights[b, k, idx].copy(),
+            (None if tensions is None or code == KIND_NOT_EQUILIBRIUM
+             else tensions[b, k, idx].copy()),
+            np.linalg.norm(sheet.vertices[idx] - contact[b, k], axis=1), KIND_NAMES[code]))
+    return tuple(out)
+
+
+def _write_row(b: int, states: tuple[Equilibrium, ...], count: np.ndarray,
+               valid: np.ndarray, taut: np.ndarray, obj: np.ndarray, contact: np.ndarray,
+               weights: np.ndarray, tensions: np.ndarray | None, kind: np.ndarray) -> None:
+    """Replace formation ``b``'s states in the padded arrays by ``states``, in place."""
+    m = len(states)
+    count[b] = m
+    valid[b] = False
+    valid[b, :m] = True
+    taut[b] = False
+    obj[b] = np.nan
+    contact[b] = np.nan
+    weights[b] = 0.0
+    kind[b] = -1
+    if tensions is not None:
+        tensions[b] = 0.0
+    for j, e in enumerate(states):
+        idx = np.array(e.taut, dtype=np.intp)
+        taut[b, j, idx] = True
+        obj[b, j] = e.object
+        contact[b, j] = e.contact
+        weights[b, j, idx] = e.weights
+        kind[b, j] = KIND_NAMES.index(e.kind)
+        if tensions is not None:
+            tensions[b, j, idx] = np.nan if e.tensions is None else e.tensions
+
+
+def _widen(a: np.ndarray, K: int, fill: float | bool | int) -> np.ndarray:
+    """A fresh copy of the padded array ``a`` (B, K0, ...) with ``K - K0`` more slots of
+    ``fill``."""
+    extra = np.full((a.shape[0], K - a.shape[1]) + a.shape[2:], fill, dtype=a.dtype)
+    return np.concatenate([a, extra], axis=1)
+
+
+def _batch_message(sheet: Sheet, formations: np.ndarray, success: np.ndarray,
+                   feasible: np.ndarray) -> str:
+    """The one-line message of a batch: how many formations hold the object, and why the
+    first the sheet cannot span cannot be spanned."""
+    message = (f"{int(np.count_nonzero(success))} of {len(success)} formation(s) hold the "
+               "object in a stable state")
+    torn = np.flatnonzero(~feasible)
+    if len(torn):
+        b = int(torn[0])
+        try:
+            check_formation(sheet, formations[b])
+            why = "the sheet cannot span it"                   # pragma: no cover
+        except InfeasibleFormationError as exc:
+            why = exc.problem
+        message += f"; {len(torn)} infeasible, the first is formation {b}: {why}"
+    return message
