@@ -33,12 +33,13 @@ demo: $(DEMO_STAMP)
 test: $(STAMP)
 	$(BIN)/taut compile
 	$(BIN)/python -m mypy
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -m "not slow and not browser"
 	$(BIN)/python -m pytest --doctest-modules src/taut -p no:cacheprovider
 
-# Heavy cases (marked `slow`); CI runs them after `make test`. Exit 5 = none collected.
+# Heavy cases (marked `slow`) and the app's browser tests (a Chromium each, seconds per test);
+# CI runs them after `make test`. Exit 5 = none collected.
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -m slow || [ $$? -eq 5 ]
+	$(BIN)/python -m pytest -m "slow or browser" || [ $$? -eq 5 ]
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[test,bench]'

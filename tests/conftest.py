@@ -17,7 +17,32 @@ from hypothesis import HealthCheck, settings
 settings.register_profile("ci", derandomize=True, deadline=None,
                           suppress_health_check=[HealthCheck.too_slow])
 settings.register_profile("dev", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("full", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+# Example counts: a test's own `max_examples` is what CI draws ("ci") and what
+# `pytest --hypothesis-profile=full` draws; a developer's run ("dev", so `make test` on a
+# workstation) draws a quarter of it, at least DEV_MIN_EXAMPLES, to keep the fast suite
+# quick. The draws are random there, so over many runs the full space is still searched.
+EXAMPLE_SHARE = {"dev": 0.25}
+DEV_MIN_EXAMPLES = 10
+
+
+def pytest_collection_modifyitems(items):
+    share = EXAMPLE_SHARE.get(settings.get_current_profile_name(), 1.0)
+    if share == 1.0:
+        return
+    done = set()
+    for item in items:
+        test = getattr(item, "obj", None)
+        test = getattr(test, "__func__", test)        # a method: its function
+        if not getattr(test, "is_hypothesis_test", False) or id(test) in done:
+            continue
+        done.add(id(test))  # parametrized cases share one function: scale it once
+        # hypothesis reads this attribute when the test runs (what @settings sets)
+        own = test._hypothesis_internal_use_settings
+        count = max(min(own.max_examples, DEV_MIN_EXAMPLES), round(own.max_examples * share))
+        test._hypothesis_internal_use_settings = settings(own, max_examples=count)
 
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).parent.parent

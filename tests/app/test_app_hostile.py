@@ -463,6 +463,9 @@ def worker_pids(parent):
     return sorted(found)
 
 
+# Worker-process lifecycle (a server and its worker per test, a heavy request killed,
+# dropped or timed out): seconds each, so in the slow target (CI runs it).
+@pytest.mark.slow
 def test_a_dropped_request_frees_its_worker():
     """With one worker: a heavy simulation whose client hangs up is killed at once (its
     worker process is gone within 3 s, a fresh one replaces it) and the next request is
@@ -490,6 +493,7 @@ def test_a_dropped_request_frees_its_worker():
     assert len(after) == 1 and after != [first]
 
 
+@pytest.mark.slow
 def test_a_request_dropped_while_queued_never_reaches_a_worker():
     """With one worker busy on a simulation: a second request whose client hangs up while
     it waits for the worker leaves the queue (the worker is not killed and restarted for
@@ -514,6 +518,7 @@ def test_a_request_dropped_while_queued_never_reaches_a_worker():
     assert after == [first], "the worker was killed for a request nobody waited for"
 
 
+@pytest.mark.slow
 def test_a_worker_that_dies_is_a_json_500_and_replaced():
     """A worker process killed in the middle of a request (a crash in compiled code, the
     kernel's OOM killer): the request gets a one-line JSON 500, a fresh worker takes its
@@ -578,6 +583,7 @@ def test_worst_requests_stay_near_1_gib(app):
     assert sum(peaks.values()) < 1.1, f"peak resident memory, GiB: {peaks}"
 
 
+@pytest.mark.slow
 def test_a_request_past_its_budget_is_stopped():
     """A 1 MB YAML upload (PyYAML parses it for many seconds) with a 2 s budget: HTTP
     503 after about 2 s, its worker killed and replaced, the next request served."""
@@ -631,6 +637,7 @@ def test_job_flood_is_bounded_and_ids_stay_valid(app):
         assert st == 200 and out["state"] in ("running", "done", "error")
 
 
+@pytest.mark.slow
 def test_a_planning_step_past_its_budget_ends_the_job_not_the_app():
     """A planning step (a worker call inside a job) that overruns the app's time budget
     ends its job with the budget's message; its worker is replaced and the app goes on
@@ -661,6 +668,7 @@ def test_a_planning_step_past_its_budget_ends_the_job_not_the_app():
 
 # --- Ctrl-C ------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_app_during_a_heavy_request():
     proc, port, token = start_app()
     body = json.dumps(heavy_body()).encode()          # a simulation of several seconds

@@ -2,6 +2,7 @@
 point load, and the rim of a rest state's basin (issue 31)."""
 
 import numpy as np
+import pytest
 
 from taut.physics._statics import barrier, least_pull, lowest_point_load, model_pull
 from taut.sheet import forward_kinematics, random_hanging_team
@@ -55,6 +56,7 @@ def test_least_pull_is_invariant_to_rotating_the_plan_and_scales_with_the_load()
         assert abs(r3 - 3 * res) <= 1e-9
 
 
+@pytest.mark.slow  # ~3.4 s of CPU: the slow target (CI runs it)
 def test_lowest_point_load_is_taut_state_and_the_basin_rim_is_above_both_ends():
     # At a state's contact point the lowest point load is taut's object; the path's top
     # is at least as high as either end (so the rim bound is >= the rise to the other).
