@@ -44,7 +44,7 @@ NOT_CALLED: dict[str, str] = {
     **{name: "result container built by an analysis, not by users" for name in
        "NavigationResult NavigationCertificate SitesResult Site UnservedTask".split()},
     **{name: "result container built by an analysis, not by users" for name in
-       "TimedPath MissionResult Phase".split()},
+       "TimedPath MissionResult Phase Reposition".split()},
 }
 
 #: Callables whose valid call runs a search or a simulation (seconds): only their model

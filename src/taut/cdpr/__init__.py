@@ -168,6 +168,7 @@ Mission
    plan_mission -- the whole mission planned and simulated, with its 1 m/s baseline
    MissionResult -- its outcome: phases, total and baseline times, unserved tasks
    Phase -- one phase: kind, task, times, margins
+   Reposition -- one task's choice of active-base offset along the shelf face
    PHASE_KINDS -- the kinds of phase
 """
 
@@ -219,6 +220,7 @@ from .mission.navigation import NavigationCertificate, NavigationResult, plan_na
 from .mission.sites import Site, SitesResult, UnservedTask, choose_sites
 from .mission.timing import TimedPath, time_optimal_path, with_box
 from .mission.mission import PHASE_KINDS, MissionResult, Phase, plan_mission
+from .mission._reposition import Reposition
 
 __all__ = [
     # Model
@@ -258,5 +260,5 @@ __all__ = [
     "Warehouse", "Shelf", "Task", "coupled_footprint", "to_robot_frame", "to_world_frame",
     "plan_navigation", "NavigationResult", "NavigationCertificate", "choose_sites",
     "SitesResult", "Site", "UnservedTask", "time_optimal_path", "TimedPath", "with_box",
-    "plan_mission", "MissionResult", "Phase", "PHASE_KINDS",
+    "plan_mission", "MissionResult", "Phase", "PHASE_KINDS", "Reposition",
 ]

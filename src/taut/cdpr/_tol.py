@@ -272,3 +272,8 @@ NAV_TOL = 1e-9
 #: halves the corner travel of the interval; 12 reach 1/4096 of a 0.1 s sample's travel
 #: (about 12 um at 0.5 m/s), far below any clearance a route is planned with.
 NAV_PROOF_DEPTH = 12
+
+#: Slack of the time-optimal path's rest test (taut.cdpr.mission.timing), m/s^2: the
+#: platform can rest at a grid point when the LP's acceleration bounds straddle zero
+#: within this (HiGHS solves to ~1e-9 feasibility).
+REST_ACCEL_SLACK = 1e-9

@@ -82,12 +82,13 @@ def plan_command(
                                                       "--trajectories, rad/s."),
     max_yaw_accel: Optional[float] = typer.Option(None, "--max-yaw-accel",
                                                   help="Largest robot yaw acceleration of "
-                                                       "--trajectories, rad/s^2 (default "
-                                                       "the library's 2)."),
+                                                       "--trajectories, rad/s^2 (default: "
+                                                       "as in taut.plan.robot_trajectories)."),
     reform_speed: Optional[float] = typer.Option(None, "--reform-speed",
                                                  help="Largest robot speed during "
-                                                      "formation changes, m/s (default "
-                                                      "the library's 0.05: quasi-static)."),
+                                                      "formation changes, m/s (default: "
+                                                      "as in taut.plan.robot_trajectories, "
+                                                      "quasi-static)."),
 ) -> int:
     """Plan the transport of the object from start to goal, crossing low obstacles under
     the sheet where that is faster; exit 0 with a plan, 1 when no plan exists, 2 on bad

@@ -51,6 +51,7 @@ from numpy.typing import ArrayLike
 from scipy.optimize import linprog
 
 from ..._outcome import check_status
+from .._tol import REST_ACCEL_SLACK
 from ..._validate import (MAX_MASS_KG, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded, as_count,
                          require_instance)
 from ...errors import InvalidInputError
@@ -225,7 +226,7 @@ def _grid_bounds(robot: CableRobot, pts: np.ndarray, e: np.ndarray, lim: _Limits
                               method="highs")
                 bounds[k, j] = res.x[-1] if res.status == 0 else np.nan
             room = ACCEL_ROOM if frac > 0 else 0.0
-            if bounds[k, 0] <= 1e-9 - room and bounds[k, 1] >= room - 1e-9:
+            if bounds[k, 0] <= REST_ACCEL_SLACK - room and bounds[k, 1] >= room - REST_ACCEL_SLACK:
                 break
     return vmax, bounds
 
@@ -349,7 +350,7 @@ def _plan(robot: CableRobot, wp: np.ndarray, lim: _Limits, grid: int | None, rat
         N = grid or max(MIN_GRID, int(np.ceil(GRID_PER_M * length)))
         pts = wp[k] + np.linspace(0.0, length, N + 1)[:, None] * e
         vmax, ub = _grid_bounds(robot, pts, e, lim)
-        bad = ~((ub[:, 0] <= 1e-9) & (ub[:, 1] >= -1e-9))
+        bad = ~((ub[:, 0] <= REST_ACCEL_SLACK) & (ub[:, 1] >= -REST_ACCEL_SLACK))
         if bad.any():
             i = int(np.argmax(bad))
             return _failed(f"the platform cannot rest at {np.round(pts[i], 3).tolist()} m "
