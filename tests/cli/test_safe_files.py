@@ -355,3 +355,18 @@ def test_every_figure_is_saved_through_the_atomic_writer():
               for n, line in enumerate(p.read_text().splitlines(), 1)
               if re.search(r"\.savefig\(|\banim\w*\.save\(|PillowWriter", line)]
     assert direct == []
+
+
+@pytest.mark.parametrize("option, name", [("--mcap", "rec.mcap"), ("--rerun", "rec.rrd"),
+                                          ("--trajectories", "tr.json")])
+def test_a_recording_over_its_scenario_is_refused(scenario_json, capsys, option, name):
+    """Every output option goes through the same input check as --out: a recording or
+    trajectory file that is the scenario (here a link to it with the output's extension)
+    is refused before planning, the input intact."""
+    before = scenario_json.read_bytes()
+    os.symlink("sc.json", name)
+    assert main(["plan", "sc.json", option, name]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"taut: error: {option}: ") and "is also an input" in err
+    assert err.count("\n") == 1
+    assert scenario_json.read_bytes() == before

@@ -158,3 +158,19 @@ def test_sweep_plot_draws_every_documented_column(tmp_path, capsys):
                          "--value", value, "--out", str(out), *extra])
             assert code == 0, capsys.readouterr().err
             assert out.stat().st_size > 1000
+
+
+def test_a_chunk_write_stops_when_the_folder_holds_another_sweeps_manifest(fk_spec,
+                                                                           tmp_path):
+    """The manifest is re-read on every chunk write: a folder handed to another sweep
+    (its manifest replaced) stops this one at its next chunk, and nothing is written."""
+    spec = fk_spec(scale=[0.8])
+    cols = {"point": np.arange(2), "value": np.zeros(2)}
+    with Store(tmp_path / "run", spec.digest, resume=False) as store:
+        store.write_chunk(0, cols)
+        (tmp_path / "run" / "manifest.json").write_text(
+            json.dumps({"sweep_digest": "another"}) + "\n")
+        with pytest.raises(SweepError) as err:
+            store.write_chunk(1, cols)
+        assert err.value.field == "out" and "another sweep's manifest" in err.value.problem
+        assert not store.has(1) and store.has(0)
