@@ -370,3 +370,57 @@ def test_a_recording_over_its_scenario_is_refused(scenario_json, capsys, option,
     assert err.startswith(f"taut: error: {option}: ") and "is also an input" in err
     assert err.count("\n") == 1
     assert scenario_json.read_bytes() == before
+
+
+def _pairs_file(path, pairs, json_form):
+    """A sheet scenario whose formation holds ``pairs`` number pairs (wrongly many robots:
+    the command reads the whole file, then refuses the formation)."""
+    rows = ", ".join(f"[{k}.5, {k}.25]" for k in range(pairs))
+    if json_form:
+        text = ('{"hold_height": 1000, "sheet": [[0, 0], [1000, 0], [0, 1000]], '
+                f'"formation": [{rows}]}}')
+    else:
+        text = f"hold_height: 1000\nsheet: [[0, 0], [1000, 0], [0, 1000]]\nformation: [{rows}]\n"
+    path.write_text(text)
+    return text
+
+
+def test_yaml_past_its_length_limit_is_refused_in_one_line(tmp_path, capsys):
+    """A YAML parser holds an object per value (a 32 MiB YAML file of numbers would take
+    ~3 GB), so YAML is read up to MAX_YAML_CHARS characters, JSON up to MAX_FILE_BYTES."""
+    from taut.io import MAX_FILE_BYTES, MAX_YAML_CHARS
+    text = _pairs_file(tmp_path / "big.yaml", MAX_YAML_CHARS // 16, json_form=False)
+    assert MAX_YAML_CHARS < len(text) < MAX_FILE_BYTES
+    t0 = time.perf_counter()
+    assert main(["fk", str(tmp_path / "big.yaml")]) == 2
+    assert time.perf_counter() - t0 < 5
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "write larger data as JSON" in err, err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("json_form", [False, True])
+def test_the_largest_readable_file_keeps_a_command_under_1_gib(tmp_path, json_form):
+    """The largest file a command reads (YAML just under MAX_YAML_CHARS, JSON just under
+    MAX_FILE_BYTES, all numbers) keeps `taut fk`'s peak resident memory under 1 GiB: it is
+    read whole, then refused in one line. Measured 0.39 GB (4 MB YAML), 0.72 GB (31 MiB
+    JSON)."""
+    import subprocess
+    import sys
+    from taut.io import MAX_FILE_BYTES, MAX_YAML_CHARS
+    limit = MAX_FILE_BYTES if json_form else MAX_YAML_CHARS
+    path = tmp_path / ("big.json" if json_form else "big.yaml")
+    n = limit // 25
+    n = int(n * 0.95 * limit / len(_pairs_file(path, n, json_form)))
+    text = _pairs_file(path, n, json_form)
+    assert 0.9 * limit < len(text) < limit
+    probe = ("import resource, subprocess, sys; r = subprocess.run(sys.argv[1:], "
+             "capture_output=True, text=True); print(r.returncode, "
+             "resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss); "
+             "print(r.stderr.strip())")
+    taut = str(Path(sys.executable).with_name("taut"))
+    out = subprocess.run([sys.executable, "-c", probe, taut, "fk", str(path)],
+                         capture_output=True, text=True, timeout=600).stdout.splitlines()
+    code, peak_kib = map(int, out[0].split())
+    assert code == 2 and out[1].startswith("taut: error: formation: "), out
+    assert peak_kib < 2**20, f"peak {peak_kib / 2**20:.2f} GiB"

@@ -2,10 +2,10 @@
 
 Files
     :func:`read_mapping` parses a YAML or JSON file whose top level is a mapping
-    (:func:`parse_mapping` the same from text; files over :data:`MAX_FILE_BYTES` and
-    alias bombs over :data:`MAX_YAML_VALUES` values refused), :func:`read_text` reads
-    one, :func:`validate_mapping` checks a parsed mapping against a pydantic model
-    (errors naming the dotted key), :func:`write_json` writes JSON,
+    (:func:`parse_mapping` the same from text; files over :data:`MAX_FILE_BYTES`, YAML
+    over :data:`MAX_YAML_CHARS` characters and alias bombs over :data:`MAX_YAML_VALUES`
+    values refused), :func:`read_text` reads one, :func:`validate_mapping` checks a
+    parsed mapping against a pydantic model (errors naming the dotted key), :func:`write_json` writes JSON,
     :func:`write_text_atomic` any text and :func:`atomic_path` gives a temporary file to
     write that replaces the target once complete (figures, animations).
 Sheet scenarios
@@ -45,8 +45,8 @@ from .._lazy import lazy_names
 
 if TYPE_CHECKING:                   # the real names, for type checkers
     from .cdpr_model import cdpr_model_from_mapping, load_cdpr_model
-    from .files import (MAX_FILE_BYTES, MAX_YAML_VALUES, parse_mapping, read_mapping,
-                        read_text, validate_mapping, write_json, write_text_atomic,
+    from .files import (MAX_FILE_BYTES, MAX_YAML_CHARS, MAX_YAML_VALUES, parse_mapping,
+                        read_mapping, read_text, validate_mapping, write_json, write_text_atomic,
                         atomic_path)
     from .plan_scenario import (load_plan_scenario, plan_scenario_from_mapping,
                                 plan_scenario_to_mapping)
@@ -60,7 +60,7 @@ _HOME = {
     "read_mapping": "files", "read_text": "files", "validate_mapping": "files",
     "write_json": "files", "parse_mapping": "files", "write_text_atomic": "files",
     "atomic_path": "files",
-    "MAX_FILE_BYTES": "files", "MAX_YAML_VALUES": "files",
+    "MAX_FILE_BYTES": "files", "MAX_YAML_VALUES": "files", "MAX_YAML_CHARS": "files",
     "load_plan_scenario": "plan_scenario", "plan_scenario_from_mapping": "plan_scenario",
     "plan_scenario_to_mapping": "plan_scenario",
     "SheetScenario": "sheet_scenario", "load_sheet_scenario": "sheet_scenario",
@@ -73,6 +73,7 @@ __all__ = [
     # files
     "read_mapping", "read_text", "parse_mapping", "validate_mapping", "write_json",
     "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
+    "MAX_YAML_CHARS",
     # sheet scenarios
     "load_sheet_scenario", "sheet_scenario_from_mapping", "SheetScenario",
     # plan scenarios

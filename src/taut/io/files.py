@@ -7,7 +7,8 @@ parsers keep the last value) and a boolean where a number is expected (pydantic'
 mode reads ``hold_height: true`` as 1).
 
 Files that could exhaust the machine are refused in one line before any work: a file
-larger than :data:`MAX_FILE_BYTES`, and a YAML document whose aliases (``*name``) would
+larger than :data:`MAX_FILE_BYTES` (YAML text longer than :data:`MAX_YAML_CHARS`: its
+parser holds an object per value), and a YAML document whose aliases (``*name``) would
 add more than :data:`MAX_YAML_VALUES` values to it (an "alias bomb": a few kB that
 expand to billions of values). The expansion is counted on the parsed node graph (each
 anchored node once), so a bomb is refused in milliseconds.
@@ -34,7 +35,8 @@ from ..errors import InvalidInputError, ScenarioError
 from .._validate import as_path, require_instance
 
 __all__ = ["read_text", "read_mapping", "parse_mapping", "validate_mapping", "write_json",
-           "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES"]
+           "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
+           "MAX_YAML_CHARS"]
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -44,6 +46,11 @@ MAX_FILE_BYTES = 32 * 2**20
 #: Most values (scalars, lists, mappings) aliases may add to a YAML document (an alias
 #: repeats its anchored value; a file without aliases is limited by its size alone).
 MAX_YAML_VALUES = 100_000
+#: Longest YAML text parsed, characters. A YAML parser holds a node object (~0.5 kB) per
+#: value: 4.2 MB of number pairs took `taut fk` to 0.39 GB and 12 s, so a 32 MiB YAML file
+#: would take ~3 GB; JSON (parsed compactly: 31 MiB measured at 0.72 GB) keeps
+#: MAX_FILE_BYTES.
+MAX_YAML_CHARS = 4 * 2**20
 
 _UMASK = os.umask(0o022)          # read once at import (os.umask is not thread safe)
 os.umask(_UMASK)
@@ -132,6 +139,10 @@ def _alias_values(root: yaml.Node) -> int:
 
 
 def _load_yaml(text: str, source: str) -> Any:
+    if len(text) > MAX_YAML_CHARS:
+        raise ScenarioError(source, f"YAML text of {len(text):,} characters; at most "
+                                    f"{MAX_YAML_CHARS:,} are read as YAML (write larger "
+                                    "data as JSON)")
     loader = _UniqueKeyLoader(text)
     try:
         node = loader.get_single_node()
