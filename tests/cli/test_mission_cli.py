@@ -52,7 +52,7 @@ def test_bad_output_suffix(capsys, tmp_path, opt, name):
 
 
 @pytest.mark.parametrize("value,field", [("1,x", "--active-base-offsets"),
-                                         ("0.3,nan", "active_base_offsets")])
+                                         ("0.3,nan", "--active-base-offsets")])
 def test_bad_active_base_offsets(capsys, value, field):
     one_line_error(*run(capsys, "cdpr", "mission", EXAMPLE, "--active-base-offsets", value),
                    field)

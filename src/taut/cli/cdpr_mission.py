@@ -92,8 +92,14 @@ def add_mission(sub: typer.Typer) -> None:
 
         wh = load_warehouse(warehouse)
         moves = _offsets(offsets)
-        with working(f"cdpr mission ({len(wh.tasks)} tasks)") as update:
-            res = plan_mission(wh, progress=update, active_base_offsets=moves)
+        from ..errors import InvalidInputError
+        try:
+            with working(f"cdpr mission ({len(wh.tasks)} tasks)") as update:
+                res = plan_mission(wh, progress=update, active_base_offsets=moves)
+        except InvalidInputError as exc:       # the library's range check, named as the option
+            if exc.field != "active_base_offsets":
+                raise
+            raise InvalidInputError("--active-base-offsets", exc.problem) from None
         if as_json:
             typer.echo(to_json(mission_to_dict(res)))
         else:
