@@ -41,7 +41,7 @@ from ._util import Q_SIGNS
 __all__ = ["TAUT_TOL", "WEIGHT_TOL", "CURVATURE_TOL", "SINGULAR_RTOL", "MAX_CONDITION",
            "ANGLE_TOL", "KIND_STABLE", "KIND_SADDLE", "KIND_NOT_EQUILIBRIUM",
            "KIND_NAMES", "Frame", "Solved", "solve_candidates", "solve_table",
-           "height_ok", "taut_masks", "maximiser_masks", "in_hull_2d",
+           "height_ok", "taut_at", "taut_masks", "maximiser_masks", "in_hull_2d",
            "reduced_hessian_min_eig", "pad_groups"]
 
 #: Codes of the kinds of rest state (``Equilibrium.kind``) in the solvers' arrays.
@@ -335,6 +335,42 @@ def height_ok(frame: Frame, depth2: np.ndarray | Solved) -> np.ndarray:
     :math:`0 < z_o < z_r` (the object above the ground). ``depth2`` normalised (M,)."""
     d2 = depth2.depth2 if isinstance(depth2, Solved) else depth2
     return (d2 > TAUT_TOL) & (d2 < frame.z * frame.z)
+
+
+def taut_at(frame: Frame, b: int, x: np.ndarray, depth2: float) -> np.ndarray:
+    """The one definition of "taut" (docs/sheet_fk_solver.md, "Which cables are taut"):
+    the cables at their full length at a state of formation ``b``.
+
+    Cable :math:`j` is taut when :math:`(L_j^2 - l_j^2)/s^2 \\ge -` ``TAUT_TOL``, with
+    :math:`L_j` the robot-to-object distance and :math:`l_j = |\\mathbf{v}_j -
+    \\mathbf{v}_o|` the cable's length on the sheet (FK paper eq. 1 with equality). In
+    lifted form (docs/sheet_kinematics.md §1) :math:`(L_j^2 - l_j^2)/s^2 = g_j(x) +
+    x^\\top J x + d^2` with :math:`g_j(x) = \\mathbf{a}_j \\cdot x + b_j` the lifted
+    piece: the compiled kernels (``_kernels.small``, ``_kernels.step``) and
+    :func:`maximiser_masks` evaluate exactly this sum as ``g_j(x) - mu`` at a solved state
+    (where :math:`d^2 = -(x^\\top J x + \\mu)`); states known only by their point (merged
+    states, the direct minimisation's) are decided here.
+
+    Parameters
+    ----------
+    frame : Frame
+        The normalised formations and sheet.
+    b : int
+        Which formation of ``frame``.
+    x : ndarray, shape (4,)
+        The state's (r_o, v_o), normalised (centred, divided by the sheet size).
+    depth2 : float
+        Its squared depth :math:`((z_r - z_o)/s)^2` (normalised area).
+
+    Returns
+    -------
+    ndarray of bool, shape (N,)
+        The taut cables.
+    """
+    P = frame.P[b]
+    stretch = P[:, :4] @ x + P[:, 4] + (x[0] * x[0] + x[1] * x[1] - x[2] * x[2]
+                                         - x[3] * x[3] + depth2)
+    return np.asarray(stretch >= -TAUT_TOL)
 
 
 def taut_masks(frame: Frame, solved: Solved, chunk: int = 1 << 24) -> tuple[np.ndarray, np.ndarray]:

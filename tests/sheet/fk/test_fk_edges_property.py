@@ -12,7 +12,9 @@ lies: taut's lowest state must exist then and lie no higher.
 
 The number of teams is ``TAUT_EDGE_TEAMS``: 2,000 by default (a few minutes, what CI
 runs), ``TAUT_EDGE_TEAMS=100000`` for the issue's count (hours on one core); each team
-is drawn from its own seed, so a failure names its seed.
+is drawn from its own seed, so a failure names its seed. ``bench/property_fk_teams.py``
+runs the same seeds through ``check_team`` at scale, counting failures by kind, merges
+and direct minimisations into a progress file.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ from typing import Callable
 import numpy as np
 
 from .._lifted import (Frame, height_ok, maximiser_masks, pad_groups, reduced_hessian_min_eig,
-    solve_candidates)
+    solve_candidates, taut_at)
 from .._tol import (ARRIVAL_ACTIVE_TOL, CURVATURE_TOL, DIRECT_MAXIT, DIRECT_NEAR_MAX,
     DIRECT_NEAR_TOL, DIRECT_RTOL, MERGE_RTOL, TAUT_TOL, WEIGHT_TOL)
 from ..sim._descent import descend
@@ -178,8 +178,8 @@ def _taut_weights(frame: Frame, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     """The cables at full length at ``x`` (within ``TAUT_TOL``), their minimum-norm
     non-negative weights and the largest achievable least weight (``_weights_family``)."""
     P = frame.P[0]
-    vals = P[:, :4] @ x + P[:, 4]
-    idx = np.flatnonzero(vals >= vals.max() - TAUT_TOL)
+    depth2 = -float(x @ (_J * x) + (P[:, :4] @ x + P[:, 4]).max())     # F's depth at x
+    idx = np.flatnonzero(taut_at(frame, 0, x, depth2))
     w, t_star = _weights_family(frame, 0, idx, x[:2], x[2:])
     return idx, w, t_star
 

@@ -6,12 +6,15 @@ Near a similar copy of the sheet (regular sheets at a scaled copy, coordinates w
 finite digits, noise far below any physical scale) the lifted points are nearly
 co-planar and float64 splits one rest point into several candidate taut sets, each
 reported as its own "state". The merged state keeps the lowest member's object and
-contact point (a stable member first), its taut set is the union of the members' taut
-sets (each member's taut set is the cables at full length at its point, and the points
-coincide), its weights are the minimum-norm non-negative weights of that set
-(``_finalize._weights_family``: an SVD-truncated, well-conditioned solve), and its kind
-the best of the members' (stable before saddle before not an equilibrium). An engine
-helper: used by the result constructors of every method, backend and the batch.
+contact point (a stable member first) and that member's taut set: the cables at full
+length at that point (the one definition, :func:`taut.sheet._lifted.taut_at`, which the
+solvers evaluated there on the formation they solved). Not the union of the members' taut
+sets: a member up to ``MERGE_RTOL`` away can have a cable taut that is slack by ~1e-6 of
+the squared size at the kept point, where the simulator, testing the cables at its own
+point, calls it slack (issue 25). Its weights are the minimum-norm non-negative weights
+of that set (``_finalize._weights_family``: an SVD-truncated, well-conditioned solve), and
+its kind the best of the members' (stable before saddle before not an equilibrium). An
+engine helper: used by the result constructors of every method, backend and the batch.
 """
 
 from __future__ import annotations

@@ -200,7 +200,7 @@ def _merge_equilibria(eqs: tuple[Equilibrium, ...], sheet: Sheet, formation: np.
             out.append(members[0])
             continue
         rep = min(members, key=lambda e: (_KIND_RANK[e.kind], e.height))
-        idx = np.array(sorted(set().union(*(e.taut for e in members))), dtype=np.intp)
+        idx = np.array(rep.taut, dtype=np.intp)     # at its point; not the members' union
         w = merged_weights(sheet.vertices, formation, hold_height, sheet.size, idx,
                            rep.object[:2], rep.contact)
         lengths = np.linalg.norm(sheet.vertices[idx] - rep.contact, axis=1)

@@ -319,5 +319,8 @@ def fk_stable(team: SheetTeam, R: np.ndarray, method: FKMethod = "fast"
 
 
 def fk_stable_batch(team: SheetTeam, R: np.ndarray) -> np.ndarray:
-    """Bool (B,): formation ``R[b]`` (B, N, 2) has a stable equilibrium."""
-    return np.asarray(cached_solver(team, "fast").solve_batch(R).stable.any(axis=1))
+    """Bool (B,): formation ``R[b]`` (B, N, 2) has a stable equilibrium. Reads the lazy
+    batch's ``success``, which runs the direct minimisation only next to a similar copy
+    of the sheet; ``stable`` would run it on every formation without a stable state
+    (bench/bench_sim_recover.py: 2-20x the batch's cost on a lost object)."""
+    return np.asarray(cached_solver(team, "fast").solve_batch(R).success)
