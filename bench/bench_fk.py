@@ -329,7 +329,8 @@ def main(argv=None):
     big, big_cpu = time.perf_counter() - start, time.process_time() - cpu
     print(f"N=1000: one forward_kinematics call {big_cpu:.2f} s CPU ({big:.2f} s wall)")
     report["n1000_s"] = {"cpu": big_cpu, "wall": big}
-    print("\nbatch throughput (formations/s, CPU; median, IQR as +-% of median):")
+    print("\nbatch throughput (formations/s, CPU; median, IQR as +-% of median; every "
+          "implementation on one thread):")
     for n, batch, held in BATCHES:
         count, rates, share = throughput(n, batch if not args.quick else batch // 4, rng,
                                          3 if args.quick else 5, args.any_team, held)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import weakref
 from types import ModuleType
+from typing import Any, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -113,7 +114,7 @@ class FKSolver:
 
     __slots__ = ("team", "sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
                  "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
-                 "_fast", "_shape", "_mass", "_pack", "_out_shape", "_make",
+                 "_fast", "_shape", "_mass", "_pack", "_out_shape", "_make", "_solve_one",
                  "__weakref__")
 
     def __init__(self, team: SheetTeam, *, method: Method = "fast",
@@ -158,12 +159,16 @@ class FKSolver:
         self._make = FKResult._rows_maker(self.method, sheet, self.hold_height, team.mass)
         self._pack = np.zeros(0)
         self._out_shape = (0, self._width)
+        self._solve_one: Callable[..., int] = _no_kernel
         if self.backend == "numba":
             _load_kernel()
             self._pack = _batch_kernel().pack(
                 self._Vn, self._A, self._lim2, self._table, self._sizes, self._scale,
                 self._vcx, self._vcy, self.hold_height, _snap_screen(self._scale))
             self._out_shape = (bk.out_rows(N, len(table)), self._width)
+            if self._fast:
+                self._solve_one = _specialised(bk.solve_one, np.zeros(self._shape),
+                                               self._pack, np.empty(self._out_shape))
 
     def __repr__(self) -> str:
         return (f"FKSolver(N={self.sheet.n}, hold_height={self.hold_height:g}, "
@@ -190,13 +195,13 @@ class FKSolver:
             As :func:`~taut.sheet.forward_kinematics`.
         """
         if self._fast:                              # the hot path: one compiled call
-            if (type(formation) is np.ndarray and formation.dtype is _FLOAT64
+            if (type(formation) is _NDARRAY and formation.dtype is _FLOAT64
                     and formation.shape == self._shape):
                 R = formation.copy()                # C-contiguous; the result keeps it
             else:
                 R = self._formation(formation, check)
-            out = np.empty(self._out_shape)
-            code = bk.solve_one(R, self._pack, out)
+            out = _EMPTY(self._out_shape)
+            code = self._solve_one(R, self._pack, out)
             if code >= 0:                           # the rows are the answer
                 return self._make(out[:code], R)
             return self._flagged(R, out, code)
@@ -429,7 +434,26 @@ class FKSolver:
         return rows[order], form[order]
 
 
-_FLOAT64 = np.dtype(np.float64)
+#: What ``solve``'s hot path looks up, as module globals (an attribute lookup on ``np``
+#: costs ~20 ns of a ~3 us call).
+_FLOAT64, _NDARRAY, _EMPTY = np.dtype(np.float64), np.ndarray, np.empty
+
+
+def _no_kernel(*args: object) -> int:
+    """``FKSolver._solve_one`` of a solver without the per-call kernel (never called:
+    ``solve`` takes the kernel path only when ``_fast``)."""
+    raise RuntimeError("this FKSolver has no per-call kernel")
+
+
+def _specialised(kernel: Any, *args: np.ndarray) -> Callable[..., int]:
+    """The compiled specialisation of ``kernel`` (a numba dispatcher) for the types of
+    ``args``, loaded from numba's on-disk cache (or compiled) as a first call would load
+    it, as a plain callable: a call skips numba's dispatch on the argument types (~0.1 us
+    of a ~3 us call at N = 3). It checks no type: the caller passes arrays of exactly
+    those types (``FKSolver.solve``: float64, C-contiguous, aligned, fresh)."""
+    import numba
+
+    return kernel.compile(tuple(numba.typeof(a) for a in args))
 
 
 def _snap_screen(size: float) -> tuple[float, float, float]:
