@@ -45,6 +45,30 @@ def test_a_ball_off_the_sheet_is_a_failed_run():
     assert np.all(np.isnan(r.position))
 
 
+def test_a_sheet_node_flung_out_of_reach_is_a_diverged_run():
+    # Seen at meshes 19-32 (examples/physics/marginal_state.py): with the contact node
+    # pinned, Newton ran at its iteration cap and the sheet flew metres apart with finite
+    # values and no MuJoCo warning, for minutes. A node farther from every robot than an
+    # inextensible sheet allows now makes the run diverged at the next check. (A node
+    # moved once is pulled back by the stiff tendons within a check interval, so the
+    # check itself is tested here, not a whole phase.)
+    from taut.physics import _run
+    from taut.physics._sheet_model import build_sheet_sim
+
+    sheet = Sheet.regular(3, 600.0)
+    R = 0.75 * sheet.vertices
+    m = sheet_mesh(sheet.vertices, 6)
+    sim = build_sheet_sim(m, sheet.vertices, R, 700.0, ball_radius=5.0, ball_start=None,
+                          tie=False, corner_tendons=True)
+    _run.ramp(sim)
+    assert not _run._escaped(sim) and not _run._unstable(sim)
+    assert _run.settle_phase(sim, 3.0)[0] == "settled"      # the same sheet, left alone
+    free = int(np.flatnonzero(sim.node_qpos[:, 0] >= 0)[0])
+    sim.data.qpos[sim.node_qpos[free]] += [0.0, 0.0, 3.0]   # 3 sheet widths up (sim m)
+    mujoco.mj_forward(sim.model, sim.data)
+    assert _run._escaped(sim) and _run._unstable(sim)  # what settle_phase checks
+
+
 @pytest.mark.slow
 def test_random_teams_every_state_checked_and_no_object_falls_through():
     # The failure: 9 of 22 released objects ended metres below the sheet. Here

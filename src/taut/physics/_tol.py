@@ -59,6 +59,10 @@ SETTLE_SPEED = 2e-3
 #: (which decides "held") is read there, and residual motion at 2e-3 m/s left pulls of up
 #: to 0.2 mg at well-conditioned stable states (0.002 mg at 2e-4).
 TIED_SETTLE_SPEED = 2e-4
+#: A node farther than this from every robot's holding point, m (sim scale, two sheet
+#: diameters), makes a run ``diverged``: an inextensible sheet keeps every point within
+#: one diameter (its flat distance) of a held corner.
+ESCAPE_DISTANCE = 2.0 * SIM_DIAMETER
 #: Settling is checked every this many seconds of simulated time.
 CHECK_INTERVAL = 0.1
 #: Longest simulated settling time of one phase, s.
