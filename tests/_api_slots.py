@@ -44,7 +44,7 @@ NOT_CALLED: dict[str, str] = {
     **{name: "result container built by an analysis, not by users" for name in
        "NavigationResult NavigationCertificate SitesResult Site UnservedTask".split()},
     **{name: "result container built by an analysis, not by users" for name in
-       "TimedPath MissionResult Phase Reposition".split()},
+       "TimedPath MissionResult Phase Reposition MovingCarry".split()},
 }
 
 #: Callables whose valid call runs a search or a simulation (seconds): only their model
@@ -55,7 +55,7 @@ HEAVY = frozenset(
     "generate_suite find_route formation_library optimal_formation inverse_kinematics "
     "find_certificate motion_from_legs verify_motion Simulator cable_forward_kinematics "
     "evaluate_chunk plan_moving_deployment staged_lift_bound plan_navigation choose_sites object_feedback "
-    "plan_mission time_optimal_path".split())
+    "plan_mission time_optimal_path moving_carry run_moving_carry".split())
 
 
 @functools.lru_cache(maxsize=None)
@@ -89,6 +89,14 @@ def fixtures() -> dict[str, Any]:
         reference=pick_and_place(robot, [[0, 0, 1.0], [0.05, 0, 1.0]], rate=200.0),
         scenario_map=plan_scenario_to_mapping(scenario),
         warehouse=load_warehouse(WAREHOUSE), fastkit_map=None)
+
+
+@functools.lru_cache(maxsize=None)
+def _carry() -> Any:
+    """A short moving-base carry of the FASTKIT preset (planned once)."""
+    from taut.cdpr import moving_carry
+    return moving_carry(fixtures()["robot"], [[0, 0, 1.0], [0.05, 0, 1.0]], (0.0, 0.02),
+                        base_accel=0.25)
 
 
 def _warehouse_map() -> dict[str, Any]:
@@ -199,6 +207,11 @@ def valid_arguments(module: str, name: str) -> dict[str, Any]:
         ("taut.cdpr", "time_optimal_path"): {"robot": f["robot"],
                                              "waypoints": [[-0.5, 0, 0.6], [0.5, 0, 0.6]]},
         ("taut.cdpr", "with_box"): {"robot": f["robot"], "mass": 2.0},
+        ("taut.cdpr", "with_base_acceleration"): {"acceleration": (0.25, 0.0, 0.0)},
+        ("taut.cdpr", "moving_carry"): {"offsets": (0.0, 0.02), "base_accel": 0.25},
+        ("taut.cdpr", "run_moving_carry"): {"warehouse": f["warehouse"],
+                                            "site_pose": (9.75, 10.05, np.pi),
+                                            "carry": _carry()},
         ("taut.cdpr", "plan_mission"): {"warehouse": f["warehouse"]},
         ("taut.io", "load_warehouse"): {"source": str(WAREHOUSE)},
         ("taut.io", "warehouse_from_mapping"): {"data": _warehouse_map()},

@@ -53,3 +53,13 @@ def twelve_cable_robot(t_min=5.0, t_max=400.0, mass=20.0):
                      for i in range(12)),
         payload=Payload(0.0),
         name="twelve cables")
+
+
+def bisect_largest(ok, hi, iters=14):
+    """Largest value in [0, hi] for which the monotone predicate ``ok`` holds, by
+    ``iters`` bisection steps (the lower end of the last bracket)."""
+    lo = 0.0
+    for _ in range(iters):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo

@@ -26,6 +26,7 @@ Model
    Cable -- one cable from a base's exit point to a platform attachment point
    check_footprint -- validate a convex ground footprint polygon
    with_stabilisers -- the robot with its bases' stabilisers deployed (or retracted)
+   with_base_acceleration -- the robot with its mobile bases accelerating (d'Alembert loads)
    with_friction -- the robot with a ground friction coefficient on its mobile bases
 
 Kinematics
@@ -169,12 +170,16 @@ Mission
    MissionResult -- its outcome: phases, total and baseline times, unserved tasks
    Phase -- one phase: kind, task, times, margins
    Reposition -- one task's choice of active-base offset along the shelf face
+   moving_carry -- a time-optimal carry with the active base driving along the face
+   MovingCarry -- its outcome: the law, the bases' motion and accelerations
+   run_moving_carry -- that carry in the control simulation, monitored as a phase
+   wheels_for_active -- the robot with the active base's stabilisers up (it drives)
    PHASE_KINDS -- the kinds of phase
 """
 
 from .model.parts import Base, Cable, Payload, Platform
 from .model.footprint import check_footprint
-from .model.robot import CableRobot, with_friction, with_stabilisers
+from .model.robot import CableRobot, with_base_acceleration, with_friction, with_stabilisers
 from .kinematics.cables import (CableState, as_poses, cable_state, gravity_wrench,
     rotation_matrices, tipping_matrix, wrench_matrix)
 from .kinematics.forward import CableFKResult, cable_forward_kinematics
@@ -221,11 +226,12 @@ from .mission.sites import Site, SitesResult, UnservedTask, choose_sites
 from .mission.timing import TimedPath, time_optimal_path, with_box
 from .mission.mission import PHASE_KINDS, MissionResult, Phase, plan_mission
 from .mission._reposition import Reposition
+from .mission.moving_carry import MovingCarry, moving_carry, run_moving_carry, wheels_for_active
 
 __all__ = [
     # Model
     "CableRobot", "Base", "Platform", "Payload", "Cable", "check_footprint",
-    "with_stabilisers", "with_friction",
+    "with_stabilisers", "with_friction", "with_base_acceleration",
     # Kinematics
     "as_poses", "rotation_matrices", "CableState", "cable_state", "wrench_matrix",
     "gravity_wrench", "tipping_matrix", "CableFKResult", "cable_forward_kinematics",
@@ -261,4 +267,5 @@ __all__ = [
     "plan_navigation", "NavigationResult", "NavigationCertificate", "choose_sites",
     "SitesResult", "Site", "UnservedTask", "time_optimal_path", "TimedPath", "with_box",
     "plan_mission", "MissionResult", "Phase", "PHASE_KINDS", "Reposition",
+    "moving_carry", "MovingCarry", "run_moving_carry", "wheels_for_active",
 ]

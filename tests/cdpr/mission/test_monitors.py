@@ -11,6 +11,7 @@ import shapely
 from hypothesis import given, settings, strategies as st
 
 from taut.cdpr import NavigationResult, Shelf, with_box, with_friction, with_stabilisers
+from taut.cdpr.mission import _execute
 from taut.cdpr.mission._execute import navigate_run, switch_stabilisers
 from taut.cdpr.mission._monitors import (_shelf_gap, cable_clearance, stabiliser_sequence)
 from taut.io import load_warehouse
@@ -93,7 +94,7 @@ def test_deploy_is_monitored_in_every_state(warehouse):
     assert run.min_tipping_margin == pytest.approx(up.min_tipping_margin)
 
 
-def test_navigation_carries_the_inertial_load(warehouse):
+def test_navigation_carries_the_inertial_load(warehouse, monkeypatch):
     robot = with_box(with_stabilisers(with_friction(warehouse.robot, warehouse.friction),
                                       deployed=False), 0)
     t = np.linspace(0.0, 4.0, 41)
@@ -105,4 +106,9 @@ def test_navigation_carries_the_inertial_load(warehouse):
                          NavigationResult(True, "ok", "", t, poses[:1].repeat(41, 0), 4.0))
     assert run.success and run.min_footprint_clearance > warehouse.clearance
     assert run.min_tension_margin < still.min_tension_margin      # the load shows
+    # the bases' own d'Alembert force (45 kg at 0.6 m, 0.25 m/s^2: 6.75 N m) costs tipping
+    # margin beyond what the platform's load alone costs
+    monkeypatch.setattr(_execute, "with_base_acceleration", lambda r, a: r)
+    old = navigate_run(warehouse, robot, np.array([0.0, 0.0, 0.5]), nav)
+    assert old.min_tipping_margin - run.min_tipping_margin == pytest.approx(6.75, rel=0.1)
     assert len(run.times) == len(t)

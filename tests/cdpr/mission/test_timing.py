@@ -3,6 +3,7 @@ brute-force bisection, feasibility re-checked by the independent tension LP."""
 
 import numpy as np
 import pytest
+from cdpr_helpers import bisect_largest
 from hypothesis import given, settings, strategies as st
 
 from taut.cdpr import (DynamicsModel, cable_state, distribute_tensions, time_optimal_path,
@@ -35,23 +36,15 @@ def _cable_speed_ok(robot, pos, vel, limit):
     return np.abs(np.einsum("bmk,bk->bm", unit, vel)).max(axis=1) <= limit * (1 + 1e-9)
 
 
-def _bisect(ok, hi, iters=14):
-    lo = 0.0
-    for _ in range(iters):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    return lo
-
-
 def test_optimal_against_brute_force_bisection(deployed):
     dyn = DynamicsModel()
     pts = PATH[0] + np.linspace(0, 1, 21)[:, None] * (PATH[1] - PATH[0])
     e = (PATH[1] - PATH[0]) / np.linalg.norm(PATH[1] - PATH[0])
     # the largest constant speed whose cable speeds stay within the winch limit everywhere
-    v_star = _bisect(lambda v: _cable_speed_ok(deployed, pts, np.tile(v * e, (21, 1)),
+    v_star = bisect_largest(lambda v: _cable_speed_ok(deployed, pts, np.tile(v * e, (21, 1)),
                                                dyn.max_cable_speed).all(), 10.0)
     # the largest constant acceleration (and deceleration) feasible everywhere, 0 margins
-    a_star = _bisect(lambda a: _feasible(deployed, pts, np.tile(a * e, (21, 1))).all()
+    a_star = bisect_largest(lambda a: _feasible(deployed, pts, np.tile(a * e, (21, 1))).all()
                      and _feasible(deployed, pts, np.tile(-a * e, (21, 1))).all(), 10.0)
     law = time_optimal_path(deployed, PATH, tension_margin=0.0, tipping_margin=0.0,
                             max_speed=None, max_accel=20.0, smoothing=0.0, grid=40)

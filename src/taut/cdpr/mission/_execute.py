@@ -26,8 +26,12 @@ tipping and sliding), evaluated along the phase's time line:
 ``navigate``
     at every sample of the verified route (0.1 s apart): the rigid footprint's gap to walls
     and shelves, the cables' gap to the shelves, and the tensions, tipping and sliding with
-    the platform's inertial load ``-m a`` of the bases' acceleration ``a`` (stabilisers up;
-    quasi-static otherwise: the bases' own inertia is not in the tipping moments);
+    the platform's inertial load ``-m a`` of the bases' acceleration ``a`` and the bases' own
+    d'Alembert forces ``-m_b a`` at their centres of mass in the tipping moments and the
+    sliding condition (:func:`~taut.cdpr.with_base_acceleration`; stabilisers up; ``a`` is
+    the translational acceleration of the coupled bases' origin, rounded to 1 mm/s^2,
+    one tension distribution per distinct value; the yaw rate's centripetal and angular
+    terms are neglected, at most 0.2 rad/s);
 ``deploy`` / ``retract``
     the stabilisers switch base by base (:func:`~._monitors.stabiliser_sequence`), each
     state held for an equal share of the phase, monitored in each.
@@ -35,17 +39,19 @@ tipping and sliding), evaluated along the phase's time line:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import shapely
 
+from ..control._setup import BaseMotion
 from ..control.controllers import TorqueController
 from ..control.dynamics import DynamicsModel
 from ..control.simulate import simulate
 from ..kinematics.cables import cable_state
-from ..model.robot import CableRobot
+from ..model.robot import CableRobot, with_base_acceleration
 from ..statics.sliding import sliding_rows
+from ..statics.tipping import tipping_moments
 from ..statics.tension import distribute_tensions
 from ..deployment.moving_base import _stabilisers
 from ._monitors import (cable_clearance, cable_segments, segments_clearance,
@@ -130,19 +136,33 @@ def footprint_gap(warehouse: Warehouse, robot: CableRobot, poses: np.ndarray) ->
 
 
 def run_motion(warehouse: Warehouse, site_pose: np.ndarray, robot: CableRobot,
-               law: TimedPath, dynamics: DynamicsModel) -> PhaseRun:
+               law: TimedPath, dynamics: DynamicsModel, bases: BaseMotion | None = None,
+               base_acc: np.ndarray | None = None) -> PhaseRun:
     """Simulate one platform motion ``law`` of the deployed ``robot`` (payload = the box
-    carried) at ``site_pose`` and monitor it (module docstring)."""
-    run = simulate(robot, law.reference(), TorqueController(), dynamics=dynamics)
+    carried) at ``site_pose`` and monitor it (module docstring). With ``bases`` (the bases'
+    poses over the law's time) and ``base_acc`` (K, T, 3) (each base's acceleration at the
+    law's times, robot frame, m/s^2) the bases move during the run: tipping, sliding and
+    the collision gaps are evaluated with the bases where they are at each recorded instant
+    and their d'Alembert forces (:func:`~taut.cdpr.with_base_acceleration`)."""
+    run = simulate(robot, law.reference(), TorqueController(), dynamics=dynamics,
+                   base_motion=bases)
     T = run.tensions
     ten = float(np.minimum(T - run.t_min, run.t_max - T).min())
     tip = float(run.tipping_margin.min()) if run.tipping_margin.size else float("inf")
     sel = slice(None, None, RECORD_EVERY)
     idx = np.r_[np.arange(len(run.times))[sel], len(run.times) - 1]
-    slide = _sliding_margin(robot, run.poses[idx], T[idx])
+    if bases is None or base_acc is None:
+        robots = [robot]
+        slide = _sliding_margin(robot, run.poses[idx], T[idx])
+    else:
+        robots = _robots_along(robot, bases, law.times, base_acc, run.times[idx])
+        tip_b, slide = _moving_margins(robots, run.poses[idx], T[idx])
+        tip = min(tip, tip_b)
     clear = _clearance(warehouse, site_pose, run.poses[idx, :3])
-    cab = cable_clearance(warehouse, robot, site_pose, run.poses[idx])
-    foot = footprint_gap(warehouse, robot, site_pose)
+    cab = min(cable_clearance(warehouse, r, site_pose, run.poses[idx[i:i + 1]])
+              for i, r in enumerate(robots)) if len(robots) > 1 else \
+        cable_clearance(warehouse, robot, site_pose, run.poses[idx])
+    foot = min(footprint_gap(warehouse, r, site_pose) for r in robots)
     ok = bool(run.success and min(ten, tip, slide, clear, cab, foot) >= 0)
     msg = run.message if ok or not run.success else (
         f"margins: tension {ten:.2f} N, tipping {tip:.2f} N m, sliding {slide:.2f} N, "
@@ -151,6 +171,33 @@ def run_motion(warehouse: Warehouse, site_pose: np.ndarray, robot: CableRobot,
     return PhaseRun(ok, msg, float(law.duration), ten, tip, slide, clear,
                     float(run.tracking_error.max()), cab, foot, run.times[idx],
                     to_world_frame(site_pose, run.poses[idx, :3]))
+
+
+def _robots_along(robot: CableRobot, bases: BaseMotion, law_times: np.ndarray,
+                  base_acc: np.ndarray, times: np.ndarray) -> list[CableRobot]:
+    """``robot`` with its bases where ``bases`` puts them at ``times`` (s) and accelerating
+    as ``base_acc`` (K, T_law, 3) m/s^2 says (held outside the law's span)."""
+    poses = bases.at(times)
+    acc = np.stack([[np.interp(times, law_times, base_acc[k, :, j]) for j in range(3)]
+                    for k in range(len(robot.bases))])              # (K, 3, S)
+    out = []
+    for i in range(len(times)):
+        moved = replace(robot, bases=tuple(
+            replace(b, exit_points=dict(b.exit_points), pose=poses[i, k])
+            for k, b in enumerate(robot.bases)))
+        out.append(with_base_acceleration(moved, acc[:, :, i]))
+    return out
+
+
+def _moving_margins(robots: list[CableRobot], poses: np.ndarray, tensions: np.ndarray
+                    ) -> tuple[float, float]:
+    """Least tipping margin (N m) and sliding margin (N) of the actual ``tensions``
+    (S, m) at platform ``poses`` (S, 6), the bases of sample ``i`` as ``robots[i]``."""
+    tip = min((float(-tipping_moments(r, poses[i], tensions[i]).moments.max())
+               for i, r in enumerate(robots) if r.has_tipping), default=float("inf"))
+    slide = min(_sliding_margin(r, poses[i:i + 1], tensions[i:i + 1])
+                for i, r in enumerate(robots))
+    return tip, slide
 
 
 def _held(robot: CableRobot, position: np.ndarray, wrench: np.ndarray | None
@@ -227,11 +274,9 @@ def navigate_run(warehouse: Warehouse, robot: CableRobot, position: np.ndarray,
     """The locked platform (at ``position``, robot frame) of ``robot`` (stabilisers up)
     carried along the verified route ``nav``, monitored at every sample (module
     docstring)."""
-    acc = np.round(_base_accel(nav), 3)
-    distinct = np.unique(acc, axis=0)
-    wrench = np.zeros((len(distinct), 6))
-    wrench[:, :2] = -robot.total_mass * distinct
-    checks = [_held(robot, position, wrench)]
+    checks = [_held(with_base_acceleration(robot, np.r_[a, 0.0]), position,
+                    np.r_[-robot.total_mass * a, np.zeros(4)][None])
+              for a in np.unique(np.round(_base_accel(nav), 3), axis=0)]
     pose6 = np.r_[position, 0.0, 0.0, 0.0][None]
     ex, at = cable_segments(robot, np.zeros(3), pose6)          # robot frame, (1, m, 3)
     c, s = np.cos(nav.poses[:, 2]), np.sin(nav.poses[:, 2])

@@ -32,7 +32,14 @@ mass and ``c`` their first moment ``sum m_j c_j`` about P):
   with the cable acceleration ``l_dd_i = (u_i . e) u + (1 - (u_i . e)^2) s_d^2 / l_i``
   bounded through the speed limit (linear in ``t`` and ``u``);
 * winch speed: ``|u_i . e| s_d <= k_l omega_max`` (the cable speed at the motor limit);
-* an optional cap on the platform speed and acceleration.
+* an optional cap on the platform speed and acceleration (a margin fraction is accepted
+  where the grid point admits ``min(ACCEL_ROOM, cap)`` each way).
+
+A segment may have moving exits (:class:`AnchorMotion`, the active base driving along,
+:mod:`taut.cdpr.mission.moving_carry`): each grid point then has its own robot, the cable
+rates are taken relative to the exits, the moving base's d'Alembert force adds a term in
+``u`` to its tipping and friction rows, and its speed and acceleration limits cap ``s_d``
+and ``u``; the admissible set stays a box.
 
 The acceleration of an interval ``[s_k, s_{k+1}]`` must be admissible at both ends
 (TOPP-RA checks the left end only); the trajectory is then sampled at ``rate`` Hz and
@@ -45,6 +52,7 @@ Units: SI (m, s, N, N m).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -189,46 +197,116 @@ def _limits(dyn: DynamicsModel, tension_margin: float, tipping_margin: float,
                    np.inf if max_speed is None else max_speed, max_accel, smoothing)
 
 
-def _grid_bounds(robot: CableRobot, pts: np.ndarray, e: np.ndarray, lim: _Limits
-                 ) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class AnchorMotion:
+    """Exits moving with the path coordinate ``s`` (a base driving along with the platform,
+    :mod:`taut.cdpr.mission.moving_carry`); per grid point of one straight segment.
+
+    Attributes
+    ----------
+    robots : tuple of CableRobot (G,)
+        The robot at each grid point (bases placed there).
+    exit_rate : (m, 3)
+        ``d(exit point)/ds`` of every cable, m/m (zero on a standing base).
+    tip_rate : (E,)
+        Edge moment per unit path acceleration ``u`` from the moving bases' d'Alembert
+        forces, N m per m/s^2 (FASTKIT eqs. 21-23 with :attr:`Base.acceleration`).
+    slide_rate : (F,)
+        Change of the friction rows' right-hand side per unit ``u``, N per m/s^2.
+    base_rate : float
+        Largest ``|d(base position)/ds|``, m/m (> 0: a standing base is ``motion=None``).
+    base_speed, base_accel : float
+        The moving base's speed (m/s) and acceleration (m/s^2) limits.
+    """
+
+    robots: tuple[CableRobot, ...]
+    exit_rate: np.ndarray
+    tip_rate: np.ndarray
+    slide_rate: np.ndarray
+    base_rate: float
+    base_speed: float
+    base_accel: float
+
+
+def _states(robot: CableRobot, P: np.ndarray, motion: AnchorMotion | None) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """W (G, n, m), gravity wrench (G, n), unit vectors (G, m, 3), lengths (G, m), tipping
+    rows (G, E, m), their right-hand side (G, E) and friction rows (G, F, m) at the grid
+    poses ``P`` (G, 6); with ``motion`` each pose with its own robot."""
+    if motion is None:
+        sts = [cable_state(robot, P, validated=True)]
+        robots = [robot]
+    else:
+        robots = list(motion.robots)
+        sts = [cable_state(r, P[k:k + 1], validated=True) for k, r in enumerate(robots)]
+    W, unit, L = (np.concatenate([getattr(st, f) for st in sts]) for f in ("W", "unit",
+                                                                         "lengths"))
+    wg = np.concatenate([gravity_wrench(r, st.R) for r, st in zip(robots, sts)])
+    m = robot.m
+    tip = (np.concatenate([tipping_matrix(r, st.unit) for r, st in zip(robots, sts)])
+           if robot.has_tipping else np.zeros((len(P), 0, m)))
+    rhs = np.stack([np.broadcast_to(-r.edge_weight_moment, (robot.n_edges,)) for r in robots])
+    rhs = np.broadcast_to(rhs, (len(P), robot.n_edges))
+    S = (np.concatenate([sliding_rows(r, st.unit)[0] for r, st in zip(robots, sts)])
+         if robot.has_sliding else np.zeros((len(P), 0, m)))
+    return W, wg, unit, L, tip, rhs, S
+
+
+def _grid_bounds(robot: CableRobot, pts: np.ndarray, e: np.ndarray, lim: _Limits,
+                 motion: AnchorMotion | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Speed limit (G,) m/s and admissible acceleration (G, 2) m/s^2 at grid points
-    ``pts`` (G, 3) of a segment of direction ``e``; NaN bounds where rest is inadmissible."""
+    ``pts`` (G, 3) of a segment of direction ``e``; NaN bounds where rest is inadmissible.
+    With ``motion`` the exits move with ``s``: the cable length rate is
+    ``u_i . (e - exit_rate_i)`` per unit ``s_d`` and the moving bases' inertia loads their
+    tipping and friction rows in proportion to ``u``."""
     P = np.hstack([pts, np.zeros_like(pts)])
-    st = cable_state(robot, P, validated=True)
-    wg = gravity_wrench(robot, st.R)
-    n, m = st.W.shape[1], robot.m
+    W, wg, unit, L, tip, tip_rhs, S = _states(robot, P, motion)
+    n, m = W.shape[1], robot.m
     mc = robot.platform.mass * robot.platform.com + robot.payload.mass * robot.payload.com
     d = np.concatenate([robot.total_mass * e, np.cross(mc, e)])[:n]
-    ue = st.unit @ e                                           # (G, m)
+    rel = e[None] - (0.0 if motion is None else motion.exit_rate)          # (m, 3)
+    ue = np.einsum("gmk,mk->gm", unit, rel)                                # (G, m)
     vmax = np.minimum(lim.max_speed, lim.cable_speed / np.maximum(np.abs(ue), 1e-12).max(1))
-    tip = tipping_matrix(robot, st.unit) if robot.has_tipping else np.zeros((len(P), 0, m))
-    S, s_rhs, _ = sliding_rows(robot, st.unit) if robot.has_sliding else (
-        np.zeros((len(P), 0, m)), np.zeros(0), None)
+    s_rhs = sliding_rows(robot, unit[:1])[1] if robot.has_sliding else np.zeros(0)
+    tip_u, slide_u, acap = np.zeros(tip.shape[1]), np.zeros(S.shape[1]), lim.max_accel
+    if motion is not None:
+        tip_u, slide_u = motion.tip_rate, -motion.slide_rate
+        vmax = np.minimum(vmax, motion.base_speed / motion.base_rate)
+        acap = min(acap, motion.base_accel / motion.base_rate)
+    rel2 = np.einsum("mk,mk->m", rel, rel)
     bounds = np.full((len(P), 2), np.nan)
     for k in range(len(P)):
-        cen = (1.0 - ue[k] ** 2) * vmax[k] ** 2 / st.lengths[k]
+        cen = (rel2 - ue[k] ** 2) * vmax[k] ** 2 / L[k]
         budget = lim.torque_budget - lim.j_over_kl * cen
         tq = np.hstack([np.eye(m) * lim.kl / lim.eta, lim.j_over_kl * ue[k][:, None]])
-        A_ub = np.vstack([np.hstack([tip[k], np.zeros((tip.shape[1], 1))]),
-                          np.hstack([S[k], np.zeros((S.shape[1], 1))]), tq,
+        A_ub = np.vstack([np.hstack([tip[k], tip_u[:, None]]),
+                          np.hstack([S[k], slide_u[:, None]]), tq,
                           tq * np.r_[np.ones(m), -1.0]])
-        b_ub = np.concatenate([-robot.edge_weight_moment - lim.tipping_margin, s_rhs,
-                               budget, budget])
-        A_eq = np.hstack([st.W[k], -d[:, None]])
-        for frac in MARGIN_STEPS:
-            mg = frac * lim.tension_margin
-            box = [(a + mg, b - mg) for a, b in zip(robot.t_min, robot.t_max)] + \
-                [(-lim.max_accel, lim.max_accel)]
-            for j, sign in enumerate((1.0, -1.0)):
-                c = np.zeros(m + 1)
-                c[-1] = sign
-                res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=-wg[k], bounds=box,
-                              method="highs")
-                bounds[k, j] = res.x[-1] if res.status == 0 else np.nan
-            room = ACCEL_ROOM if frac > 0 else 0.0
-            if bounds[k, 0] <= REST_ACCEL_SLACK - room and bounds[k, 1] >= room - REST_ACCEL_SLACK:
-                break
+        b_ub = np.concatenate([tip_rhs[k] - lim.tipping_margin, s_rhs, budget, budget])
+        bounds[k] = _accel_range(robot, A_ub, b_ub, np.hstack([W[k], -d[:, None]]), -wg[k],
+                                 lim, acap)
     return vmax, bounds
+
+
+def _accel_range(robot: CableRobot, A_ub: np.ndarray, b_ub: np.ndarray, A_eq: np.ndarray,
+                 b_eq: np.ndarray, lim: _Limits, acap: float) -> np.ndarray:
+    """``[u_lo, u_hi]`` (2,) m/s^2 over tensions and ``u`` (two LPs), with the largest
+    fraction of the tension margin that leaves :data:`ACCEL_ROOM` (NaN: no rest)."""
+    m = robot.m
+    out = np.full(2, np.nan)
+    for frac in MARGIN_STEPS:
+        mg = frac * lim.tension_margin
+        box = [(a + mg, b - mg) for a, b in zip(robot.t_min, robot.t_max)] + [(-acap, acap)]
+        for j, sign in enumerate((1.0, -1.0)):
+            c = np.zeros(m + 1)
+            c[-1] = sign
+            res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=box,
+                          method="highs")
+            out[j] = res.x[-1] if res.status == 0 else np.nan
+        room = min(ACCEL_ROOM, acap) if frac > 0 else 0.0
+        if out[0] <= REST_ACCEL_SLACK - room and out[1] >= room - REST_ACCEL_SLACK:
+            break
+    return out
 
 
 def _passes(h: float, xmax: np.ndarray, ulo: np.ndarray, uhi: np.ndarray
@@ -326,6 +404,18 @@ def time_optimal_path(robot: CableRobot, waypoints: ArrayLike, *,
         raise InvalidInputError("waypoints", "must be at least two (x, y, z) positions, m")
     as_poses(robot, wp, "waypoints")
     dyn = DynamicsModel() if dynamics is None else dynamics
+    lim = checked_limits(robot, dyn, tension_margin, tipping_margin, max_speed, max_accel,
+                         smoothing)
+    rate = as_bounded(rate, "rate", MAX_RATE_HZ, "Hz")
+    return _plan(robot, wp, lim, None if grid is None else as_count(grid, "grid", minimum=1,
+                                                                   maximum=MAX_GRID), rate)
+
+
+def checked_limits(robot: CableRobot, dyn: DynamicsModel, tension_margin: float,
+                   tipping_margin: float, max_speed: float | None, max_accel: float,
+                   smoothing: float) -> _Limits:
+    """The options of :func:`time_optimal_path` validated (fields named) into the
+    constraints' constants."""
     if not isinstance(dyn, DynamicsModel):
         raise InvalidInputError("dynamics", "must be a taut.cdpr.DynamicsModel")
     tm = as_bounded(tension_margin, "tension_margin", float(robot.t_max.max()), "N",
@@ -333,23 +423,23 @@ def time_optimal_path(robot: CableRobot, waypoints: ArrayLike, *,
     tpm = as_bounded(tipping_margin, "tipping_margin", 1e6, "N m", positive=False)
     vcap = None if max_speed is None else as_bounded(max_speed, "max_speed", MAX_SPEED, "m/s")
     acap = as_bounded(max_accel, "max_accel", 1e3 * MAX_SPEED, "m/s^2")
-    rate = as_bounded(rate, "rate", MAX_RATE_HZ, "Hz")
     sm = as_bounded(smoothing, "smoothing", 10.0, "s", positive=False)
-    lim = _limits(dyn, tm, tpm, vcap, acap, sm)
-    return _plan(robot, wp, lim, None if grid is None else as_count(grid, "grid", minimum=1,
-                                                                   maximum=MAX_GRID), rate)
+    return _limits(dyn, tm, tpm, vcap, acap, sm)
 
 
-def _plan(robot: CableRobot, wp: np.ndarray, lim: _Limits, grid: int | None, rate: float
+def _plan(robot: CableRobot, wp: np.ndarray, lim: _Limits, grid: int | None, rate: float,
+          motion_for: Callable[[int, np.ndarray], AnchorMotion | None] | None = None
           ) -> TimedPath:
-    """The engine of :func:`time_optimal_path` on validated inputs."""
+    """The engine of :func:`time_optimal_path` on validated inputs; ``motion_for(k, pts)``
+    gives segment ``k``'s moving exits at its grid points ``pts`` (None: standing)."""
     out: list[list[np.ndarray]] = [[], [], [], []]
     gp, gs, gl, gb, seg_t = [], [], [], [], []
     t0 = 0.0
     for k, (length, e) in enumerate(waypoint_segments(wp)):
         N = grid or max(MIN_GRID, int(np.ceil(GRID_PER_M * length)))
         pts = wp[k] + np.linspace(0.0, length, N + 1)[:, None] * e
-        vmax, ub = _grid_bounds(robot, pts, e, lim)
+        motion = None if motion_for is None else motion_for(k, pts)
+        vmax, ub = _grid_bounds(robot, pts, e, lim, motion)
         bad = ~((ub[:, 0] <= REST_ACCEL_SLACK) & (ub[:, 1] >= -REST_ACCEL_SLACK))
         if bad.any():
             i = int(np.argmax(bad))

@@ -69,6 +69,13 @@ class Base(CompactRepr):
     friction_sides : int
         Number of faces (>= 3) of the linearised friction pyramid (inscribed in the cone,
         so conservative by at most ``1 - cos(pi / friction_sides)``; default 8: 7.6 %).
+    acceleration : (3,), default (0, 0, 0)
+        Translational acceleration of a mobile base in the world frame, m/s^2 (a base
+        driving: navigation, or the active base moving in task mode). Its d'Alembert force
+        ``-mass * acceleration`` acts at ``com`` and enters the tipping moments (FASTKIT
+        eqs. 21-23, :attr:`CableRobot.edge_weight_moment`) and the sliding condition with
+        the weight, i.e. the base feels the effective gravity ``g - acceleration``.
+        Ignored for a fixed frame.
     """
 
     name: str
@@ -82,6 +89,7 @@ class Base(CompactRepr):
     stabilisers_deployed: bool = False
     friction: float | None = None
     friction_sides: int = 8
+    acceleration: Any = (0.0, 0.0, 0.0)
     exit_names: tuple[str, ...] = field(init=False)
     exit_local: np.ndarray = field(init=False, repr=False)
 
@@ -97,6 +105,8 @@ class Base(CompactRepr):
         object.__setattr__(self, "exit_points", MappingProxyType(dict(zip(names, pts))))
         object.__setattr__(self, "pose", as_array(self.pose, f"{f}.pose", shape=(3,)))
         object.__setattr__(self, "com", as_array(self.com, f"{f}.com", shape=(3,)))
+        object.__setattr__(self, "acceleration", as_array(self.acceleration,
+                                                          f"{f}.acceleration", shape=(3,)))
         object.__setattr__(self, "mass", as_finite_scalar(self.mass, f"{f}.mass"))
         if self.friction is not None:
             mu = as_finite_scalar(self.friction, f"{f}.friction")
@@ -122,6 +132,11 @@ class Base(CompactRepr):
         if not _inside_convex(fp, self.com[:2]):
             raise InvalidModelError(f"{f}.com", "centre of mass lies outside the wheel "
                                                 "footprint: the base tips over unloaded")
+
+    def effective_gravity(self, gravity: np.ndarray) -> np.ndarray:
+        """``gravity - acceleration`` (3,), m/s^2: the base's weight and its d'Alembert
+        inertial force together are ``mass * effective_gravity(g)`` at ``com``."""
+        return np.asarray(gravity, dtype=float) - self.acceleration
 
     @property
     def rotation(self) -> np.ndarray:

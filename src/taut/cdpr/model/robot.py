@@ -28,7 +28,7 @@ from ..._validate import as_flag, require_instance, require_instances
 from ..._repr import CompactRepr
 
 __all__ = ["Base", "Platform", "Payload", "Cable", "CableRobot", "check_footprint",
-           "with_stabilisers", "with_friction"]
+           "with_stabilisers", "with_friction", "with_base_acceleration"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -75,7 +75,10 @@ class CableRobot(CompactRepr):
         world frame, counter-clockwise (FASTKIT's ``c_j`` and ``u_Cj``).
     edge_base : ndarray (E,) of int
     edge_weight_moment : ndarray (E,)
-        ``u_Cj . ((g - c_j) x w_g)``: moment of the base weight about each edge, N m (< 0).
+        ``u_Cj . ((g - c_j) x w_g)``: moment of the base weight about each edge, N m (< 0
+        at rest), with ``g`` the base centre of mass and ``w_g = m_b (g_vec - a_b)``: the
+        weight plus the d'Alembert force of the base's own acceleration ``a_b``
+        (:attr:`Base.acceleration`, zero unless the base drives).
     """
 
     bases: tuple[Base, ...]
@@ -202,7 +205,7 @@ class CableRobot(CompactRepr):
             d = np.roll(c, -1, axis=0) - c
             d /= np.linalg.norm(d, axis=1, keepdims=True)
             com = base.to_world(base.com)
-            wg = base.mass * g
+            wg = base.mass * base.effective_gravity(g)      # weight + d'Alembert force
             pts.append(c)
             dirs.append(d)
             eb.append(np.full(len(c), k))
@@ -284,4 +287,29 @@ def with_stabilisers(robot: CableRobot, *, deployed: bool = True) -> CableRobot:
     bases = tuple(replace(b, exit_points=dict(b.exit_points),
                           stabilisers_deployed=bool(deployed and b.stabilisers is not None))
                   if b.mobile else b for b in robot.bases)
+    return replace(robot, bases=bases)
+
+
+def with_base_acceleration(robot: CableRobot, acceleration: Any) -> CableRobot:
+    """The same robot with every mobile base accelerating at ``acceleration`` (3,) m/s^2,
+    world frame (coupled bases translating together, e.g. navigation mode; rotation
+    neglected), or base ``k`` at row ``k`` of a (K, 3) array (one base driving in task mode):
+    their d'Alembert forces enter tipping and sliding (:attr:`Base.acceleration`).
+
+    Examples
+    --------
+    >>> from taut.io.cdpr_model import load_cdpr_model
+    >>> robot = load_cdpr_model("fastkit")
+    >>> a = with_base_acceleration(robot, [0.25, 0, 0])
+    >>> bool((a.edge_weight_moment != robot.edge_weight_moment).any())
+    True
+    """
+    require_instance(robot, CableRobot, "robot")
+    acc = as_array(acceleration, "acceleration")
+    if acc.shape == (3,):
+        acc = np.tile(acc, (len(robot.bases), 1))
+    acc = as_array(acc, "acceleration", shape=(len(robot.bases), 3))
+    from dataclasses import replace
+    bases = tuple(replace(b, exit_points=dict(b.exit_points), acceleration=a)
+                  if b.mobile else b for b, a in zip(robot.bases, acc))
     return replace(robot, bases=bases)

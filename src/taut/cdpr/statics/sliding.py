@@ -19,7 +19,10 @@ the pyramid of ``P = friction_sides`` faces *inscribed* in it,
     ``d_j . f_k <= mu_k cos(pi / P) N_k``,   ``d_j = (cos(2 pi j / P), sin(2 pi j / P))``,
 
 i.e. ``sum_i t_i (d_j . u_i,xy - mu_k cos(pi / P) u_iz) <= -mu_k cos(pi / P) m_k g_z``:
-P rows per base, linear in ``t``. Inscribed, so the condition is conservative (it may call
+P rows per base, linear in ``t``. A base accelerating at ``a_k``
+(:attr:`~taut.cdpr.Base.acceleration`) feels its d'Alembert force too: ``g`` becomes the
+effective gravity ``g_e = g - a_k`` in ``F_k``, so the right-hand side is
+``m_k (d_j . g_e,xy - mu_k cos(pi / P) g_e,z)``. Inscribed, so the condition is conservative (it may call
 a pose sliding that holds by at most ``1 - cos(pi / P)`` of the friction force) and never
 optimistic. ``mu_k = 0`` leaves ``d_j . f_k <= 0`` for all j, i.e. ``f_k = 0``: a
 frictionless floor resists no horizontal pull.
@@ -60,7 +63,8 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
         One row per pyramid face of every mobile base with a friction coefficient (N per N
         of tension; F = 0 when no base has one).
     s : (F,)
-        ``-mu_k cos(pi / P) m_k g_z``, N.
+        ``m_k (d_j . g_e,xy - mu_k cos(pi / P) g_e,z)``, N (``-mu_k cos(pi / P) m_k g_z``
+        for a base at rest).
     base : (F,) int
         Base index of each row.
 
@@ -81,7 +85,6 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
     unit = as_array(unit, "unit", shape=(None, robot.m, 3))
     B, m, _ = unit.shape
     rows, rhs, owner = [], [], []
-    g_z = float(robot.gravity[2])
     for k, base in enumerate(robot.bases):
         if not base.mobile or base.friction is None:
             continue
@@ -90,7 +93,8 @@ def sliding_rows(robot: CableRobot, unit: np.ndarray) -> tuple[np.ndarray, np.nd
         on = (robot.cable_base == k).astype(float)                            # (m,)
         coef = np.einsum("pj,bmj->bpm", d, unit[..., :2]) - mu_c * unit[:, None, :, 2]
         rows.append(coef * on[None, None, :])
-        rhs.append(np.full(len(d), -mu_c * base.mass * g_z))
+        ge = base.effective_gravity(robot.gravity)           # weight + d'Alembert force
+        rhs.append(base.mass * (d @ ge[:2] - mu_c * ge[2]))
         owner.append(np.full(len(d), k))
     if not rows:
         return np.zeros((B, 0, m)), np.zeros(0), np.zeros(0, dtype=np.intp)
