@@ -30,11 +30,22 @@ demo: $(DEMO_STAMP)
 
 # `taut compile` returns at once when the kernels are cached; after a kernel edit it
 # compiles them once here, not in the middle of the tests.
+# The suite runs on one pytest-xdist worker per core (`auto`; TEST_WORKERS=0: one process),
+# each test file whole on one worker (`loadfile`): a module's fixtures are built once and
+# tests/test_readme.py's snippets run in order in one namespace. mypy and the doctests run
+# beside it (mypy from an empty cache is ~40 s of CPU) and print when the suite is done;
+# the target fails if any of the three fails.
+TEST_WORKERS ?= auto
 test: $(STAMP)
 	$(BIN)/taut compile
-	$(BIN)/python -m mypy
-	$(BIN)/python -m pytest -m "not slow and not browser"
-	$(BIN)/python -m pytest --doctest-modules src/taut -p no:cacheprovider
+	@log=$$(mktemp); \
+	{ $(BIN)/python -m mypy; types=$$?; \
+	  $(BIN)/python -m pytest --doctest-modules src/taut -p no:cacheprovider; docs=$$?; \
+	  [ $$types -eq 0 ] && [ $$docs -eq 0 ]; } >$$log 2>&1 & checks=$$!; \
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile -m "not slow and not browser"; \
+	tests=$$?; wait $$checks; checked=$$?; \
+	echo "--- mypy and the doctests:"; cat $$log; rm -f $$log; \
+	[ $$tests -eq 0 ] && [ $$checked -eq 0 ]
 
 # Heavy cases (marked `slow`) and the app's browser tests (a Chromium each, seconds per test);
 # CI runs them after `make test`. Exit 5 = none collected.

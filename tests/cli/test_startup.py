@@ -11,6 +11,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).parent.parent.parent
 EXAMPLE1 = str(ROOT / "examples" / "sheet" / "example1.yaml")
 #: Modules `taut fk` (no --plot) must not load: other domains, figures, numba (a
@@ -60,6 +62,9 @@ def _cpu(args: list[str]) -> float:
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+# A timing bound (~3.5 s of CPU in interleaved interpreter starts): the slow target, which
+# CI runs, like the app's latency bound; test_fk_loads_only_what_fk_needs stays fast.
+@pytest.mark.slow
 def test_startup_budget_as_a_ratio_to_importing_numpy():
     runs: dict[str, list[float]] = {"numpy": [], "version": [], "fk": []}
     cmds = {"numpy": ["-c", "import numpy"], "version": ["-m", "taut", "--version"],

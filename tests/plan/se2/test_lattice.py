@@ -154,6 +154,9 @@ def test_neighbour_table_matches_offsets(small):
     assert np.allclose(grid.cells[grid.start_cell], sc.start)
 
 
+# ~5 s of CPU: the slow target (CI runs it); test_lattice_plan_changes_formation_and_is_verified
+# keeps a lattice formation change in the fast suite.
+@pytest.mark.slow
 def test_two_formation_changes_in_an_l_corridor():
     """Suite scenario 2034 (7 robots, L-shaped corridor): the lattice crosses the first
     low obstacle, changes formation to cross one taller, and changes again in the
