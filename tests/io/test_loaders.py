@@ -141,25 +141,3 @@ def test_model_file_with_a_bomb_in_its_dynamics_is_refused_fast(fastkit, tmp_pat
     assert time.perf_counter() - t0 < 1.0
     assert err.value.field == str(path)
     assert main(["cdpr", "tensions", str(path), "--pose", "0", "0", "1"]) == 2
-
-
-def test_boolean_check_reports_the_first_in_file_order_at_any_depth():
-    """validate_mapping's boolean check walks the data without recursion: a free-form
-    field nested deeper than a recursive walk could go (two frames a level) is validated,
-    and a boolean read as a number is named at its first location in the file."""
-    from typing import Any
-
-    from pydantic import BaseModel
-
-    from taut.io import parse_mapping, validate_mapping
-
-    class Model(BaseModel):
-        x: list[float] = []
-        free: Any = None
-
-    deep = parse_mapping('{"free": ' + "[" * 700 + "true" + "]" * 700 + "}", "f",
-                         suffix=".json")
-    assert validate_mapping(Model, deep).x == []
-    with pytest.raises(ScenarioError) as err:
-        validate_mapping(Model, {"free": [True], "x": [1.0, True, False]})
-    assert err.value.field == "x[1]" and "boolean" in err.value.problem

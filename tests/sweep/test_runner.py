@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from taut.errors import SweepError
-from taut.sweep import read_results, run_sweep
+from taut.sweep import read_results, run_sweep, sweep_from_mapping
 
 
 def _serial(spec, tmp_path, name="serial"):
@@ -98,6 +98,54 @@ def test_a_killed_worker_loses_and_duplicates_nothing(fk_spec, tmp_path, same_ro
     cols, _ = read_results(tmp_path / "dask")
     np.testing.assert_array_equal(cols["point"], np.arange(180))
     same_rows(cols, _serial(spec, tmp_path)[0])
+
+
+def _dask_logs(client):
+    """Every debugging log Dask keeps in the sweep's process (a local cluster's scheduler
+    runs there): name -> deque."""
+    sched = client.cluster.scheduler
+    logs = {"transitions": sched.transition_log,
+            "client stream": client.scheduler_comm.recent_message_log}
+    logs.update({f"event topic {k}": t.events for k, t in sched._broker._topics.items()})
+    logs.update({f"stream to {k}": b.recent_message_log
+                 for k, b in {**sched.stream_comms, **sched.client_comms}.items()})
+    return logs
+
+
+@pytest.mark.slow
+def test_the_clients_dask_logs_stay_bounded_however_many_chunks(examples_dir, tmp_path,
+                                                                monkeypatch):
+    """Issue 32: the 10^7-point run's client grew ~10 kB a chunk: Dask's debugging logs
+    (1,000 entries each by default: task specs of recent messages, an event per submitted
+    chunk) live in the client's process with a local cluster. A run of 3x as many
+    chunks as the bound leaves every log within it, and some log full (so the bound, not
+    the run's length, is what limits it)."""
+    pytest.importorskip("distributed")
+    from taut.sweep import runner
+
+    opened = []
+
+    def keep(workers, scheduler):
+        client = open_client(workers, scheduler)
+        opened.append(client)
+        return client
+
+    open_client = runner._open_client
+    monkeypatch.setattr(runner, "_open_client", keep)
+    n = 3 * runner.DASK_LOG_ENTRIES
+    seen = {}
+
+    def inspect(done, total):
+        if done == total:
+            seen.update({k: (len(v), v.maxlen) for k, v in _dask_logs(opened[0]).items()})
+
+    spec = sweep_from_mapping({"task": "fk_stability_map", "chunk_size": 1,
+                               "base": "examples/sheet/example2_r2_r4_353mm.yaml",
+                               "parameters": {"scale": {"range": [0.6, 1.0], "num": n}}},
+                              examples_dir.parent)
+    assert run_sweep(spec, tmp_path / "dask", workers=1, progress=inspect).success
+    assert seen and all(size <= runner.DASK_LOG_ENTRIES for size, _ in seen.values()), seen
+    assert max(size for size, _ in seen.values()) == runner.DASK_LOG_ENTRIES, seen
 
 
 @pytest.mark.slow

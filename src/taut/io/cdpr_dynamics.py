@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict
 
 from ..cdpr.control.dynamics import DynamicsModel
 from .cdpr_model import preset_path
-from .files import read_mapping, validate_mapping
+from .files import Number, read_mapping, validate_mapping
 
 __all__ = ["load_cdpr_dynamics", "dynamics_from_mapping"]
 
@@ -29,24 +29,24 @@ class _Dynamics(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
     # Defaults live in DynamicsModel only: a key left out keeps its default there; an
     # explicit null reaches DynamicsModel and is refused by its own checks.
-    cable_stiffness: Optional[float] = None
-    cable_damping: Optional[float] = None
-    drum_diameter: Optional[float] = None
-    gear_ratio: Optional[float] = None
-    efficiency: Optional[float] = None
-    backdrive_efficiency: Optional[float] = None
-    rated_torque: Optional[float] = None
-    peak_torque: Optional[float] = None
-    peak_duration: Optional[float] = None
-    motor_speed_limit: Optional[float] = None
-    rotor_inertia: Optional[float] = None
-    friction_static: Optional[float] = None
-    friction_coulomb: Optional[float] = None
-    friction_viscous: Optional[float] = None
-    stribeck_speed: Optional[float] = None
-    drive_speed_gain: Optional[float] = None
-    drive_integral_gain: Optional[float] = None
-    routing_length: Optional[Union[float, list[float]]] = None
+    cable_stiffness: Optional[Number] = None
+    cable_damping: Optional[Number] = None
+    drum_diameter: Optional[Number] = None
+    gear_ratio: Optional[Number] = None
+    efficiency: Optional[Number] = None
+    backdrive_efficiency: Optional[Number] = None
+    rated_torque: Optional[Number] = None
+    peak_torque: Optional[Number] = None
+    peak_duration: Optional[Number] = None
+    motor_speed_limit: Optional[Number] = None
+    rotor_inertia: Optional[Number] = None
+    friction_static: Optional[Number] = None
+    friction_coulomb: Optional[Number] = None
+    friction_viscous: Optional[Number] = None
+    stribeck_speed: Optional[Number] = None
+    drive_speed_gain: Optional[Number] = None
+    drive_integral_gain: Optional[Number] = None
+    routing_length: Optional[Union[Number, list[Number]]] = None
 
 
 class _Section(BaseModel):

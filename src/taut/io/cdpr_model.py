@@ -29,15 +29,15 @@ from pydantic import BaseModel, ConfigDict, Field
 from .._units import GRAVITY
 from ..cdpr.model.robot import Base, Cable, CableRobot, Payload, Platform
 from ..errors import InvalidModelError, ScenarioError, TautError
-from .files import read_mapping, validate_mapping
+from .files import Number, read_mapping, validate_mapping
 from .._validate import MAX_CDPR_LENGTH_M, MAX_MASS_KG, as_path, check_range
 
 __all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
 
 PRESETS = ("fastkit", "ipanema", "fastkit_fc")
 
-Vec3 = tuple[float, float, float]
-Vec2 = tuple[float, float]
+Vec3 = tuple[Number, Number, Number]
+Vec2 = tuple[Number, Number]
 
 
 class _Strict(BaseModel):
@@ -53,23 +53,23 @@ class _Base(_Strict):
     name: str
     mobile: bool = False
     pose: Vec3 = (0.0, 0.0, 0.0)
-    mass: float = 0.0
+    mass: Number = 0.0
     com: Vec3 = (0.0, 0.0, 0.0)
     footprint: list[Vec2] | None = None
     stabilisers: _Stabilisers | None = None
     exit_points: dict[str, Vec3] = Field(min_length=1)
-    friction: float | None = None       # ground friction coefficient (sliding condition)
+    friction: Number | None = None       # ground friction coefficient (sliding condition)
 
 
 class _Platform(_Strict):
-    mass: float = 0.0
+    mass: Number = 0.0
     com: Vec3 = (0.0, 0.0, 0.0)
     inertia: Vec3 | tuple[Vec3, Vec3, Vec3] = (0.0, 0.0, 0.0)
     attachment_points: dict[str, Vec3] = Field(min_length=1)
 
 
 class _Payload(_Strict):
-    mass: float = 0.0
+    mass: Number = 0.0
     com: Vec3 = (0.0, 0.0, 0.0)
     inertia: Vec3 | tuple[Vec3, Vec3, Vec3] = (0.0, 0.0, 0.0)
 
@@ -78,8 +78,8 @@ class _Cable(_Strict):
     name: str
     exit: str
     attachment: str
-    t_min: float
-    t_max: float
+    t_min: Number
+    t_max: Number
 
 
 class _Box(_Strict):
@@ -100,7 +100,7 @@ class _ModelFile(_Strict):
     # Elastic cables and winches, read by taut.io.cdpr_dynamics (key names and ranges
     # validated there); here already a flat mapping of numbers (routing_length: a number
     # or a list of numbers), never free-form data.
-    dynamics: dict[str, Optional[float | list[float]]] | None = None
+    dynamics: dict[str, Optional[Number | list[Number]]] | None = None
 
 
 def _file_field(exc: TautError, raw: _ModelFile) -> str:

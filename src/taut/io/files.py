@@ -3,8 +3,9 @@ name the offending field. Every loader in :mod:`taut.io` (and the sweep file, an
 app's uploads) goes through these functions.
 
 Two silent conversions are refused: a key given twice in one mapping (YAML and JSON
-parsers keep the last value) and a boolean where a number is expected (pydantic's lax
-mode reads ``hold_height: true`` as 1).
+parsers keep the last value, refused by the parser here) and a boolean or a string where a
+number is expected (pydantic's lax mode reads ``hold_height: true`` as 1): every file
+model types its numbers :data:`Number` and :data:`Integer`, pydantic's strict types.
 
 Files that could exhaust the machine are refused in one line before any work: a file
 larger than :data:`MAX_FILE_BYTES` (YAML text longer than :data:`MAX_YAML_CHARS`: its
@@ -26,19 +27,28 @@ import os
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Annotated, Any, TypeVar
 
 import yaml
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, Strict, ValidationError
 
 from ..errors import InvalidInputError, ScenarioError
 from .._validate import as_path, require_instance
 
 __all__ = ["read_text", "read_mapping", "parse_mapping", "validate_mapping", "write_json",
            "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
-           "MAX_YAML_CHARS"]
+           "MAX_YAML_CHARS", "Number", "Integer"]
 
 M = TypeVar("M", bound=BaseModel)
+
+#: A number in a file model: a float, or an integer read as a float; never a boolean or
+#: a string (pydantic's lax ``float`` reads ``true`` as 1.0 and ``"2"`` as 2.0).
+Number = Annotated[float, Strict()]
+#: An integer in a file model; never a boolean, a float or a string.
+Integer = Annotated[int, Strict()]
+#: Error types of :data:`Number` and :data:`Integer` given a boolean: reported as
+#: "must be a number, got a boolean", the wording of :mod:`taut._validate` for the API.
+_NUMBER_ERRORS = frozenset({"float_type", "int_type"})
 
 #: Largest input file read, bytes (scenarios, models, sweeps, trajectories: a few kB to a
 #: few MB in practice).
@@ -57,20 +67,43 @@ os.umask(_UMASK)
 
 
 def read_text(path: str | Path) -> str:
-    """The UTF-8 text of a file; a missing or unreadable file is a :class:`ScenarioError`
-    naming the path."""
+    """The UTF-8 text of a file, without a leading byte-order mark (U+FEFF, which
+    spreadsheet programs write and which would otherwise stick to the first cell or key).
+
+    Raises
+    ------
+    ScenarioError
+        Naming the path: missing, a directory or another non-regular file (a FIFO is
+        refused without opening it, so it cannot block), larger than
+        :data:`MAX_FILE_BYTES`, unreadable, or not UTF-8 (naming the line and byte).
+    """
     path = as_path(path)
     p = Path(path)
     if not p.is_file():
-        raise ScenarioError(str(path), "file not found")
+        raise ScenarioError(str(path), _not_a_file(p))
     try:
         size = p.stat().st_size
         if size > MAX_FILE_BYTES:
             raise ScenarioError(str(path), f"file is {size / 2**20:.0f} MiB; at most "
                                            f"{MAX_FILE_BYTES // 2**20} MiB are read")
-        return p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+        data = p.read_bytes()
+    except OSError as exc:
         raise ScenarioError(str(path), f"cannot read file ({exc.__class__.__name__})") from None
+    try:
+        return data.decode("utf-8").removeprefix("\ufeff")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise ScenarioError(f"{path}:{line}", f"not UTF-8 text (byte {exc.start + 1} of "
+                                              "the file)") from None
+
+
+def _not_a_file(p: Path) -> str:
+    """Why ``p``, which is not a regular file, cannot be read."""
+    if p.is_dir():
+        return "is a directory, not a file"
+    if p.exists():
+        return "is not a regular file (a FIFO, socket or device); save it as a file"
+    return "file not found"
 
 
 _SafeBase: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -234,37 +267,6 @@ def _location(loc: tuple[Any, ...]) -> str:
     return out or "(top level)"
 
 
-def _booleans(data: Any) -> Iterator[tuple[Any, ...]]:
-    """Locations of the boolean values in parsed file data, in file order.
-
-    A loop over an explicit stack, not a recursion: a model with a free-form field (an
-    ``Any``) accepts data nested as deep as the parser allows (about 1,000 levels),
-    deeper than a recursive walk (two frames a level on Python 3.11) could follow."""
-    stack: list[tuple[Any, tuple[Any, ...]]] = [(data, ())]
-    while stack:
-        value, loc = stack.pop()
-        if isinstance(value, bool):
-            yield loc
-        elif isinstance(value, (dict, list)):
-            items = value.items() if isinstance(value, dict) else enumerate(value)
-            stack.extend((v, loc + (k,)) for k, v in reversed(list(items))
-                         if isinstance(v, (bool, dict, list)))
-
-
-def _at(obj: Any, loc: tuple[Any, ...]) -> Any:
-    """The validated value at ``loc`` (attribute, key or index steps), or ``_NOT_FOUND``."""
-    for part in loc:
-        try:
-            if isinstance(part, int) or isinstance(obj, dict):
-                obj = obj[part]
-            else:
-                obj = getattr(obj, str(part))
-        except (KeyError, IndexError, AttributeError, TypeError):
-            return _NOT_FOUND
-    return obj
-
-
-_NOT_FOUND = object()
 #: Steps pydantic adds to an error's location to say which branch of a union failed.
 _UNION_TAGS = frozenset({"float", "int", "str", "bool", "none"})
 
@@ -284,33 +286,42 @@ def _data_loc(data: Any, loc: tuple[Any, ...]) -> tuple[Any, ...]:
     return tuple(out)
 
 
+def _first_error(data: Any, errors: list[Any]) -> tuple[Any, tuple[Any, ...]]:
+    """The error to report and its location in the file: the first error, or, when the
+    value there failed every branch of a union (``3`` or ``[3, 4]``), the branch error
+    deepest inside it (``routing_length[1]`` rather than ``routing_length``: not a
+    number)."""
+    best, where = errors[0], _data_loc(data, errors[0]["loc"])
+    for err in errors[1:]:
+        loc = _data_loc(data, err["loc"])
+        if loc[:len(where)] == where and len(loc) > len(where):
+            best, where = err, loc
+    return best, where
+
+
 def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
     """Validate ``data`` against a pydantic model; the first error becomes a
     :class:`ScenarioError` whose field is the dotted path (``sheet[2]``, ``cables[0].max``).
 
-    A boolean in the file that the model turned into a number is an error too (pydantic's
-    lax mode accepts ``true`` for a float); booleans kept as booleans are fine. This check
-    is needed while a model has lax floats (the sheet, plan, cable-robot, dynamics and
-    warehouse files); the sweep file's strict numbers refuse a boolean themselves."""
+    A boolean where the model expects a number is refused by the model's own types
+    (:data:`Number`, :data:`Integer`): one validation pass, no second walk over the data.
+    """
     if not (isinstance(model, type) and issubclass(model, BaseModel)):
         raise ScenarioError("model", "must be a pydantic model class")
     require_instance(data, dict, "data")
     try:
         validated = model.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = _location(_data_loc(data, err["loc"]))
+        err, where = _first_error(data, exc.errors())
+        loc = _location(where)
         msg = err["msg"]
-        if err["type"] == "extra_forbidden":
+        if err["type"] in _NUMBER_ERRORS and isinstance(err.get("input"), bool):
+            msg = "must be a number, got a boolean"
+        elif err["type"] == "extra_forbidden":
             msg = "unknown key"
         elif err["type"] == "missing":
             msg = "required key is missing"
         raise ScenarioError(loc, msg[0].lower() + msg[1:]) from None
-    for where in _booleans(data):
-        value = _at(validated, where)
-        if value is not _NOT_FOUND and not isinstance(value, bool) \
-                and isinstance(value, (int, float)):
-            raise ScenarioError(_location(where), "must be a number, got a boolean")
     return validated
 
 

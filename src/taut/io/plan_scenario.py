@@ -31,32 +31,32 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from ..errors import ScenarioError, TautError
 from ..plan.world import MAX_TEAM_ROBOTS, Obstacle, Scenario, Team, World
 from ..sheet import Sheet, SheetTeam
-from .files import read_mapping, validate_mapping
+from .files import Integer, Number, read_mapping, validate_mapping
 from .._validate import require_instance
 
 __all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]
 
-Point = tuple[float, float]
+Point = tuple[Number, Number]
 
 
 class _Regular(BaseModel):
     model_config = ConfigDict(extra="forbid")
-    n: int = Field(ge=3)
-    circumradius: float = Field(gt=0, allow_inf_nan=False)
-    phase: float = Field(default=0.0, allow_inf_nan=False)
+    n: Integer = Field(ge=3)
+    circumradius: Number = Field(gt=0, allow_inf_nan=False)
+    phase: Number = Field(default=0.0, allow_inf_nan=False)
 
 
 class _Team(BaseModel):
     model_config = ConfigDict(extra="forbid")
     sheet: list[Point] | None = None
     regular: _Regular | None = None
-    hold_height: float = Field(gt=0, allow_inf_nan=False)
-    robot_radius: float = Field(gt=0, allow_inf_nan=False)
-    height_safety: float = Field(ge=0, allow_inf_nan=False)
-    lateral_safety: float = Field(ge=0, allow_inf_nan=False)
-    speed: float = Field(gt=0, allow_inf_nan=False)
-    rotation_speed: float = Field(gt=0, allow_inf_nan=False)
-    mass: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    hold_height: Number = Field(gt=0, allow_inf_nan=False)
+    robot_radius: Number = Field(gt=0, allow_inf_nan=False)
+    height_safety: Number = Field(ge=0, allow_inf_nan=False)
+    lateral_safety: Number = Field(ge=0, allow_inf_nan=False)
+    speed: Number = Field(gt=0, allow_inf_nan=False)
+    rotation_speed: Number = Field(gt=0, allow_inf_nan=False)
+    mass: Number | None = Field(default=None, gt=0, allow_inf_nan=False)
 
     @model_validator(mode="after")
     def _one_sheet(self):
@@ -67,10 +67,10 @@ class _Team(BaseModel):
 
 class _Obstacle(BaseModel):
     model_config = ConfigDict(extra="forbid")
-    id: str | int
-    height: float = Field(gt=0, allow_inf_nan=False)
+    id: Integer | str
+    height: Number = Field(gt=0, allow_inf_nan=False)
     center: Point | None = None
-    radius: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    radius: Number | None = Field(default=None, gt=0, allow_inf_nan=False)
     polygon: list[Point] | None = None
 
     @model_validator(mode="after")

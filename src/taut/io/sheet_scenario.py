@@ -21,18 +21,18 @@ from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, check_range
 from ..errors import ScenarioError, TautError
 from ..sheet.model import Sheet, check_formation
 from ..sheet.team import SheetTeam
-from .files import read_mapping, validate_mapping
+from .files import Number, read_mapping, validate_mapping
 from .._repr import CompactRepr
 
 __all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"]
 
-Point = tuple[float, float]
+Point = tuple[Number, Number]
 
 
 class _ObjectFile(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=False)
 
-    radius: float = Field(gt=0, allow_inf_nan=False)
+    radius: Number = Field(gt=0, allow_inf_nan=False)
 
 
 class _SheetScenarioFile(BaseModel):
@@ -40,8 +40,8 @@ class _SheetScenarioFile(BaseModel):
 
     name: str | None = None
     units: str | None = None
-    hold_height: float = Field(allow_inf_nan=False)
-    mass: float | None = Field(default=None, allow_inf_nan=False)
+    hold_height: Number = Field(allow_inf_nan=False)
+    mass: Number | None = Field(default=None, allow_inf_nan=False)
     sheet: list[Point]
     formation: list[Point] | None = None
     object: _ObjectFile | None = None

@@ -27,13 +27,13 @@ from pydantic import BaseModel, ConfigDict, Field
 from ..cdpr.mission.warehouse import SHELF_HEIGHT, Shelf, Task, Warehouse
 from ..errors import ScenarioError, TautError
 from .cdpr_model import load_cdpr_model
-from .files import read_mapping, validate_mapping
+from .files import Number, read_mapping, validate_mapping
 from .._validate import as_path
 
 __all__ = ["load_warehouse", "warehouse_from_mapping"]
 
-Vec3 = tuple[float, float, float]
-Vec2 = tuple[float, float]
+Vec3 = tuple[Number, Number, Number]
+Vec2 = tuple[Number, Number]
 
 
 class _Strict(BaseModel):
@@ -43,14 +43,14 @@ class _Strict(BaseModel):
 class _Shelf(_Strict):
     name: str = Field(min_length=1)
     footprint: list[Vec2] = Field(min_length=3)
-    height_m: float = SHELF_HEIGHT
+    height_m: Number = SHELF_HEIGHT
 
 
 class _Task(_Strict):
     name: str = Field(min_length=1)
     pick: Vec3
     place: Vec3
-    mass: float
+    mass: Number
 
 
 class _WarehouseFile(_Strict):
@@ -60,13 +60,13 @@ class _WarehouseFile(_Strict):
     shelves: list[_Shelf] = []
     start: Vec3
     tasks: list[_Task] = Field(min_length=1)
-    gripper_reach_m: float = 1.0
-    standoff_m: float = 0.95
-    clearance_m: float = 0.1
-    friction: Optional[float] = 0.5
-    max_speed_m_s: float = 0.5
-    max_accel_m_s2: float = 0.25
-    max_turn_rate_rad_s: float = 0.2
+    gripper_reach_m: Number = 1.0
+    standoff_m: Number = 0.95
+    clearance_m: Number = 0.1
+    friction: Optional[Number] = 0.5
+    max_speed_m_s: Number = 0.5
+    max_accel_m_s2: Number = 0.25
+    max_turn_rate_rad_s: Number = 0.2
 
 
 #: File key of each Warehouse field whose name differs.

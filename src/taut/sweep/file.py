@@ -39,7 +39,7 @@ from pydantic import BaseModel, ConfigDict, Discriminator, Field, Strict, Tag
 
 from .._validate import MAX_CDPR_LENGTH_M, as_path
 from ..errors import ScenarioError, SweepError
-from ..io.files import read_mapping, read_text, validate_mapping
+from ..io.files import Integer, Number, read_mapping, read_text, validate_mapping
 from .registry import TASKS
 from .spec import DISTRIBUTIONS, Parameter, SweepSpec, _choice
 
@@ -64,7 +64,7 @@ TASK_OPTIONS: dict[str, dict[str, str]] = {
 # --- The file's shape, as pydantic models (strict: a boolean or a string is no number) ---
 
 #: A finite number (an integer is accepted as a float; a boolean is not).
-_Number = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+_Number = Annotated[Number, Field(allow_inf_nan=False)]
 
 
 def _shape(value: Any) -> str:
@@ -80,7 +80,7 @@ class _Axis(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
     range: list[_Number] | None = None
-    num: Annotated[int, Strict(), Field(ge=1, le=MAX_AXIS)] | None = None
+    num: Annotated[Integer, Field(ge=1, le=MAX_AXIS)] | None = None
     step: _Number | None = None
     values: Annotated[list[_Number], Field(min_length=1)] | None = None
 
@@ -106,7 +106,7 @@ class _Options(BaseModel):
     """Task options; which ones a task takes is checked against :data:`TASK_OPTIONS`."""
 
     model_config = ConfigDict(extra="allow")
-    grid: list[Annotated[int, Strict(), Field(ge=1, le=MAX_GRID_POINTS)]] | None = None
+    grid: list[Annotated[Integer, Field(ge=1, le=MAX_GRID_POINTS)]] | None = None
     box: list[list[_Number]] | None = None
 
 
@@ -115,9 +115,9 @@ class _SweepFile(BaseModel):
     task: Annotated[str, Strict()]
     base: Annotated[str, Strict()] | None = None
     mode: Literal["grid", "random"] = "grid"
-    seed: Annotated[int, Strict(), Field(ge=0, le=2**63 - 1)] = 0
-    samples: Annotated[int, Strict(), Field(ge=1, le=MAX_POINTS)] | None = None
-    chunk_size: Annotated[int, Strict(), Field(ge=0, le=MAX_CHUNK)] = 0
+    seed: Annotated[Integer, Field(ge=0, le=2**63 - 1)] = 0
+    samples: Annotated[Integer, Field(ge=1, le=MAX_POINTS)] | None = None
+    chunk_size: Annotated[Integer, Field(ge=0, le=MAX_CHUNK)] = 0
     parameters: dict[str, _Value]
     outputs: list[Annotated[str, Strict()]] = []
     options: _Options = _Options()

@@ -5,8 +5,12 @@ Each chunk is evaluated by :func:`evaluate_chunk`, a pure function of the spec a
 chunk's bounds; the client writes each finished chunk once (as its future completes), so a
 worker that dies mid-chunk only makes Dask recompute that chunk elsewhere: nothing is lost
 or duplicated. The client keeps at most :data:`IN_FLIGHT_PER_WORKER` chunks per worker
-thread submitted at a time and drops each result once written, so its memory does not grow
-with the number of points (measured in ``bench/bench_sweep.py --memory``).
+thread submitted at a time and drops each result once written, and bounds the debugging
+logs Dask keeps in its process (:data:`DASK_LOG_ENTRIES`, :data:`DASK_MONITOR_SAMPLES`), so
+its memory does not grow with the number of points (measured in ``bench/bench_sweep.py
+--memory``, traced with ``--trace``). What remains per chunk: the chunk bounds (~140 B a
+chunk, 67 MB for 10^9 points in chunks of 2,048) and Dask's cache of task-key prefixes
+(``dask.utils.key_split``, ~150 B a chunk, at most 100,000 keys).
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import numpy as np
 
 from .. import __version__
 from .._validate import as_array, as_count, as_flag, as_path, require_instance
-from ..errors import SweepError
+from ..errors import MissingExtraError, SweepError
 from .file import base_model
 from .points import chunk_bounds, chunk_streams, expand, point_seeds
 from .registry import TASKS
@@ -38,6 +42,18 @@ CONNECT_TIMEOUT = 5.0
 #: Chunks submitted but not yet written, per worker thread of the cluster (one running,
 #: one queued so a worker never waits for the client).
 IN_FLIGHT_PER_WORKER = 2
+#: Entries Dask keeps in each of its debugging logs in the process running the sweep
+#: (``distributed.admin.low-level-log-length``, default 1,000): the last messages of every
+#: connection (a chunk's task spec, ~1-2 kB, per message), the scheduler's event topics
+#: (an ``update-graph`` event per submitted chunk) and its transition log. A local
+#: cluster's scheduler runs in this process, so at the default these grew the client by
+#: ~10 kB a chunk over the first ~1,000 chunks (traced with tracemalloc; the "4 MiB a
+#: million points" of the 10^7 run).
+DASK_LOG_ENTRIES = 50
+#: Samples the scheduler's system monitor keeps (``distributed.admin.system-monitor.
+#: log-length``, default 7,200: an hour at its 0.5 s interval, ~10 series) for the
+#: dashboard: 60 s here.
+DASK_MONITOR_SAMPLES = 120
 
 _CONTEXTS: dict[str, Any] = {}
 
@@ -119,11 +135,23 @@ def evaluate_chunk(spec: SweepSpec, start: int, stop: int,
 
 
 def _connect(workers: int | None, scheduler: str | None) -> Any:
+    """A client of ``scheduler``, else of a new local cluster, whose Dask logs in this
+    process are bounded by :data:`DASK_LOG_ENTRIES` and :data:`DASK_MONITOR_SAMPLES` (each
+    log's length is read when the scheduler, a connection or the client is created)."""
     try:
-        from distributed import Client, LocalCluster
-    except ImportError:  # pragma: no cover - depends on the install
-        raise SweepError("workers", "parallel sweeps need dask.distributed: pip install "
-                         "'taut[sweep]' (or run serially with --workers 0)") from None
+        import dask
+        from distributed import Client  # noqa: F401
+    except ImportError as exc:
+        raise MissingExtraError(exc.name or "distributed") from None
+    with dask.config.set({"distributed.admin.low-level-log-length": DASK_LOG_ENTRIES,
+                          "distributed.admin.system-monitor.log-length":
+                              DASK_MONITOR_SAMPLES}):
+        return _open_client(workers, scheduler)
+
+
+def _open_client(workers: int | None, scheduler: str | None) -> Any:
+    from distributed import Client, LocalCluster
+
     if scheduler is not None:
         try:
             return Client(scheduler, timeout=CONNECT_TIMEOUT)
@@ -247,9 +275,8 @@ def _execute(spec: SweepSpec, bounds: list[tuple[int, int]], todo: list[bool],
         for k, lo, hi, states in pending:
             yield k, _evaluate_part(spec, lo, hi, states)
         return
+    client = _connect(workers, scheduler)          # first: a missing extra is named
     from distributed import as_completed
-
-    client = _connect(workers, scheduler)
     try:
         index: dict[str, int] = {}
         # The spec goes to the workers once; a task names it. Sent with every task, a
