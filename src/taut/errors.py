@@ -9,6 +9,13 @@ parameter name such as ``"formation"``, or a dotted path into a scenario file su
 
 from __future__ import annotations
 
+import importlib
+
+#: Top-level modules of the optional extras -> the extra that installs them.
+EXTRAS = {"mujoco": "physics", "dask": "sweep", "distributed": "sweep", "pyarrow": "sweep",
+          "starlette": "app", "uvicorn": "app", "ompl": "plan-ompl",
+          "selenium": "app-test", "matplotlib": "viz"}
+
 __all__ = [
     "TautError",
     "InvalidInputError",
@@ -20,6 +27,9 @@ __all__ = [
     "InfeasiblePoseError",
     "PlanningError",
     "SweepError",
+    "MissingExtraError",
+    "EXTRAS",
+    "require_extra",
 ]
 
 
@@ -87,3 +97,27 @@ class PlanningError(TautError):
 class SweepError(InvalidInputError):
     """A sweep file or run request is invalid: unknown task, parameter or output, an empty
     range, a scheduler that does not answer, an output folder holding another sweep."""
+
+
+class MissingExtraError(TautError, ImportError):
+    """An optional dependency is not installed. ``field`` is its top-level module (e.g.
+    ``"mujoco"``) and ``extra`` the extra of taut that installs it (:data:`EXTRAS`); the
+    problem is the one line ``not installed; install taut[physics] (pip install
+    'taut[physics]')``. Also an ``ImportError``, which it replaces."""
+
+    def __init__(self, module: str) -> None:
+        top = module.split(".")[0]
+        self.extra = EXTRAS.get(top, top)
+        super().__init__(top, f"not installed; install taut[{self.extra}] (pip install "
+                              f"'taut[{self.extra}]')")
+        self.name = top                         # ImportError's: the module not found
+
+
+def require_extra(module: str) -> None:
+    """Import ``module`` (one of an optional extra's) at an entry point of the library,
+    before any work, so its absence is a :class:`MissingExtraError` naming the extra
+    instead of a ``ModuleNotFoundError`` from deep inside a call."""
+    try:
+        importlib.import_module(module)
+    except ImportError:
+        raise MissingExtraError(module) from None

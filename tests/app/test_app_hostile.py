@@ -637,6 +637,59 @@ def test_job_flood_is_bounded_and_ids_stay_valid(app):
         assert st == 200 and out["state"] in ("running", "done", "error")
 
 
+def _poll(port, token, jid, deadline, pause=0.05):
+    """Poll planning job ``jid`` until it is no longer running (which fetches it once it
+    has finished) or the deadline passes; returns its last state."""
+    state = {"state": "running"}
+    while state["state"] == "running" and time.monotonic() < deadline:
+        time.sleep(pause)
+        state = api(port, token, f"/api/plan/job/{jid}", method="GET")[2]
+    return state
+
+
+def _finish(port, token, sc, deadline):
+    """Submit a planning job and poll it until it has finished; returns its id."""
+    st, _, out, _ = api(port, token, "/api/plan/run", {"scenario": sc})
+    assert st == 200, out
+    state = _poll(port, token, out["job"], deadline)
+    assert state["state"] == "done", state
+    return out["job"]
+
+
+@pytest.mark.slow                       # ~25 s: eleven plans, two steps each
+def test_a_finished_job_stays_fetchable_until_fetched(monkeypatch):
+    """A job that finished while the page was away keeps its id while later jobs are
+    submitted and finish (up to the kept bound, here 2 finished-and-unfetched jobs; the
+    app keeps 16), answers once with its plans, and only then is spent; past the bound the
+    oldest unfetched one is dropped with the 422 saying so."""
+    from taut.app import jobs
+    monkeypatch.setattr(jobs, "_KEEP_JOBS", 2)
+    with one_worker_app() as (_, port, token):
+        deadline = time.monotonic() + 120
+        st, out = 503, {}
+        while st == 503 and time.monotonic() < deadline:           # the worker starts
+            st, _, out, _ = api(port, token, "/api/plan/load",
+                                {"example": "paper_corridor.yaml"})
+        sc = dict(out["scenario"], obstacles=[], goal=[1.6, 0.0])  # a plan in ~1 s
+        first = api(port, token, "/api/plan/run", {"scenario": sc})[2]["job"]
+        unfetched = api(port, token, "/api/plan/run", {"scenario": sc})[2]["job"]
+        for _ in range(jobs.MAX_JOBS + 1):      # more jobs than the queue holds at once;
+            _finish(port, token, sc, deadline)  # jobs run in order: the first two are done
+        st, _, got, _ = api(port, token, f"/api/plan/job/{first}", method="GET")
+        assert st == 200 and got["state"] == "done", got
+        assert got["steps"] == 2 and {"baseline", "plan"} <= set(got), sorted(got)
+        st, _, again, _ = api(port, token, f"/api/plan/job/{first}", method="GET")
+        assert st == 422 and "already fetched" in again["error"]
+        # the bound: with two more finished, unfetched jobs (each known finished when the
+        # job after it is), the next submission drops the oldest unfetched one
+        for _ in range(2):
+            api(port, token, "/api/plan/run", {"scenario": sc})
+            _finish(port, token, sc, deadline)
+        _finish(port, token, sc, deadline)
+        st, _, gone, _ = api(port, token, f"/api/plan/job/{unfetched}", method="GET")
+        assert st == 422 and gone["error"].startswith(f"job: no planning job '{unfetched}'")
+
+
 @pytest.mark.slow
 def test_a_planning_step_past_its_budget_ends_the_job_not_the_app():
     """A planning step (a worker call inside a job) that overruns the app's time budget
@@ -654,10 +707,7 @@ def test_a_planning_step_past_its_budget_ends_the_job_not_the_app():
         while st == 503 and time.monotonic() < deadline:      # scenario check vs. budget
             st, _, job, _ = api(port, token, "/api/plan/run", {"scenario": out["scenario"]})
         assert st == 200, job
-        state = {"state": "running"}
-        while state["state"] == "running" and time.monotonic() < deadline:
-            time.sleep(0.1)
-            state = api(port, token, f"/api/plan/job/{job['job']}", method="GET")[2]
+        state = _poll(port, token, job["job"], deadline, pause=0.1)
         assert state["state"] == "error", state
         assert "took longer than its 0.3 s budget" in state["error"]
         st = 503

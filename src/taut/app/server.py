@@ -45,16 +45,20 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs
 
-import anyio
-from starlette.applications import Starlette
-from starlette.exceptions import HTTPException
-from starlette.requests import Request
-from starlette.responses import FileResponse, JSONResponse, Response
-from starlette.routing import BaseRoute, Mount, Route
-from starlette.staticfiles import StaticFiles
-from starlette.types import ASGIApp, Receive, Scope, Send
+from ..errors import InvalidInputError, MissingExtraError
 
-from ..errors import InvalidInputError
+try:
+    import anyio
+    from starlette.applications import Starlette
+    from starlette.exceptions import HTTPException
+    from starlette.requests import Request
+    from starlette.responses import FileResponse, JSONResponse, Response
+    from starlette.routing import BaseRoute, Mount, Route
+    from starlette.staticfiles import StaticFiles
+    from starlette.types import ASGIApp, Receive, Scope, Send
+except ImportError as exc:                  # the app extra is missing: one line naming it
+    raise MissingExtraError(exc.name or "starlette") from None
+
 from .catalog import Catalog
 from .jobs import PlanJobs
 from .payload import kind_of_mapping

@@ -33,7 +33,7 @@ import typer
 from typer.exceptions import TyperException
 
 from .. import __version__
-from ..errors import TautError
+from ..errors import EXTRAS, MissingExtraError, TautError
 
 #: The root command's settings.
 _APP_OPTIONS: dict[str, Any] = dict(
@@ -140,19 +140,10 @@ def _interrupted(exc: BaseException | None) -> bool:
     return False
 
 
-#: Top-level modules of the optional extras -> the extra that installs them.
-EXTRAS = {"mujoco": "physics", "dask": "sweep", "distributed": "sweep", "pyarrow": "sweep",
-          "starlette": "app", "uvicorn": "app", "ompl": "plan-ompl",
-          "selenium": "app-test", "matplotlib": "viz"}
-
-
 def _missing_extra(exc: ModuleNotFoundError) -> str | None:
     """The one line for an optional dependency that is not installed, else None."""
     top = (exc.name or "").split(".")[0]
-    extra = EXTRAS.get(top)
-    if extra is None:
-        return None
-    return f"{top}: not installed; install taut[{extra}] (pip install 'taut[{extra}]')"
+    return str(MissingExtraError(top)) if top in EXTRAS else None
 
 
 def _stopped() -> int:

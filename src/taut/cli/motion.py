@@ -89,8 +89,8 @@ def register(app: typer.Typer) -> None:
         m = as_mass(mass, "--mass") if mass is not None else None
         sc = load_sheet_scenario(scenario)
         team = sc.team if m is None else replace(sc.team, mass=m)
-        r = inverse_kinematics(team, object_position, contact=contact,
-                               heading=heading)
+        with working("ik"):
+            r = inverse_kinematics(team, object_position, contact=contact, heading=heading)
         if not r.success:                      # a valid question answered "no": exit 1
             typer.echo(f"taut: {r.status}: {r.message}", err=True)
             raise typer.Exit(1)

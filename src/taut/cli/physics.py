@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import Any, Optional
 
 import typer
 
-from ..errors import InvalidInputError, ScenarioError
+from ..errors import ScenarioError, require_extra
 from ._paths import ANIMATION_SUFFIXES, output_path
+from ._progress import working
 from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, sheet_unit, write_recordings
 
 
@@ -77,23 +77,12 @@ def register(app: typer.Typer) -> None:
                                 "the robots' positions)")
         mcap, rerun = recording_paths(mcap, rerun)
         unit = sheet_unit(sc.units, mcap, rerun)
-        try:
-            from ..physics import DEFAULT_MESH, replay_equilibria, settle
-            import mujoco  # noqa: F401
-        except ImportError:
-            raise InvalidInputError("physics", "needs MuJoCo: pip install 'taut[physics]'"
-                                    ) from None
+        from ..physics import DEFAULT_MESH, replay_equilibria, settle
+        require_extra("mujoco")                    # before any work: one line naming the extra
         div = DEFAULT_MESH if mesh is None else mesh
-        if not as_json and sys.stdout.isatty():
-            from rich.progress import Progress
-            with Progress(transient=True) as bar:
-                task = bar.add_task("settling each state", total=None)
-                check = replay_equilibria(sc.team, sc.formation, mesh=div,
-                                          ball=sc.object_radius,
-                                          progress=lambda d, t: bar.update(task, completed=d,
-                                                                           total=t))
-        else:
-            check = replay_equilibria(sc.team, sc.formation, mesh=div, ball=sc.object_radius)
+        with working("physics (settling each state)") as update:
+            check = replay_equilibria(sc.team, sc.formation, mesh=div, ball=sc.object_radius,
+                                      progress=update)
         if as_json:
             typer.echo(to_json(equilibria_check_to_dict(check, sc.units)))
         else:

@@ -18,6 +18,7 @@ from typer.core import TyperGroup
 
 from ..errors import InvalidInputError, SweepError
 from ._paths import FIGURE_SUFFIXES, output_path
+from ._progress import working
 
 __all__ = ["register"]
 
@@ -121,7 +122,7 @@ def plot_command(
     out: Optional[Path] = typer.Option(None, "--out", help="Figure file (.png, .pdf, .svg; "
                                        "default DIR/<value>.png)."),
 ) -> int:
-    from ..sweep import read_results, results_columns
+    from ..sweep import results_columns
 
     names, meta, _ = results_columns(folder)
     target = output_path(out if out is not None else folder / f"{value}.png", "--out",
@@ -131,6 +132,17 @@ def plot_command(
         if name is not None and name not in names:
             raise SweepError(flag, f"no column {name!r} in the results; columns: "
                              f"{', '.join(names)}")
+    with working("sweep plot"):                  # a large sweep reads and draws for seconds
+        _plot(folder, x, y, value, target, meta)
+    print(f"figure -> {target}")
+    return 0
+
+
+def _plot(folder: Path, x: str, y: Optional[str], value: str, target: Path,
+          meta: dict[str, str]) -> None:
+    """Read the columns of a results folder and draw them (see :func:`plot_command`)."""
+    from ..sweep import read_results
+
     columns, _ = read_results(folder, columns=[c for c in (x, y, value) if c is not None])
     from ..sweep import TASKS
     from ..viz.sweep import plot_sweep
@@ -141,8 +153,6 @@ def plot_command(
                                                              columns[value].dtype.kind != "b"
                                                              else " (rate)")
     plot_sweep(columns, x, value, target, y=y, title=title, labels=labels)
-    print(f"figure -> {target}")
-    return 0
 
 
 def register(app: typer.Typer) -> None:

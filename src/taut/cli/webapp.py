@@ -11,7 +11,7 @@ from typing import Optional
 
 import typer
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, MissingExtraError
 
 __all__ = ["register"]
 
@@ -45,8 +45,7 @@ def app_command(
     try:
         from ..app.server import bind, create_app, serve
     except ImportError as exc:
-        raise InvalidInputError("taut app", "needs the app extra: pip install 'taut[app]' "
-                                f"({exc.name} is missing)") from None
+        raise MissingExtraError(exc.name or "starlette") from None
     initial = _validated(scenario) if scenario is not None else None
     app = create_app(initial, hosts=(host,))
     sock = bind(host, port)

@@ -22,7 +22,7 @@ from .._validate import MAX_DURATION_S, as_array, as_bounded, as_positive
 from ..cdpr import (CableRobot, TensionMethod, distribute_tensions, rotation_matrices,
                     tipping_moments)
 from ..cdpr.kinematics.cables import as_poses
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, require_extra
 from . import _tol
 from .._repr import CompactRepr
 
@@ -222,6 +222,7 @@ def replay_tipping(robot: CableRobot, pose: Any, tensions: Any, *,
     >>> r.verdicts, r.taut_stays, bool(r.success)
     (('stays', 'stays'), True, True)
     """
+    require_extra("mujoco")
     import mujoco
 
     P = as_poses(robot, pose)
@@ -265,6 +266,7 @@ def replay_tipping_grid(robot: CableRobot, poses: Any, *,
     check asks whether taut's tipping verdict for tensions chosen *without* the tipping
     constraints agrees with the simulated bases; tensions that already avoid tipping would
     leave nothing to check."""
+    require_extra("mujoco")
     duration = as_bounded(duration, "duration", MAX_DURATION_S, "s")
     P = as_poses(robot, poses)
     dist = distribute_tensions(robot, P, method, tipping=tipping)

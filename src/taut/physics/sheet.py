@@ -16,7 +16,7 @@ import numpy as np
 from .._outcome import check_status
 from .._units import GRAVITY
 from .._validate import as_array, as_flag, as_positive
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, require_extra
 from ..sheet import Equilibrium, Sheet, SheetTeam, check_formation, forward_kinematics
 from ..sheet.team import require_team
 from . import _run, _tol
@@ -250,6 +250,7 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
     >>> bool(r.converged), bool(0 < r.position[2] < 800)
     (True, True)
     """
+    require_extra("mujoco")
     trace = as_flag(trace, "trace")
     R, div, radius = _check_inputs(team, formation, mesh, ball)
     sheet, z = team.sheet, team.hold_height
@@ -450,6 +451,7 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     -------
     EquilibriaCheck
     """
+    require_extra("mujoco")
     corner_tendons = as_flag(corner_tendons, "corner_tendons")
     R, div, radius = _check_inputs(team, formation, mesh, ball)
     sheet, z = team.sheet, team.hold_height
