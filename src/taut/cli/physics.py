@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import typer
 
-from ..errors import ScenarioError, require_extra
+from ..errors import ScenarioError
 from ._paths import ANIMATION_SUFFIXES, output_path
 from ._progress import working
 from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, sheet_unit, write_recordings
@@ -78,7 +78,6 @@ def register(app: typer.Typer) -> None:
         mcap, rerun = recording_paths(mcap, rerun)
         unit = sheet_unit(sc.units, mcap, rerun)
         from ..physics import DEFAULT_MESH, replay_equilibria, settle
-        require_extra("mujoco")                    # before any work: one line naming the extra
         div = DEFAULT_MESH if mesh is None else mesh
         with working("physics (settling each state)") as update:
             check = replay_equilibria(sc.team, sc.formation, mesh=div, ball=sc.object_radius,

@@ -11,7 +11,7 @@ from typing import Optional
 
 import typer
 
-from ..errors import InvalidInputError, MissingExtraError
+from ..errors import InvalidInputError
 
 __all__ = ["register"]
 
@@ -42,10 +42,7 @@ def app_command(
     token; requests without it are refused. Stop with Ctrl+C."""
     if not 0 <= port <= 65535:
         raise InvalidInputError("--port", f"must be between 0 and 65535, got {port}")
-    try:
-        from ..app.server import bind, create_app, serve
-    except ImportError as exc:
-        raise MissingExtraError(exc.name or "starlette") from None
+    from ..app.server import bind, create_app, serve   # a MissingExtraError without the extra
     initial = _validated(scenario) if scenario is not None else None
     app = create_app(initial, hosts=(host,))
     sock = bind(host, port)

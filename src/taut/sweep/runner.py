@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import __version__
 from .._validate import as_array, as_count, as_flag, as_path, require_instance
-from ..errors import MissingExtraError, SweepError
+from ..errors import SweepError, require_extra
 from .file import base_model
 from .points import chunk_bounds, chunk_streams, expand, point_seeds
 from .registry import TASKS
@@ -138,11 +138,10 @@ def _connect(workers: int | None, scheduler: str | None) -> Any:
     """A client of ``scheduler``, else of a new local cluster, whose Dask logs in this
     process are bounded by :data:`DASK_LOG_ENTRIES` and :data:`DASK_MONITOR_SAMPLES` (each
     log's length is read when the scheduler, a connection or the client is created)."""
-    try:
-        import dask
-        from distributed import Client  # noqa: F401
-    except ImportError as exc:
-        raise MissingExtraError(exc.name or "distributed") from None
+    require_extra("dask")
+    require_extra("distributed")
+    import dask
+
     with dask.config.set({"distributed.admin.low-level-log-length": DASK_LOG_ENTRIES,
                           "distributed.admin.system-monitor.log-length":
                               DASK_MONITOR_SAMPLES}):
