@@ -102,7 +102,7 @@ MAX_TENSION_N = 1e9
 #: Largest speed or rate limit (m/s, rad/s) and twist component.
 MAX_SPEED = 1e3
 #: Largest acceleration limit or acceleration, m/s^2 (10^5 g).
-MAX_ACCEL = 1e3 * MAX_SPEED
+MAX_ACCELERATION = 1e3 * MAX_SPEED
 #: Largest number of robots in a team (FK is O(N^2) hull faces; planning far less).
 MAX_ROBOTS = 1000
 #: Largest number of poses / formations / grid points in one call.
@@ -118,7 +118,7 @@ LIMITS: dict[str, tuple[float, str]] = {
     "mass": (MAX_MASS_KG, "kg"),
     "tension": (MAX_TENSION_N, "N"),
     "speed": (MAX_SPEED, "m/s or rad/s"),
-    "acceleration": (MAX_ACCEL, "m/s^2"),
+    "acceleration": (MAX_ACCELERATION, "m/s^2"),
     "robots": (MAX_ROBOTS, "robots"),
     "batch": (MAX_BATCH, "items"),
     "rate": (MAX_RATE_HZ, "Hz"),

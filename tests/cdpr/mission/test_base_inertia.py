@@ -89,7 +89,7 @@ def test_bad_acceleration_is_named(fastkit):
 
 @pytest.mark.parametrize("a", [1e308, -1e7, 1.0000001e6])
 def test_an_acceleration_past_the_accepted_range_is_named(fastkit, a):
-    """Finite but past MAX_ACCEL (1e6 m/s^2): refused, not turned into NaN moments."""
+    """Finite but past MAX_ACCELERATION (1e6 m/s^2): refused, not turned into NaN moments."""
     with pytest.raises(InvalidInputError, match=r"acceleration.*exceeds the accepted range"):
         with_base_acceleration(fastkit, [0.0, a, 0.0])
     assert np.isfinite(with_base_acceleration(fastkit, [0.0, 1e6, 0.0]).edge_weight_moment).all()

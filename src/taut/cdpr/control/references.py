@@ -14,8 +14,8 @@ from typing import Literal, get_args
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import (MAX_ACCEL, MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded,
-    as_choice, as_nonnegative, as_positive)
+from ..._validate import (MAX_ACCELERATION, MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED,
+                          as_array, as_bounded, as_choice, as_nonnegative, as_positive)
 from ...errors import InvalidInputError, InvalidTrajectoryError
 from .._tol import MAX_REFERENCE_SPEED, WAYPOINT_SAME
 from ..kinematics.cables import as_poses
@@ -157,7 +157,7 @@ def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, 
     (1.0, 4.35)
     """
     speed = as_bounded(speed, "speed", MAX_SPEED, "m/s")
-    acceleration = as_bounded(acceleration, "acceleration", MAX_ACCEL, "m/s^2")
+    acceleration = as_bounded(acceleration, "acceleration", MAX_ACCELERATION, "m/s^2")
     rate = as_bounded(rate, "rate", MAX_RATE_HZ, "Hz")
     dwell = as_bounded(dwell, "dwell", MAX_DURATION_S, "s", positive=False)
     as_choice(profile, get_args(Profile), "profile")

@@ -60,8 +60,8 @@ from scipy.optimize import linprog
 
 from ..._outcome import check_status
 from .._tol import REST_ACCEL_SLACK
-from ..._validate import (MAX_ACCEL, MAX_MASS_KG, MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded, as_count,
-                         require_instance)
+from ..._validate import (MAX_ACCELERATION, MAX_MASS_KG, MAX_RATE_HZ, MAX_SPEED,
+                          as_array, as_bounded, as_count, require_instance)
 from ...errors import InvalidInputError
 from ..control.dynamics import DynamicsModel
 from ..control.references import Reference, waypoint_segments
@@ -422,7 +422,7 @@ def checked_limits(robot: CableRobot, dyn: DynamicsModel, tension_margin: float,
                     positive=False)
     tpm = as_bounded(tipping_margin, "tipping_margin", 1e6, "N m", positive=False)
     vcap = None if max_speed is None else as_bounded(max_speed, "max_speed", MAX_SPEED, "m/s")
-    acap = as_bounded(max_accel, "max_accel", MAX_ACCEL, "m/s^2")
+    acap = as_bounded(max_accel, "max_accel", MAX_ACCELERATION, "m/s^2")
     sm = as_bounded(smoothing, "smoothing", 10.0, "s", positive=False)
     return _limits(dyn, tm, tpm, vcap, acap, sm)
 

@@ -14,7 +14,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..._validate import MAX_ACCEL, as_array, as_finite_scalar, as_points, check_range
+from ..._validate import MAX_ACCELERATION, as_array, as_finite_scalar, as_points, check_range
 from ...errors import InvalidModelError
 from .._tol import INERTIA_REL
 from .footprint import check_footprint
@@ -107,7 +107,7 @@ class Base(CompactRepr):
         object.__setattr__(self, "com", as_array(self.com, f"{f}.com", shape=(3,)))
         object.__setattr__(self, "acceleration", check_range(
             as_array(self.acceleration, f"{f}.acceleration", shape=(3,)),
-            f"{f}.acceleration", MAX_ACCEL, "m/s^2"))
+            f"{f}.acceleration", MAX_ACCELERATION, "m/s^2"))
         object.__setattr__(self, "mass", as_finite_scalar(self.mass, f"{f}.mass"))
         if self.friction is not None:
             mu = as_finite_scalar(self.friction, f"{f}.friction")
