@@ -57,8 +57,9 @@ from ..statics.sliding import sliding_rows
 from ._execute import PhaseRun, run_motion
 from ._reposition import active_index, shifted
 from .warehouse import Warehouse
-from .timing import (MAX_ACCEL, MAX_GRID, MAX_PLATFORM_SPEED, SMOOTHING_S, TENSION_MARGIN_N,
-                     TIPPING_MARGIN_NM, AnchorMotion, TimedPath, _plan, checked_limits)
+from .timing import (DEFAULT_MAX_ACCEL_MPS2, DEFAULT_MAX_SPEED_MPS, MAX_GRID, SMOOTHING_S,
+                     TENSION_MARGIN_N, TIPPING_MARGIN_NM, AnchorMotion, TimedPath, _plan,
+                     checked_limits)
 
 __all__ = ["MovingCarry", "moving_carry", "run_moving_carry", "wheels_for_active"]
 
@@ -148,7 +149,8 @@ def moving_carry(robot: CableRobot, waypoints: ArrayLike, offsets: ArrayLike, *,
                  dynamics: DynamicsModel | None = None,
                  tension_margin: float = TENSION_MARGIN_N,
                  tipping_margin: float = TIPPING_MARGIN_NM,
-                 max_speed: float | None = MAX_PLATFORM_SPEED, max_accel: float = MAX_ACCEL,
+                 max_speed: float | None = DEFAULT_MAX_SPEED_MPS,
+                 max_accel: float = DEFAULT_MAX_ACCEL_MPS2,
                  smoothing: float = SMOOTHING_S, rate: float = 1000.0,
                  grid: int | None = None) -> MovingCarry:
     """Time-optimal carry through ``waypoints`` with the active base driving from

@@ -88,7 +88,7 @@ MAX_GRID = 100_000
 #: ramp instead of stepping; it lengthens each segment by the window).
 TENSION_MARGIN_N = 8.0
 TIPPING_MARGIN_NM = 5.0
-MAX_ACCEL = 4.0
+DEFAULT_MAX_ACCEL_MPS2 = 4.0
 #: Fractions of the tension margin tried in turn at a grid point where the platform cannot
 #: rest with the whole margin (near the workspace's edge the margin shrinks there only).
 MARGIN_STEPS = (1.0, 0.5, 0.25, 0.0)
@@ -96,7 +96,7 @@ MARGIN_STEPS = (1.0, 0.5, 0.25, 0.0)
 #: accepted there, m/s^2 (else the next, smaller fraction: a margin that leaves the platform
 #: no room to brake would make it creep; the last fraction only needs rest).
 ACCEL_ROOM = 1.0
-MAX_PLATFORM_SPEED = 1.5
+DEFAULT_MAX_SPEED_MPS = 1.5
 SMOOTHING_S = 0.1
 
 
@@ -352,8 +352,8 @@ def time_optimal_path(robot: CableRobot, waypoints: ArrayLike, *,
                       dynamics: DynamicsModel | None = None, grid: int | None = None,
                       tension_margin: float = TENSION_MARGIN_N,
                       tipping_margin: float = TIPPING_MARGIN_NM,
-                      max_speed: float | None = MAX_PLATFORM_SPEED,
-                      max_accel: float = MAX_ACCEL, smoothing: float = SMOOTHING_S,
+                      max_speed: float | None = DEFAULT_MAX_SPEED_MPS,
+                      max_accel: float = DEFAULT_MAX_ACCEL_MPS2, smoothing: float = SMOOTHING_S,
                       rate: float = 1000.0) -> TimedPath:
     """Time-optimal motion through ``waypoints``, at rest at each (TOPP-RA, see the module
     docstring for the constraints).
