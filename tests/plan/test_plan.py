@@ -281,7 +281,9 @@ def test_scenario_file_errors(paper):
     bad["obstacles"][0]["colour"] = "red"
     with pytest.raises(ScenarioError) as e:
         plan_scenario_from_mapping(bad)
-    assert e.value.field == "obstacles[0].colour" and e.value.problem == "unknown key"
+    assert e.value.field == "obstacles[0].colour"
+    assert e.value.problem.startswith("unknown key; expected one of ")   # the obstacle's keys
+    assert "height" in e.value.problem and "start" not in e.value.problem
     bad = json.loads(json.dumps(data))
     bad["start"] = [2.0, 0.0]
     with pytest.raises(PlanningError) as e:

@@ -14,39 +14,15 @@ first), ``rated_torque`` and ``peak_torque`` (N m), ``peak_duration`` (s),
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any
 
 from pydantic import BaseModel, ConfigDict
 
 from ..cdpr.control.dynamics import DynamicsModel
-from .cdpr_model import preset_path
-from .files import Number, read_mapping, validate_mapping
+from .cdpr_model import _Dynamics, preset_path
+from .files import read_mapping, validate_mapping
 
 __all__ = ["load_cdpr_dynamics", "dynamics_from_mapping"]
-
-
-class _Dynamics(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    # Defaults live in DynamicsModel only: a key left out keeps its default there; an
-    # explicit null reaches DynamicsModel and is refused by its own checks.
-    cable_stiffness: Optional[Number] = None
-    cable_damping: Optional[Number] = None
-    drum_diameter: Optional[Number] = None
-    gear_ratio: Optional[Number] = None
-    efficiency: Optional[Number] = None
-    backdrive_efficiency: Optional[Number] = None
-    rated_torque: Optional[Number] = None
-    peak_torque: Optional[Number] = None
-    peak_duration: Optional[Number] = None
-    motor_speed_limit: Optional[Number] = None
-    rotor_inertia: Optional[Number] = None
-    friction_static: Optional[Number] = None
-    friction_coulomb: Optional[Number] = None
-    friction_viscous: Optional[Number] = None
-    stribeck_speed: Optional[Number] = None
-    drive_speed_gain: Optional[Number] = None
-    drive_integral_gain: Optional[Number] = None
-    routing_length: Optional[Union[Number, list[Number]]] = None
 
 
 class _Section(BaseModel):

@@ -13,7 +13,8 @@ its centre of mass, 3 numbers or 3x3, default a point mass), ``cables`` (list; e
 ``exit`` "base.point", ``attachment``, ``t_min``, ``t_max``), optional ``bounds`` and
 ``desired_workspace`` ({``min``: [x, y, z], ``max``: [x, y, z]}), optional
 ``platform_inside_exits`` (bool, default false: the platform must stay inside the exits'
-bounding box, a workspace condition).
+bounding box, a workspace condition), optional ``dynamics`` (elastic cables and winches;
+keys and units in :mod:`taut.io.cdpr_dynamics`).
 
 :func:`load_cdpr_model` accepts a preset name (``fastkit``, ``ipanema``) or a file path.
 """
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 from importlib import resources
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -87,6 +88,30 @@ class _Box(_Strict):
     max: Vec3
 
 
+class _Dynamics(_Strict):
+    """The ``dynamics:`` section (keys: :mod:`taut.io.cdpr_dynamics`; SI, motor side)."""
+    # Defaults live in DynamicsModel only: a key left out keeps its default there; an
+    # explicit null reaches DynamicsModel and is refused by its own checks.
+    cable_stiffness: Optional[Number] = None
+    cable_damping: Optional[Number] = None
+    drum_diameter: Optional[Number] = None
+    gear_ratio: Optional[Number] = None
+    efficiency: Optional[Number] = None
+    backdrive_efficiency: Optional[Number] = None
+    rated_torque: Optional[Number] = None
+    peak_torque: Optional[Number] = None
+    peak_duration: Optional[Number] = None
+    motor_speed_limit: Optional[Number] = None
+    rotor_inertia: Optional[Number] = None
+    friction_static: Optional[Number] = None
+    friction_coulomb: Optional[Number] = None
+    friction_viscous: Optional[Number] = None
+    stribeck_speed: Optional[Number] = None
+    drive_speed_gain: Optional[Number] = None
+    drive_integral_gain: Optional[Number] = None
+    routing_length: Optional[Union[Number, list[Number]]] = None
+
+
 class _ModelFile(_Strict):
     name: str = "cable robot"
     gravity: Vec3 = (0.0, 0.0, -GRAVITY)
@@ -97,10 +122,10 @@ class _ModelFile(_Strict):
     bounds: _Box | None = None
     desired_workspace: _Box | None = None
     platform_inside_exits: bool = False
-    # Elastic cables and winches, read by taut.io.cdpr_dynamics (key names and ranges
-    # validated there); here already a flat mapping of numbers (routing_length: a number
-    # or a list of numbers), never free-form data.
-    dynamics: dict[str, Optional[Number | list[Number]]] | None = None
+    # Elastic cables and winches: the section's keys are checked with the rest of the file
+    # (an unknown key is ``dynamics.<key>: unknown key`` whatever the command); their
+    # ranges are DynamicsModel's, when taut.io.cdpr_dynamics builds it.
+    dynamics: _Dynamics | None = None
 
 
 def _file_field(exc: TautError, raw: _ModelFile) -> str:
@@ -172,18 +197,26 @@ def physical_ranges(robot: CableRobot) -> CableRobot:
     Raises
     ------
     InvalidModelError
-        The field out of range (``payload.mass``, ``bases``, ``platform``, ``bounds``).
+        The field out of range, named as in a model file (``platform.mass``,
+        ``payload.mass``, ``bases[0].exit_points.A1``, ``bases[0].pose``,
+        ``platform.attachment_points.B1``, ``bounds``, ``desired_workspace``).
     """
     total = float(robot.platform.mass + robot.payload.mass)
     if not total <= MAX_MASS_KG:
-        raise InvalidModelError("payload.mass", f"platform + payload {total:g} kg exceeds "
+        where = ("platform.mass" if not robot.platform.mass <= MAX_MASS_KG else
+                 "payload.mass")
+        raise InvalidModelError(where, f"platform + payload {total:g} kg exceeds "
                                 f"the accepted range {MAX_MASS_KG:g} kg")
     r: Any = robot                         # exits_world: set when the model is validated
-    for where, values in (("bases", r.exits_world),
-                          ("platform.attachment_points",
-                           list(robot.platform.attachment_points.values())),
-                          ("bounds", robot.bounds), ("desired_workspace",
-                                                     robot.desired_workspace)):
+    checks: list[tuple[str, Any]] = []
+    for i, b in enumerate(robot.bases):
+        checks += [(f"bases[{i}].exit_points.{n}", p) for n, p in b.exit_points.items()]
+        checks.append((f"bases[{i}].pose", b.pose[:2]))
+    checks += [("bases", r.exits_world)]   # world exits: pose + point, each in range
+    checks += [(f"platform.attachment_points.{n}", p)
+               for n, p in robot.platform.attachment_points.items()]
+    checks += [("bounds", robot.bounds), ("desired_workspace", robot.desired_workspace)]
+    for where, values in checks:
         if values is not None:
             try:
                 check_range(values, where, MAX_CDPR_LENGTH_M, "m")

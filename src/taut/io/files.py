@@ -25,6 +25,7 @@ import contextlib
 import json
 import os
 import tempfile
+import typing
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
@@ -299,6 +300,32 @@ def _first_error(data: Any, errors: list[Any]) -> tuple[Any, tuple[Any, ...]]:
     return best, where
 
 
+def _models_in(kind: Any) -> list[type[BaseModel]]:
+    """The pydantic models a field annotation can hold (through Optional, Union, list,
+    dict values and Annotated)."""
+    if isinstance(kind, type) and issubclass(kind, BaseModel):
+        return [kind]
+    args = [a for a in typing.get_args(kind) if a is not type(None)]
+    if typing.get_origin(kind) is dict:
+        args = args[1:]
+    return [m for a in args for m in _models_in(a)]
+
+
+def _known_keys(model: type[BaseModel], loc: tuple[Any, ...]) -> list[str]:
+    """The keys the (sub)model at a pydantic error location takes; empty when the location
+    does not lead to one model (so an unknown key's message can list what is known)."""
+    models = [model]
+    for part in loc:
+        if not isinstance(part, str):
+            continue                             # a list index: the same item model
+        found = [m for mod in models if part in mod.model_fields
+                 for m in _models_in(mod.model_fields[part].annotation)]
+        if not found:
+            return []
+        models = found
+    return list(models[0].model_fields) if len(models) == 1 else []
+
+
 def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
     """Validate ``data`` against a pydantic model; the first error becomes a
     :class:`ScenarioError` whose field is the dotted path (``sheet[2]``, ``cables[0].max``).
@@ -318,7 +345,8 @@ def validate_mapping(model: type[M], data: dict[str, Any]) -> M:
         if err["type"] in _NUMBER_ERRORS and isinstance(err.get("input"), bool):
             msg = "must be a number, got a boolean"
         elif err["type"] == "extra_forbidden":
-            msg = "unknown key"
+            keys = _known_keys(model, err["loc"][:-1])
+            msg = f"unknown key; expected one of {', '.join(keys)}" if keys else "unknown key"
         elif err["type"] == "missing":
             msg = "required key is missing"
         raise ScenarioError(loc, msg[0].lower() + msg[1:]) from None

@@ -103,9 +103,10 @@ _Value = Annotated[Union[
 
 
 class _Options(BaseModel):
-    """Task options; which ones a task takes is checked against :data:`TASK_OPTIONS`."""
+    """Task options (every option any task takes; an unknown key is refused here, which
+    of them a task takes is checked against :data:`TASK_OPTIONS`)."""
 
-    model_config = ConfigDict(extra="allow")
+    model_config = ConfigDict(extra="forbid")
     grid: list[Annotated[Integer, Field(ge=1, le=MAX_GRID_POINTS)]] | None = None
     box: list[list[_Number]] | None = None
 
@@ -154,8 +155,7 @@ def _grid_values(value: Any, field: str) -> np.ndarray:
 def _options(value: _Options, task: str) -> dict[str, Any]:
     """The ``options`` checked against :data:`TASK_OPTIONS` (plain lists kept)."""
     known = TASK_OPTIONS.get(task, {})
-    for key in [*(k for k in ("grid", "box") if k in value.model_fields_set),
-                *(value.model_extra or {})]:
+    for key in [k for k in _Options.model_fields if k in value.model_fields_set]:
         if key not in known:
             expected = (f"expected one of {', '.join(known)}" if known else
                         f"task {task} takes no options")
