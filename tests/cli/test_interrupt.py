@@ -105,10 +105,75 @@ def swaying(tmp_path, team, steps):
     return tmp_path / "team.json", tmp_path / "walk.csv"
 
 
-# Ctrl-C during IK of the largest team is answered only when its current search step ends
-# (measured 14 s after the signal on an idle machine): slow target, and the issue-24 note
-# names the latency. `taut fk` of the largest team (1,000 robots) answers in ~1.4 s, before
-# its first progress line, so it has no interrupt test of its own.
+def test_fk_exhaustive_interrupted(tmp_path):
+    """The paper's Algorithm 1 over every taut set of a 20-robot team (2^20 sets, 11 s of
+    CPU): `taut fk` of the largest team answers before its first progress line, this
+    method does not."""
+    (tmp_path / "team.json").write_text(json.dumps(big_team(20)))
+    assert_interrupted(*interrupt(["fk", str(tmp_path / "team.json"), "--method",
+                                   "exhaustive"], "taut: fk (exhaustive): working"))
+
+
+def ring_of_cables(m):
+    """A fixed-frame cable robot of ``m`` cables (a model mapping, SI units): exits
+    alternately on a top (z = 3 m) and a bottom (z = 0 m) ring of radius 2 m, each cable to
+    its own attachment point on a 0.15 m ring of the platform."""
+    a = 2 * np.pi * np.arange(m) / m
+    exits = {f"A{i + 1}": [round(2 * np.cos(x), 6), round(2 * np.sin(x), 6), 3.0 - 3.0 * (i % 2)]
+             for i, x in enumerate(a)}
+    points = {f"B{i + 1}": [round(0.15 * np.cos(x + 0.3), 6), round(0.15 * np.sin(x + 0.3), 6),
+                            0.1 - 0.2 * (i % 2)] for i, x in enumerate(a)}
+    return {"name": f"ring of {m} cables",
+            "bases": [{"name": "frame", "mobile": False, "exit_points": exits}],
+            "platform": {"mass": 2.0, "inertia": [0.02, 0.02, 0.03],
+                         "attachment_points": points},
+            "cables": [{"name": f"C{i + 1}", "exit": f"frame.A{i + 1}", "attachment": f"B{i + 1}",
+                        "t_min": 10.0, "t_max": 1500.0} for i in range(m)]}
+
+
+def ring_of_bases(k):
+    """FASTKIT's cable robot with ``k`` copies of its active mobile base (4 cables each) on
+    a 3 m circle around the platform (a model mapping)."""
+    import yaml
+
+    from taut.io.cdpr_model import preset_path
+    fastkit = yaml.safe_load(preset_path("fastkit").read_text())
+    base, points = fastkit["bases"][0], list(fastkit["platform"]["attachment_points"])
+    bases, cables = [], []
+    for i, phi in enumerate(2 * np.pi * np.arange(k) / k):
+        bases.append(dict(base, name=f"base{i + 1}", pose=[round(-3 * np.cos(phi), 6),
+                                                            round(-3 * np.sin(phi), 6),
+                                                            round(phi, 6)]))
+        cables += [{"name": f"C{j + 1}{i + 1}", "exit": f"base{i + 1}.{p}",
+                    "attachment": points[(4 * i + j) % len(points)], "t_min": 5.0,
+                    "t_max": 45.0} for j, p in enumerate(base["exit_points"])]
+    return {"name": f"{k} mobile bases", "bases": bases, "platform": fastkit["platform"],
+            "payload": fastkit["payload"], "cables": cables}
+
+
+@pytest.mark.parametrize("model, args", [
+    # one pose takes milliseconds for any real robot; the closed form fixes one cable a step,
+    # so 6,000 cables take ~5 s of CPU (and 1.3 GB; 9 s loaded: slow). qp_min_norm is no test:
+    # DAQP's solve holds the interpreter, Ctrl-C is answered when it returns (25 s for 1,500
+    # cables, loaded)
+    pytest.param(ring_of_cables(6000), ["tensions"], id="tensions", marks=pytest.mark.slow),
+    pytest.param(ring_of_cables(12), ["wrench-set"], id="wrench-set"),     # ~9 s of CPU
+    pytest.param(ring_of_bases(6), ["twist-set", "--moving", "base1", "--moving", "base2"],
+                 id="twist-set"),                                            # ~12 s of CPU
+])
+def test_cable_robot_pose_commands_interrupted(tmp_path, model, args):
+    """The one-pose analyses, on models whose size makes them take seconds."""
+    (tmp_path / "model.json").write_text(json.dumps(model))
+    assert_interrupted(*interrupt(["cdpr", args[0], str(tmp_path / "model.json"), "--pose",
+                                   "0", "0", "1.5", *args[1:]], f"taut: cdpr {args[0]}: working"))
+
+
+# IK of the largest team: at its first progress line it is verifying candidates with
+# forward kinematics (short steps; Ctrl-C answered in 0.5 s, loaded). Later its SLSQP step
+# builds dense arrays of N(N-1)/2 pair constraints x 2N unknowns (8 GB each for N = 1,000)
+# and then runs SciPy's Fortran SLSQP, which holds the interpreter for minutes (N = 400):
+# there Ctrl-C waits for the current numpy operation or Fortran call (7-28 s measured,
+# loaded). Slow target.
 @pytest.mark.slow
 def test_ik_of_a_large_team_interrupted(tmp_path):
     (tmp_path / "team.json").write_text(json.dumps(big_team()))

@@ -62,7 +62,8 @@ def _tensions(model: str, pose: Any, rpy: Any, method: Optional[str],
     robot = load_robot(model, stabilisers)
     if method is not None:
         as_choice(method, METHODS, "--method")
-    res = distribute_tensions(robot, P, **given(method=method, tipping=tipping))
+    with working("cdpr tensions"):
+        res = distribute_tensions(robot, P, **given(method=method, tipping=tipping))
     code = 0 if res.success else 1
     if as_json:
         typer.echo(to_json(tensions_to_dict(robot, P, res)))
@@ -104,12 +105,13 @@ def _wrench_set(model: str, pose: Any, rpy: Any, external_wrench: Any, stabilise
         hw[:min(len(vals), robot.dof)] = vals[:robot.dof]
         D = external_wrench_box(robot, hw)
     modes: dict[str, dict[str, Any]] = {}
-    for tip in ([False, True] if robot.has_tipping else [False]):
-        modes["with_tipping" if tip else "tension_limits_only"] = {
-            "capacities": axis_capacities(robot, P, tipping=tip),
-            "halfspaces": available_wrench_set(robot, P, tipping=tip).facets(),
-            "margin": float(capacity_margin(robot, P, D, tipping=tip)),
-            "gravity_feasible": bool(wrench_feasible(robot, P, tipping=tip))}
+    with working("cdpr wrench-set"):
+        for tip in ([False, True] if robot.has_tipping else [False]):
+            modes["with_tipping" if tip else "tension_limits_only"] = {
+                "capacities": axis_capacities(robot, P, tipping=tip),
+                "halfspaces": available_wrench_set(robot, P, tipping=tip).facets(),
+                "margin": float(capacity_margin(robot, P, D, tipping=tip)),
+                "gravity_feasible": bool(wrench_feasible(robot, P, tipping=tip))}
     out = wrench_set_to_dict(robot, P, modes)
     caps = {key: m["capacities"] for key, m in modes.items()}
     if plot is not None:
