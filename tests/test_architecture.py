@@ -120,6 +120,29 @@ def test_no_import_cycles():
     assert _cycles(GRAPH) == []
 
 
+#: Modules at the package root that drive the families (the command line, the warmup that
+#: runs their entry points) rather than serve them.
+ROOT_DRIVERS = {"taut.__main__", "taut._warmup"}
+
+
+def _family_imports(name: str) -> set[str]:
+    """The modules of family folders (``taut.sheet``, ``taut.cdpr``, ...) ``name`` imports."""
+    return {t for t in GRAPH[name] if t.count(".") >= 1
+            and (PACKAGE / t.split(".")[1]).is_dir()}
+
+
+def test_shared_root_modules_import_no_family():
+    """The other root modules are shared by the families (validation, errors, the compiled
+    kernels' set-up, the QP solver, the one convex hull of ``taut._geometry`` that the
+    planner's kernels and the cable robots both use): a family imported there would tie
+    every family that shares the module to it."""
+    root = [n for n, p in MODULES.items() if p.parent == PACKAGE and p.name != "__init__.py"]
+    assert "taut._geometry" in root and ROOT_DRIVERS <= set(root)
+    assert {n: _family_imports(n) for n in root if n not in ROOT_DRIVERS and
+            _family_imports(n)} == {}
+    assert all(_family_imports(n) for n in ROOT_DRIVERS)     # the exception is needed
+
+
 def test_folders_hold_few_modules():
     crowded = {}
     for folder in sorted({p.parent for p in MODULES.values()}):

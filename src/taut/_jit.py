@@ -56,9 +56,9 @@ MODES = ("auto", "always", "never")
 #: The files compiled code is built from, relative to the package: every file holding
 #: ``@jit`` kernels and the tolerance files whose constants numba freezes into them (their
 #: sources key the stamp; tests/test_jit.py checks that none is missing here).
-KERNEL_SOURCES = ("_jit.py", "sheet/_kernels/linalg.py", "sheet/_kernels/small.py",
-                  "sheet/_kernels/batch.py", "sheet/_kernels/step.py", "sheet/_tol.py",
-                  "plan/_kernels/clearance.py", "plan/_kernels/lattice.py",
+KERNEL_SOURCES = ("_jit.py", "_geometry.py", "sheet/_kernels/linalg.py",
+                  "sheet/_kernels/small.py", "sheet/_kernels/batch.py", "sheet/_kernels/step.py",
+                  "sheet/_tol.py", "plan/_kernels/clearance.py", "plan/_kernels/lattice.py",
                   "cdpr/control/_kernel.py", "cdpr/_tol.py")
 #: A warmup started less than this long ago (s) is taken to be still running.
 WARMUP_LOCK_S = 900.0

@@ -17,7 +17,7 @@ import pytest
 import yaml
 
 from taut.cdpr import cable_state, distribute_tensions
-from taut.cdpr.model.footprint import convex_hull_2d
+from taut._geometry import convex_hull_2d
 from taut.errors import InfeasibleFormationError
 from taut.io import load_cdpr_model, load_plan_scenario, load_sheet_scenario, \
     sheet_scenario_from_mapping
@@ -360,6 +360,13 @@ def test_simulate_plays_the_path_and_marks_the_jump(page):
     assert titles["sim-height"] == ["step along the path [index]", "object height [m]"]
     assert titles["sheet-3d"] == ["x [m]", "y [m]", "z [m]"]
     assert_units(titles)
+    # the 3D view's caption says what it shows: the lowest stable state again after the
+    # playback (FK of the last formation), a step of the simulation during it
+    caption = "document.getElementById('sheet-3d-caption').textContent"
+    wait_for(d, f"{caption}.startsWith('3D: lowest stable state')")    # FK again after play
+    d.execute_script("SheetView.drawSimulation(arguments[0], SheetView.sim, 3)", dense.tolist())
+    assert d.execute_script(f"return {caption}") == \
+        f"3D: simulated state at step 3/{len(dense) - 1} (drag to turn)"
 
 
 def test_cable_robot_link_reproduces_the_pose(page):

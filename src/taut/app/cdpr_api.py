@@ -20,7 +20,7 @@ import yaml
 from ..cdpr import (CableRobot, cable_state, distribute_tensions, grid_points,
                     tipping_moments, wrench_feasible_workspace, with_stabilisers)
 from ..cdpr import METHODS as TENSION_METHODS
-from ..cdpr.model.footprint import convex_hull_2d
+from .._geometry import convex_hull_2d
 from .._validate import as_choice
 from ..errors import InfeasiblePoseError, InvalidInputError
 from ..io import cdpr_model_from_mapping
@@ -69,17 +69,12 @@ def _pose(body: dict[str, Any]) -> np.ndarray:
 
 def outline(attachments: np.ndarray) -> dict[str, list[list[float]]]:
     """The platform as the 2D views draw it: the convex hull (counter-clockwise, the
-    library's :func:`~taut.cdpr.model.footprint.convex_hull_2d`) of the attachment
-    points (m, world frame, shape (m, 3)) projected on the x-z plane (``"xz"``, the side
-    view) and on the x-y plane (``"xy"``, the top view); rows are (horizontal, vertical)
-    points in m. Attachments that meet in one point (a point-mass platform) give that
-    point."""
-    out = {}
-    for name, k in (("xz", 2), ("xy", 1)):
-        pts = attachments[:, [0, k]]
-        hull = convex_hull_2d(pts)
-        out[name] = (hull if len(hull) else pts[:1]).tolist()
-    return out
+    library's :func:`~taut._geometry.convex_hull_2d`) of the attachment points (m, world
+    frame, shape (m, 3)) projected on the x-z plane (``"xz"``, the side view) and on the
+    x-y plane (``"xy"``, the top view); rows are (horizontal, vertical) points in m.
+    Attachments that meet in one point (a point-mass platform) give that point."""
+    return {name: convex_hull_2d(attachments[:, [0, k]]).tolist()
+            for name, k in (("xz", 2), ("xy", 1))}
 
 
 class CdprAPI:

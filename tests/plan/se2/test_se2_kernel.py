@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from shapely.geometry import Point, Polygon
 
 from taut.plan import _tol
-from taut.plan._kernels.clearance import (OBST_COLS, convex_hull, morph_clear, motion_clear,
+from taut.plan._kernels.clearance import (OBST_COLS, morph_clear, motion_clear,
     poses_clearance)
 
 #: Circles in shapely: a 256-gon inscribed in the circle (the kernel's circle is exact), so
@@ -95,21 +95,6 @@ def test_clearance_matches_shapely(form, kind, seed):
         # ... and the same value where they hold (the kernel's value is exact there).
         if exact > TOL:
             assert k == pytest.approx(exact, abs=TOL)
-
-
-def test_convex_hull_matches_shapely():
-    rng = np.random.default_rng(5)
-    for n in range(3, 13):
-        for _ in range(20):
-            p = rng.uniform(-1, 1, (n, 2))
-            if n > 4:
-                p[0] = (p[1] + p[2]) / 2                     # a point on a segment
-            out = np.empty((n + 1, 2))
-            m = convex_hull(p, np.empty(n, np.int64), out)
-            ref = shapely.convex_hull(shapely.multipoints(p))
-            assert Polygon(out[:m]).is_valid
-            assert Polygon(out[:m]).area == pytest.approx(ref.area, rel=1e-12)
-            assert shapely.Polygon(out[:m]).exterior.is_ccw
 
 
 @settings(max_examples=60, deadline=None)

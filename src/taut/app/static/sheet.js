@@ -213,6 +213,8 @@ const SheetView = {
     this.drawRobots();
     document.getElementById("sheet-status").textContent =
       `simulate: step ${k}/${F.length - 1}, object height ${o[2] === null ? "lost" : o[2].toFixed(2) + " " + this.units()}`;
+    document.getElementById("sheet-3d-caption").textContent =
+      `3D: simulated state at step ${k}/${F.length - 1} (drag to turn)`;
     this.view3d.set({formation: F[k], hold: this.sc.hold_height, units: this.sc.units,
                      object: o[0] === null ? null : o, taut: sim.taut[k], note: "object lost"});
   },

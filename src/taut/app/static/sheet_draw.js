@@ -106,6 +106,7 @@ Object.assign(SheetView, {
 
   draw3D(F, fk) {
     const low = fk && fk.feasible && fk.lowest !== null ? fk.equilibria[fk.lowest] : null;
+    document.getElementById("sheet-3d-caption").textContent = "3D: lowest stable state (drag to turn)";
     this.view3d.set({formation: F, hold: this.sc.hold_height, units: this.sc.units,
                      object: low ? low.object : null, taut: low ? low.taut : [],
                      note: fk && !fk.feasible ? "infeasible formation" : "no stable state"});

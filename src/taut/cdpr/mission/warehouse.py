@@ -25,10 +25,10 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from ..._geometry import convex_hull_2d
 from ..._validate import (MAX_CDPR_LENGTH_M, MAX_SPEED, as_array, as_bounded, as_flag,
                           as_mass, check_range, require_instance, require_instances)
 from ...errors import InvalidInputError, InvalidModelError
-from ..model.footprint import convex_hull_2d
 from ..model.robot import CableRobot
 
 #: Default shelf height (:class:`Shelf`), m.

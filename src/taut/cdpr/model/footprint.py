@@ -1,6 +1,7 @@
 """Ground-contact polygons of mobile bases: validation of a footprint (convex, simple,
 non-degenerate, returned counter-clockwise as the tipping moments of FASTKIT eqs. 21-23
-need) and the convex hull of wheels and stabiliser feet. Units: m."""
+need). The convex hull of wheels and stabiliser feet is :func:`taut._geometry.convex_hull_2d`.
+Units: m."""
 
 from __future__ import annotations
 
@@ -66,23 +67,6 @@ def check_footprint(vertices: Any, fld: str) -> np.ndarray:
         raise InvalidModelError(fld, "footprint must be a simple convex polygon "
                                      "(it winds around more than once)")
     return pts if area2 > 0 else pts[::-1].copy()
-
-
-def convex_hull_2d(pts: np.ndarray) -> np.ndarray:
-    """Counter-clockwise convex hull (monotone chain), dropping collinear points."""
-    p = np.unique(pts, axis=0)
-    p = p[np.lexsort((p[:, 1], p[:, 0]))]
-
-    def half(seq: np.ndarray) -> list[np.ndarray]:
-        out: list[np.ndarray] = []
-        for q in seq:
-            while len(out) >= 2 and _cross2(out[-1] - out[-2], q - out[-2]) <= 0:
-                out.pop()
-            out.append(q)
-        return out
-
-    lower, upper = half(p), half(p[::-1])
-    return np.array(lower[:-1] + upper[:-1])
 
 
 def inside_convex(poly: np.ndarray, pt: np.ndarray) -> bool:

@@ -14,11 +14,11 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..._geometry import convex_hull_2d as _convex_hull_2d
 from ..._validate import MAX_ACCELERATION, as_array, as_finite_scalar, as_points, check_range
 from ...errors import InvalidModelError
 from .._tol import INERTIA_REL
 from .footprint import check_footprint
-from .footprint import convex_hull_2d as _convex_hull_2d
 from .footprint import inside_convex as _inside_convex
 from ..._repr import CompactRepr
 

@@ -42,10 +42,11 @@ import math
 
 import numpy as np
 
+from ..._geometry import convex_hull
 from ..._jit import jit
 
 __all__ = ["OBST_COLS", "robots_clearance", "poses_clearance", "motion_clear", "morph_clear",
-           "convex_hull", "segment_point_distance", "convex_point_signed_distance"]
+           "segment_point_distance", "convex_point_signed_distance"]
 
 #: Columns of an obstacle row (module docstring).
 OBST_COLS = 8
@@ -173,44 +174,6 @@ def _convex_polygon_distance(H, P, start, count):
                 return 0.0
         j = i
     return best
-
-
-@jit
-def _cross(o, a, b):
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-
-@jit
-def convex_hull(points, order, hull):
-    """Convex hull of ``points`` (N, 2) into ``hull`` (>= N + 1 rows), counter-clockwise
-    without repeating the first vertex (Andrew's monotone chain; ``order`` is an int
-    scratch array of N). Returns the number of hull vertices."""
-    N = points.shape[0]
-    for i in range(N):
-        order[i] = i
-    for i in range(1, N):                      # insertion sort by (x, y): N <= a dozen
-        k = order[i]
-        j = i - 1
-        while j >= 0 and (points[order[j], 0] > points[k, 0] or (
-                points[order[j], 0] == points[k, 0] and points[order[j], 1] > points[k, 1])):
-            order[j + 1] = order[j]
-            j -= 1
-        order[j + 1] = k
-    m = 0
-    for i in range(N):                         # lower chain
-        p = points[order[i]]
-        while m >= 2 and _cross(hull[m - 2], hull[m - 1], p) <= 0.0:
-            m -= 1
-        hull[m, 0], hull[m, 1] = p[0], p[1]
-        m += 1
-    low = m + 1
-    for i in range(N - 2, -1, -1):             # upper chain
-        p = points[order[i]]
-        while m >= low and _cross(hull[m - 2], hull[m - 1], p) <= 0.0:
-            m -= 1
-        hull[m, 0], hull[m, 1] = p[0], p[1]
-        m += 1
-    return m - 1
 
 
 @jit

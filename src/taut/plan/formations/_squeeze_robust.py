@@ -18,8 +18,8 @@ that needs it is not admitted.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
+from ..._geometry import convex_hull_2d
 from ...errors import TautError
 from ...sheet import Equilibrium, FKSolver, object_covariance
 from .. import _options, _tol
@@ -35,11 +35,11 @@ SEED = 20241
 
 
 def convex_hull(P: np.ndarray) -> np.ndarray | None:
-    """Vertices of the convex hull of ``P`` (k, 2), counter-clockwise; None without area."""
-    try:
-        return P[ConvexHull(P).vertices]
-    except (QhullError, ValueError):       # fewer than three points, or all on a line
-        return None
+    """Vertices of the convex hull of ``P`` (k, 2), counter-clockwise
+    (:func:`taut._geometry.convex_hull_2d`); None without area (fewer than three points
+    off one line)."""
+    hull = convex_hull_2d(P)
+    return hull if len(hull) >= 3 else None
 
 
 def hull_inset(P: np.ndarray, q: np.ndarray) -> float:
