@@ -114,3 +114,26 @@ def test_pack_holds_the_solver_exactly(n):
     ints = p[h:h + 6 * C].view(np.int64)
     np.testing.assert_array_equal(ints[:5 * C].reshape(C, 5), solver._table)
     np.testing.assert_array_equal(ints[5 * C:], solver._sizes)
+
+
+def test_kernel_result_fields_made_on_read():
+    """A result of the per-call kernel holds its buffer; its rows and formation (the
+    kernel's copy of the input, whatever its strides) are made on first read, and it
+    pickles and reads back the same."""
+    import pickle
+
+    sheet, R = make_team("convex", 5, 4)
+    solver = FKSolver(SheetTeam(sheet, sheet.size, mass=1.0))
+    R = np.ascontiguousarray(R)
+    wide = np.zeros((4, 6))
+    wide[:, 1::3] = R
+    res = solver.solve(wide[:, 1::3])
+    assert "formation" not in vars(res) and "_rows" not in vars(res)
+    assert res.formation.tolist() == R.tolist() and res.formation.flags.c_contiguous
+    wide[:] = 0.0                                 # the caller's array changes afterwards
+    assert res.formation.tolist() == R.tolist()
+    want = _states(solver.solve(R))
+    assert _states(res) == want
+    assert _states(pickle.loads(pickle.dumps(solver.solve(R)))) == want
+    with pytest.raises(AttributeError):
+        res.not_a_field                           # noqa: B018

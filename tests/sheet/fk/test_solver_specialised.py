@@ -78,8 +78,9 @@ def test_specialised_call_returns_what_the_dispatcher_returns(kind, seed, n):
 
 @pytest.mark.skipif(not HAVE_NUMBA, reason="compiled kernels not in use")
 def test_arrays_the_specialised_call_was_not_made_for_take_the_converting_route():
-    """The specialised call checks no type: big-endian, read-only, unaligned and subclass
-    formations reach it only as fresh native float64 copies, with the same result."""
+    """The specialised call checks no type: big-endian and subclass formations reach it
+    only as fresh native float64 copies; read-only, unaligned and strided float64 ones
+    as they are (it reads any strides and copies them first); the same result."""
     sheet, R = make_team("convex", 11, 4)
     solver = FKSolver(SheetTeam(sheet, sheet.size, mass=1.0))
     R = np.ascontiguousarray(R, dtype=np.float64)

@@ -71,9 +71,10 @@ def pack(Vn, A, lim2, table, sizes, scale, vcx, vcy, hold, snap):
 
 def out_rows(N: int, C: int) -> int:
     """Rows of :func:`solve_one`'s ``out`` for ``N`` robots and ``C`` candidates: ``C``
-    result rows, then the float, int64 and bool work arrays of ``solve_into``."""
+    result rows, then the float, int64 and bool work arrays of ``solve_into``, then one
+    row whose first ``2 N`` floats hold the copy of the formation."""
     work = work_floats(N, C) + 2 * C + (C * N + 7) // 8
-    return C + -(-work // (12 + 3 * N))
+    return C + -(-work // (12 + 3 * N)) + 1
 
 
 def decode(code: int) -> tuple[int, int]:
@@ -94,13 +95,20 @@ def solve_one(R, solver, out):
     within the snap distance of a similar copy of the sheet, not larger than it; next to
     one the formation is answered as the copy, stable states or not:
     docs/sheet_fk_solver.md). ``out`` (C + extra, width): rows in ``out[:C]``, the work
-    arrays after them (:func:`out_rows` rows in all).
+    arrays after them, and ``R`` copied into the first ``2 N`` floats of the last row
+    (:func:`out_rows` rows in all): the caller keeps that copy, whatever the layout of
+    ``R`` (any strides), and everything here reads it.
 
     Returns one int (the cheapest value to return to Python): the number of rows when
     they are the answer (no state, or a stable one and no weight family, and not next to
     a similar copy), else ``-1 - (rows | flags << FLAGS_SHIFT)`` (:func:`decode`; the
     flag ``TORN`` for a torn or non-finite ``R``)."""
     N = R.shape[0]
+    last = out.shape[0] - 1
+    for i in range(N):
+        out[last, 2 * i] = R[i, 0]
+        out[last, 2 * i + 1] = R[i, 1]
+    Rc = out[last, 0:2 * N].reshape(N, 2)
     C = int(solver[1])
     g = HEADER
     Vn = solver[g:g + 2 * N].reshape(N, 2)
@@ -117,12 +125,12 @@ def solve_one(R, solver, out):
     iw = flat[o:o + 2 * C].view(np.int64)
     o += 2 * C
     taut = flat[o:o + (C * N + 7) // 8].view(np.bool_)[:C * N].reshape(C, N)
-    k, stable, pending = solve_into(R, Vn, table, sizes, solver[2], solver[3], solver[4],
+    k, stable, pending = solve_into(Rc, Vn, table, sizes, solver[2], solver[3], solver[4],
                                     solver[5], lim2, out, fw, iw, taut)
     if k < 0:
         return -1 - (TORN << FLAGS_SHIFT)
     flags = (HAS_STABLE if stable else 0) | (HAS_PENDING if pending else 0)
-    scale, dist = similar_fit(R, A)
+    scale, dist = similar_fit(Rc, A)
     if solver[6] < dist <= solver[7] and scale <= solver[8]:
         flags |= NEAR_COPY
     if k == 0 and flags == 0 or flags == HAS_STABLE:

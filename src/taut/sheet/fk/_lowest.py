@@ -22,6 +22,7 @@ front end or the result classes.
 from __future__ import annotations
 
 from itertools import combinations
+from math import sqrt
 from typing import Callable
 
 import numpy as np
@@ -33,7 +34,8 @@ from .._tol import (ARRIVAL_ACTIVE_TOL, CURVATURE_TOL, DIRECT_MAXIT, DIRECT_NEAR
 from ..sim._descent import descend
 from ._finalize import _min_eig_family, _weights_family
 
-__all__ = ["lowest_by_descent", "may_find_stable", "FLOOR", "OFF_SHEET", "NO_REST"]
+__all__ = ["lowest_by_descent", "may_find_stable", "may_find_stable_batch", "FLOOR",
+           "OFF_SHEET", "NO_REST"]
 
 _J = np.array([1.0, 1.0, -1.0, -1.0])
 
@@ -45,6 +47,11 @@ _State = tuple[np.ndarray, np.ndarray, np.ndarray, bool]
 FLOOR, OFF_SHEET, NO_REST = "floor", "off_sheet", "no_rest"
 
 
+#: Most cables taut at a rest state of a formation in general position: the object's
+#: position (3 unknowns) and its contact point on the sheet (2) meet one equation per taut
+#: cable. Larger teams always get the direct minimisation (:func:`may_find_stable`).
+GENERIC_TAUT_MAX = 5
+
 #: Teams up to this size get the pure-Python copy distance (``_copy_distance``).
 _PY_MAX_N = 12
 
@@ -52,14 +59,25 @@ _PY_MAX_N = 12
 def may_find_stable(vertices: np.ndarray, formation: np.ndarray, size: float) -> bool:
     """Whether :func:`lowest_by_descent` can supply a *stable* state the enumeration missed.
 
-    Only next to a similar copy of the sheet (robots within ``DIRECT_RTOL * size`` of
-    one): there float64 cannot tell a cable slack by ~1e-9 from a taut one, and the
-    enumeration can lose a strict minimum (seed 34152 of the issue-25 property test).
+    Where float64 cannot tell a cable slack by ~1e-9 from a taut one, the enumeration can
+    lose a strict minimum. That happens in two places:
+
+    * next to a similar copy of the sheet (robots within ``DIRECT_RTOL * size`` of one;
+      seed 34152 of the issue-25 property test);
+    * in every team of more than :data:`GENERIC_TAUT_MAX` robots: a rest state has five
+      unknowns (object position, contact point), so more taut cables than five meet only
+      on a set of formations of measure zero -- exactly the all-taut formations that IK
+      and the planner make. There the enumeration's five-cable solution counts the other
+      cables taut or overstretched by rounding alone (suite-2024 scenario 39's narrow
+      hexagon: found on one CPU, lost on another).
+
     Elsewhere the enumeration is exact up to the rounding of well-conditioned systems and
     its stable states are complete; the descent then adds only a non-strict minimum or
     the reason why there is no rest state, so the common question "does this formation
     hold the object?" (``FKResult.stable``, ``success``) skips it. The decision is made
-    here and nowhere else.
+    here (:func:`_near_copy`, :data:`GENERIC_TAUT_MAX`) and nowhere else;
+    :func:`may_find_stable_batch` makes it for many formations at once, with the same
+    numbers.
 
     Parameters
     ----------
@@ -68,30 +86,108 @@ def may_find_stable(vertices: np.ndarray, formation: np.ndarray, size: float) ->
     size : float
         Sheet size (same unit).
     """
-    return _copy_distance(vertices, formation) <= DIRECT_RTOL * size
+    if len(vertices) > GENERIC_TAUT_MAX:
+        return True
+    return bool(_near_copy(_copy_distance(vertices, formation), size))
+
+
+def may_find_stable_batch(vertices: np.ndarray, formations: np.ndarray, size: float
+                          ) -> np.ndarray:
+    """:func:`may_find_stable` of each of ``B`` formations, in one numpy pass.
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (N, 2)
+        Sheet vertices (caller's length unit).
+    formations : ndarray, shape (B, N, 2)
+        Robot positions (same unit).
+    size : float
+        Sheet size (same unit).
+
+    Returns
+    -------
+    ndarray of bool, shape (B,)
+        The scalar decision for each formation (the same distances, bit for bit, up to
+        ``_PY_MAX_N`` robots: the same operations in the same order).
+    """
+    if len(vertices) > GENERIC_TAUT_MAX:
+        return np.ones(len(formations), dtype=bool)
+    return np.asarray(_near_copy(_copy_distances(vertices, formations), size), dtype=bool)
+
+
+def _near_copy(dist: np.ndarray | float, size: float) -> np.ndarray | bool:
+    """The decision of :func:`may_find_stable` on copy distances (``_copy_distance``)."""
+    return dist <= DIRECT_RTOL * size
 
 
 def _copy_distance(vertices: np.ndarray, formation: np.ndarray) -> float:
     """Largest robot displacement (caller's unit) to the nearest similar copy (rotation and
     scale, centroid kept) of the sheet: the closed-form 2-D Procrustes fit in complex
-    numbers, :math:`c = \\sum \\bar a_i f_i / \\sum |a_i|^2` (as fk._similar, without its
-    batched SVD). It runs on every ``FKResult.stable`` without a stable state: up to
-    ``_PY_MAX_N`` robots in Python complex numbers (2-4x faster there than numpy's
-    per-call overhead), above in numpy."""
+    numbers :math:`a_i, f_i` (centred vertices and robots),
+    :math:`c = \\sum \\bar a_i f_i / \\sum |a_i|^2`, distance
+    :math:`\\max_i |c a_i - f_i|` (as fk._similar, without its batched SVD). It runs on
+    every ``FKResult.stable`` without a stable state: up to ``_PY_MAX_N`` robots in
+    Python floats, in real and imaginary parts (2-4x faster there than numpy's per-call
+    overhead; sequential sums, the operations of :func:`_copy_distances` in its order),
+    above in numpy complex numbers (the batched version's ~20 array operations cost 2-3x
+    these 8 on one formation; the same distance up to rounding)."""
     if len(vertices) > _PY_MAX_N:
         av = np.ascontiguousarray(vertices).view(np.complex128)[:, 0]
         fv = np.ascontiguousarray(formation).view(np.complex128)[:, 0]
         av, fv = av - av.mean(), fv - fv.mean()
         cv = np.vdot(av, fv) / np.vdot(av, av).real
         return float(np.abs(cv * av - fv).max())
-    a = [complex(x, y) for x, y in vertices.tolist()]
-    f = [complex(x, y) for x, y in formation.tolist()]
-    a_mean, f_mean = sum(a) / len(a), sum(f) / len(f)
-    a = [z - a_mean for z in a]
-    f = [z - f_mean for z in f]
-    c = (sum(ai.conjugate() * fi for ai, fi in zip(a, f))
-         / sum(ai.real * ai.real + ai.imag * ai.imag for ai in a))
-    return max(abs(c * ai - fi) for ai, fi in zip(a, f))
+    vx, vy = zip(*vertices.tolist())
+    fx, fy = zip(*formation.tolist())
+    n = len(vx)
+    vmx = vmy = fmx = fmy = 0.0
+    for i in range(n):
+        vmx += vx[i]
+        vmy += vy[i]
+        fmx += fx[i]
+        fmy += fy[i]
+    vmx, vmy, fmx, fmy = vmx / n, vmy / n, fmx / n, fmy / n
+    ax = [x - vmx for x in vx]
+    ay = [y - vmy for y in vy]
+    bx = [x - fmx for x in fx]
+    by = [y - fmy for y in fy]
+    num_r = num_i = den = 0.0
+    for i in range(n):
+        num_r += ax[i] * bx[i] + ay[i] * by[i]
+        num_i += ax[i] * by[i] - ay[i] * bx[i]
+        den += ax[i] * ax[i] + ay[i] * ay[i]
+    cr, ci = num_r / den, num_i / den
+    worst = 0.0
+    for i in range(n):
+        dx = cr * ax[i] - ci * ay[i] - bx[i]
+        dy = cr * ay[i] + ci * ax[i] - by[i]
+        d2 = dx * dx + dy * dy
+        if d2 > worst:
+            worst = d2
+    return sqrt(worst)
+
+
+def _copy_distances(vertices: np.ndarray, formations: np.ndarray) -> np.ndarray:
+    """:func:`_copy_distance` of each of ``B`` formations (B, N, 2): the same operations
+    on (N, B) arrays, every sum sequential as the loops of the scalar version (the last
+    entry of a cumulative sum; a reduction would sum pairwise along a contiguous axis,
+    e.g. for B = 1)."""
+    F = np.asarray(formations, dtype=np.float64)
+    n = F.shape[1]
+    V = np.asarray(vertices, dtype=np.float64)
+    vx, vy = V[:, 0], V[:, 1]
+    ax = (vx - np.cumsum(vx)[-1] / n)[:, None]                  # (N, 1)
+    ay = (vy - np.cumsum(vy)[-1] / n)[:, None]
+    den = float(np.cumsum(ax * ax + ay * ay)[-1])
+    fx = np.ascontiguousarray(F[:, :, 0].T)                     # (N, B)
+    fy = np.ascontiguousarray(F[:, :, 1].T)
+    bx = fx - np.cumsum(fx, axis=0)[-1] / n
+    by = fy - np.cumsum(fy, axis=0)[-1] / n
+    cr = np.cumsum(ax * bx + ay * by, axis=0)[-1] / den
+    ci = np.cumsum(ax * by - ay * bx, axis=0)[-1] / den
+    dx = cr * ax - ci * ay - bx
+    dy = cr * ay + ci * ax - by
+    return np.sqrt((dx * dx + dy * dy).max(axis=0))
 
 
 def _off_sheet(V: np.ndarray) -> Callable[[np.ndarray, np.ndarray], str | None]:

@@ -114,7 +114,8 @@ class FKSolver:
 
     __slots__ = ("team", "sheet", "hold_height", "method", "backend", "_Vn", "_table", "_sizes",
                  "_scale", "_vcx", "_vcy", "_lim2", "_width", "_hull", "_A", "_args",
-                 "_fast", "_shape", "_mass", "_pack", "_out_shape", "_make", "_solve_one",
+                 "_fast", "_shape", "_mass", "_pack", "_out_shape", "_make", "_make_out",
+                 "_solve_one",
                  "__weakref__")
 
     def __init__(self, team: SheetTeam, *, method: Method = "fast",
@@ -157,6 +158,7 @@ class FKSolver:
         self._shape = (N, 2)
         self._mass = team.mass
         self._make = FKResult._rows_maker(self.method, sheet, self.hold_height, team.mass)
+        self._make_out = FKResult._out_maker(self.method, sheet, self.hold_height, team.mass)
         self._pack = np.zeros(0)
         self._out_shape = (0, self._width)
         self._solve_one: Callable[..., int] = _no_kernel
@@ -167,7 +169,7 @@ class FKSolver:
                 self._vcx, self._vcy, self.hold_height, _snap_screen(self._scale))
             self._out_shape = (bk.out_rows(N, len(table)), self._width)
             if self._fast:
-                self._solve_one = _specialised(bk.solve_one, np.zeros(self._shape),
+                self._solve_one = _specialised(bk.solve_one, _any_formation(N),
                                                self._pack, np.empty(self._out_shape))
 
     def __repr__(self) -> str:
@@ -197,14 +199,14 @@ class FKSolver:
         if self._fast:                              # the hot path: one compiled call
             if (type(formation) is _NDARRAY and formation.dtype is _FLOAT64
                     and formation.shape == self._shape):
-                R = formation.copy()                # C-contiguous; the result keeps it
+                R = formation                       # any strides: the kernel copies it
             else:
                 R = self._formation(formation, check)
             out = _EMPTY(self._out_shape)
             code = self._solve_one(R, self._pack, out)
             if code >= 0:                           # the rows are the answer
-                return self._make(out[:code], R)
-            return self._flagged(R, out, code)
+                return self._make_out(out, code)
+            return self._flagged(out, code)
         if self.backend != "numba":
             return forward_numpy(self.sheet, formation, self.hold_height, self._mass,
                                  self.method)
@@ -221,10 +223,12 @@ class FKSolver:
             check_formation(self.sheet, R)          # raises the shape error
         return R
 
-    def _flagged(self, R: np.ndarray, out: np.ndarray, code: int) -> FKResult:
+    def _flagged(self, out: np.ndarray, code: int) -> FKResult:
         """The result of a :func:`~taut.sheet._kernels.batch.solve_one` call whose rows need
         more than the kernel did (an infeasible formation, weight families, a formation
         next to a similar copy of the sheet)."""
+        N = self.sheet.n
+        R = out[-1, :2 * N].reshape(N, 2)           # the kernel's copy of the formation
         k, flags = bk.decode(code)
         rows = None if k < 0 else self._finish(R, out[:k], flags & bk.HAS_PENDING,
                                                near=bool(flags & bk.NEAR_COPY))
@@ -450,10 +454,22 @@ def _specialised(kernel: Any, *args: np.ndarray) -> Callable[..., int]:
     ``args``, loaded from numba's on-disk cache (or compiled) as a first call would load
     it, as a plain callable: a call skips numba's dispatch on the argument types (~0.1 us
     of a ~3 us call at N = 3). It checks no type: the caller passes arrays of exactly
-    those types (``FKSolver.solve``: float64, C-contiguous, aligned, fresh)."""
+    those types (``FKSolver.solve``: a float64 (N, 2) formation of any layout, then the
+    pack and a fresh C-contiguous buffer)."""
     import numba
 
     return kernel.compile(tuple(numba.typeof(a) for a in args))
+
+
+def _any_formation(N: int) -> np.ndarray:
+    """An example float64 (N, 2) formation of numba's most general array type (any
+    strides, read-only; numba types unaligned arrays as aligned ones, as its dispatcher
+    does): ``solve_one`` specialised for it reads any native float64 (N, 2) array, which
+    it copies before anything else (``FKSolver.solve`` passes the caller's array as it
+    is)."""
+    example = np.zeros((N, 3))[:, :2]
+    example.flags.writeable = False
+    return example
 
 
 def _snap_screen(size: float) -> tuple[float, float, float]:
