@@ -201,6 +201,19 @@ IK_SLSQP_FTOL = 1e-12
 #: (dimensionless): strictly inside, 1000x BOUNDARY_RTOL, so the small moves of polishing
 #: keep the pairs within their limits.
 IK_PAIR_SHRINK = 1e-7
+#: Pair-limit constraint generation (dense SLSQP gets one Jacobian row per pair it is
+#: given: all N(N-1)/2 pairs of a 1,000-robot team are 8 GB per copy). Each solve is given
+#: every robot's this many nearest robots (at the current point) ...
+IK_PAIR_NEIGHBOURS = 6
+#: ... plus every pair whose squared-distance slack is below this fraction of its squared
+#: limit (dimensionless; violated pairs included). After a solve, any left-out pair below it
+#: is added and the solve repeated, so a pair left out of the final solve is at least this
+#: far inside its limit: inactive, and the answer is the all-pairs problem's.
+IK_PAIR_NEAR = 0.05
+#: Most solves (rounds) of that constraint generation per optimisation; when a round still
+#: leaves out a near or violated pair, the last point is returned and the caller's exact
+#: check (``check_solution``) decides, as for any other SLSQP result.
+IK_PAIR_ROUNDS = 6
 #: A cable counts as too short for the depth when its length is at most ``depth * (1 + this)``
 #: (dimensionless): rounding of the given lengths (~1e-16) must not hide a cable at the depth.
 DEPTH_RTOL = 1e-12

@@ -15,7 +15,10 @@ at the origin, lengths divided by the sheet size; robot ``i`` stands at :math:`\
   directions, and random angles), each solved for feasibility with the pair limits *without*
   margin, so solutions with a pair at exactly its sheet distance (the boundary case) are
   found;
-* :func:`check_solution`: the exact acceptance test of a candidate.
+* :func:`check_solution`: the exact acceptance test of a candidate;
+* :func:`solve_pairs` and :class:`PairLimits`: both stages' SLSQP solves, given only the
+  robot pairs near their limits or neighbouring (constraint generation: every pair is
+  checked on each result and the near ones added), not all N(N-1)/2 pair rows.
 """
 
 from __future__ import annotations
@@ -28,11 +31,11 @@ from scipy.optimize import linprog, minimize
 
 from ._weights import closure_directions
 from .._lifted import Frame, reduced_hessian_min_eig
-from .._tol import (BOUNDARY_RTOL, EQUATION_RTOL, IK_PAIR_SHRINK, IK_SLSQP_FTOL, MIN_CURVATURE,
-    MIN_WEIGHT, RANK_TOL, TINY)
+from .._tol import (BOUNDARY_RTOL, EQUATION_RTOL, IK_PAIR_NEAR, IK_PAIR_NEIGHBOURS,
+    IK_PAIR_ROUNDS, IK_PAIR_SHRINK, IK_SLSQP_FTOL, MIN_CURVATURE, MIN_WEIGHT, RANK_TOL, TINY)
 
 __all__ = ["robots", "curvature", "check_solution", "joint_optimise", "multistart_search",
-           "Candidate"]
+           "solve_pairs", "PairLimits", "Candidate"]
 
 
 @dataclass(frozen=True)
@@ -123,15 +126,53 @@ def polish(V: np.ndarray, rho: np.ndarray, w: np.ndarray, th: np.ndarray
     return th, w
 
 
-def _constraints(V: np.ndarray, rho: np.ndarray, spacing_factor: float, min_weight: float,
-                 need_curv: bool, margin: float = 0.0) -> list[dict[str, Any]]:
+@dataclass(frozen=True)
+class PairLimits:
+    """The pair limits :math:`|r_i - r_j|^2 \\le L_{ij} = (D_{ij} - m)^2 \\cdot`
+    ``spacing_factor`` over all pairs ``i < j`` (``np.triu_indices`` order; normalised
+    lengths, ``margin`` :math:`m`)."""
+
+    iu: np.ndarray
+    ju: np.ndarray
+    lim2: np.ndarray
+
+    @classmethod
+    def build(cls, V: np.ndarray, spacing_factor: float, margin: float = 0.0
+              ) -> "PairLimits":
+        iu, ju = np.triu_indices(len(V), 1)
+        D = np.maximum(np.sqrt(np.sum((V[iu] - V[ju]) ** 2, axis=1)) - margin, 0.0)
+        return cls(iu, ju, D * D * spacing_factor)
+
+    def slack(self, R: np.ndarray) -> np.ndarray:
+        """:math:`L_{ij} - |r_i - r_j|^2` of every pair for robots R (N, 2)."""
+        return self.lim2 - np.sum((R[self.iu] - R[self.ju]) ** 2, axis=1)
+
+    def working(self, R: np.ndarray, neighbours: int) -> np.ndarray:
+        """Mask of the pairs a solve from robots R (N, 2) is given: those whose slack is
+        below ``IK_PAIR_NEAR`` of their limit (violated ones included) and each robot's
+        ``neighbours`` nearest robots."""
+        N = len(R)
+        use = self.slack(R) < IK_PAIR_NEAR * self.lim2
+        k = min(neighbours, N - 1)
+        if k >= N - 1:
+            use[:] = True
+        elif k > 0:
+            d2 = np.sum((R[:, None, :] - R[None, :, :]) ** 2, axis=-1)
+            np.fill_diagonal(d2, np.inf)
+            near = np.argpartition(d2, k - 1, axis=1)[:, :k]
+            i = np.repeat(np.arange(N), k)
+            lo, hi = np.minimum(i, near.ravel()), np.maximum(i, near.ravel())
+            use[lo * N - lo * (lo + 1) // 2 + hi - lo - 1] = True
+        return use
+
+
+def _constraints(V: np.ndarray, rho: np.ndarray, limits: PairLimits, use: np.ndarray,
+                 min_weight: float, need_curv: bool) -> list[dict[str, Any]]:
     """SLSQP constraints over z = (theta, w): the five equations, the weights, the pair
-    limits :math:`(D_{ij} - m)^2 \\cdot` ``spacing_factor`` :math:`- |r_i - r_j|^2 \\ge 0`
-    (``margin`` :math:`m`, normalised length) and, for N <= 4, the curvature."""
+    limits ``limits`` selected by the mask ``use`` (:class:`PairLimits`) and, for N <= 4,
+    the curvature."""
     N = len(rho)
-    iu, ju = np.triu_indices(N, 1)
-    D = np.maximum(np.sqrt(np.sum((V[iu] - V[ju]) ** 2, axis=1)) - margin, 0.0)
-    vdist2 = D * D * spacing_factor
+    iu, ju, vdist2 = limits.iu[use], limits.ju[use], limits.lim2[use]
 
     def d_robots(th: np.ndarray) -> np.ndarray:
         return rho[:, None] * np.column_stack([-np.sin(th), np.cos(th)])
@@ -216,17 +257,47 @@ def _slsqp(obj: Callable[[np.ndarray], tuple[float, np.ndarray]], z0: np.ndarray
     return np.asarray(res.x)
 
 
+def solve_pairs(obj: Callable[[np.ndarray], tuple[float, np.ndarray]], z0: np.ndarray,
+                V: np.ndarray, rho: np.ndarray, limits: PairLimits, min_weight: float,
+                need_curv: bool, maxiter: int = 300,
+                neighbours: int = IK_PAIR_NEIGHBOURS) -> np.ndarray | None:
+    """SLSQP over z = (theta, w) from ``z0`` with the pair limits generated: the first
+    solve is given the pairs :meth:`PairLimits.working` picks at ``z0``; after each solve
+    every pair is checked, the pairs it picks at the result that were left out are added,
+    and the solve is repeated from ``z0`` (a warm start from the violating point reached
+    fewer formations in the tests), at most ``IK_PAIR_ROUNDS`` solves; then the last point
+    is returned, for the caller's exact check. A pair left out of the final solve is at
+    least ``IK_PAIR_NEAR`` of its limit inside it (inactive), so a stationary point of the
+    final solve is one of the problem with every pair. Returns z, or None when SLSQP
+    fails."""
+    N = len(rho)
+    use = limits.working(robots(rho, z0[:N]), neighbours)
+    z = z0
+    for _ in range(IK_PAIR_ROUNDS):
+        out = _slsqp(obj, z0, _constraints(V, rho, limits, use, min_weight, need_curv), N,
+                     maxiter)
+        if out is None or not np.all(np.isfinite(out)):
+            return out
+        z = out
+        add = limits.working(robots(rho, z[:N]), neighbours) & ~use
+        if not add.any():
+            break
+        use |= add
+    return z
+
+
 def joint_optimise(V: np.ndarray, rho: np.ndarray, phi: np.ndarray, w0: np.ndarray,
                    th0: np.ndarray, ref: np.ndarray | None, need_curv: bool,
                    margin: float = 0.0) -> tuple[np.ndarray, np.ndarray] | None:
     """SLSQP over (theta, w) from (th0, w0): the alignment with ``phi`` (or the motion
     from ``ref``), pair limits kept strictly inside (factor 1 - 1e-7) and ``margin``
-    (normalised length) inside their sheet distances. Returns polished (theta, w) or
-    None."""
+    (normalised length) inside their sheet distances, generated (:func:`solve_pairs`).
+    Returns polished (theta, w) or None."""
     N = len(rho)
     obj = _alignment_objective(rho, phi) if ref is None else _motion_objective(rho, ref)
-    cons = _constraints(V, rho, 1 - IK_PAIR_SHRINK, MIN_WEIGHT * 10, need_curv, margin)
-    z = _slsqp(obj, np.concatenate([th0, w0]), cons, N)
+    limits = PairLimits.build(V, 1 - IK_PAIR_SHRINK, margin)
+    z = solve_pairs(obj, np.concatenate([th0, w0]), V, rho, limits, MIN_WEIGHT * 10,
+                    need_curv)
     return None if z is None else polish(V, rho, z[N:], z[:N])
 
 
@@ -278,7 +349,7 @@ def multistart_search(V: np.ndarray, rho: np.ndarray, w_max: np.ndarray, phi: np
     """
     N = len(rho)
     rng = np.random.default_rng(seed)
-    cons = _constraints(V, rho, 1.0, 2 * MIN_WEIGHT, N <= 4)
+    limits = PairLimits.build(V, 1.0)
     tried = 0
     for th0, w0 in _starts(V, rho, w_max, phi, rng, budget):
         tried += 1
@@ -288,7 +359,7 @@ def multistart_search(V: np.ndarray, rho: np.ndarray, w_max: np.ndarray, phi: np
             d = z - z0
             return 1e-3 * float(d @ d), 2e-3 * d
 
-        z = _slsqp(obj, z0, cons, N, maxiter=200)
+        z = solve_pairs(obj, z0, V, rho, limits, 2 * MIN_WEIGHT, N <= 4, maxiter=200)
         out = None if z is None else polish(V, rho, z[N:], z[:N])
         if out is not None and accept(*out):
             return Candidate(out[0], out[1], "search"), tried
