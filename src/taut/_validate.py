@@ -105,6 +105,17 @@ MAX_SPEED = 1e3
 MAX_ACCELERATION = 1e3 * MAX_SPEED
 #: Largest number of robots in a team (FK is O(N^2) hull faces; planning far less).
 MAX_ROBOTS = 1000
+#: Largest number of cables of a cable robot (real CDPRs have 4 to a few tens; FASTKIT 8).
+MAX_CABLES = 100
+#: Largest count of numbers (candidate facets times the subset matrix and row each holds)
+#: an exact wrench or twist set may build for one pose (:mod:`taut.cdpr.sets._budget`).
+#: Measured (`/usr/bin/time`, peak RSS, ~0.17 GB of it start-up; CPU time loaded):
+#: `taut cdpr wrench-set`, 6-DoF fixed ring of 12 cables: 16.6 million, 0.43 GB, 9-10 s;
+#: the library's wrench set of a 3-DoF ring of 11 cables (37 million, now refused): 0.76 GB;
+#: `taut cdpr twist-set`, 48 cables and one moving base: 27.6 million, 0.74 GB, 3 s; 10
+#: cables on 4 moving bases: 28.0 million, 0.50 GB, 6.5 s. So an accepted set stays under
+#: ~0.8 GB; one more cable multiplies the count by 2-6.
+MAX_SET_NUMBERS = 30_000_000
 #: Largest number of poses / formations / grid points in one call.
 MAX_BATCH = 10_000_000
 #: Largest control or sampling rate, Hz (1 MHz; FASTKIT's controller runs at 1 kHz).
@@ -120,6 +131,7 @@ LIMITS: dict[str, tuple[float, str]] = {
     "speed": (MAX_SPEED, "m/s or rad/s"),
     "acceleration": (MAX_ACCELERATION, "m/s^2"),
     "robots": (MAX_ROBOTS, "robots"),
+    "cables": (MAX_CABLES, "cables"),
     "batch": (MAX_BATCH, "items"),
     "rate": (MAX_RATE_HZ, "Hz"),
     "duration": (MAX_DURATION_S, "s"),

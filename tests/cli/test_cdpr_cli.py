@@ -178,3 +178,48 @@ def test_options_left_out_take_the_library_defaults(capsys, monkeypatch):
         for name in ("base_min", "base_max", "cable_min", "cable_max"):
             np.testing.assert_array_equal(getattr(got, name), getattr(want, name))
     capsys.readouterr()
+
+
+# --- the set budget: presets pass, models past it fail in one line ---------------------------
+
+def _ring(m: int) -> dict:
+    """A fixed frame of ``m`` cables (exits on a top and a bottom ring, 6-DoF platform)."""
+    a = 2 * np.pi * np.arange(m) / m
+    return {"name": f"ring of {m}",
+            "bases": [{"name": "frame", "mobile": False, "exit_points": {
+                f"A{i}": [2 * np.cos(x), 2 * np.sin(x), 3.0 * (i % 2)] for i, x in enumerate(a)}}],
+            "platform": {"mass": 2.0, "attachment_points": {
+                f"B{i}": [0.15 * np.cos(x), 0.15 * np.sin(x), 0.1 - 0.2 * (i % 2)]
+                for i, x in enumerate(a)}},
+            "cables": [{"name": f"C{i}", "exit": f"frame.A{i}", "attachment": f"B{i}",
+                        "t_min": 10.0, "t_max": 1500.0} for i in range(m)]}
+
+
+@pytest.mark.parametrize("model", PRESETS)
+def test_presets_pass_the_set_budget(capsys, model):
+    """wrench-set and twist-set (every base moving) on each preset answer (exit 0 or 1)."""
+    robot = load_cdpr_model(model)
+    pose = ["--pose", "0", "0", "1.0"]
+    assert main(["cdpr", "wrench-set", model, *pose]) in (0, 1)
+    moving = [f"--moving={b.name}" for b in robot.bases if b.mobile]
+    assert main(["cdpr", "twist-set", model, *pose, *moving]) in (0, 1)
+    assert "error" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("m, command, ok", [(16, "wrench-set", False), (13, "wrench-set", False),
+                                            (16, "twist-set", True)])
+def test_set_past_its_budget_is_one_line(tmp_path, capsys, m, command, ok):
+    """A wrench set of 13 or 16 cables is refused in one line (exit 2) naming the cable
+    count and the budget; the twist set of the same frame (no moving base) is small."""
+    from taut._validate import MAX_SET_NUMBERS
+    path = tmp_path / "ring.json"
+    path.write_text(json.dumps(_ring(m)))
+    code = main(["cdpr", command, str(path), "--pose", "0", "0", "1.5"])
+    err = capsys.readouterr().err
+    if ok:
+        assert code in (0, 1) and "error" not in err
+        return
+    assert code == 2
+    assert err.count("\n") == 1
+    assert err.startswith(f"taut: error: cables: {m} cables give ")
+    assert err.rstrip().endswith(f"at most {MAX_SET_NUMBERS:,} numbers")

@@ -131,41 +131,60 @@ def ring_of_cables(m):
                         "t_min": 10.0, "t_max": 1500.0} for i in range(m)]}
 
 
-def ring_of_bases(k):
-    """FASTKIT's cable robot with ``k`` copies of its active mobile base (4 cables each) on
-    a 3 m circle around the platform (a model mapping)."""
+def ring_of_bases(k, cables=None):
+    """FASTKIT's cable robot with ``k`` copies of its active mobile base on a 3 m circle
+    around the platform (a model mapping); ``cables[i]`` of the 4 exits of base ``i`` are
+    used (default all 4)."""
     import yaml
 
     from taut.io.cdpr_model import preset_path
     fastkit = yaml.safe_load(preset_path("fastkit").read_text())
     base, points = fastkit["bases"][0], list(fastkit["platform"]["attachment_points"])
-    bases, cables = [], []
+    bases, cables_ = [], []
     for i, phi in enumerate(2 * np.pi * np.arange(k) / k):
         bases.append(dict(base, name=f"base{i + 1}", pose=[round(-3 * np.cos(phi), 6),
                                                             round(-3 * np.sin(phi), 6),
                                                             round(phi, 6)]))
-        cables += [{"name": f"C{j + 1}{i + 1}", "exit": f"base{i + 1}.{p}",
-                    "attachment": points[(4 * i + j) % len(points)], "t_min": 5.0,
-                    "t_max": 45.0} for j, p in enumerate(base["exit_points"])]
+        used = list(base["exit_points"])[:4 if cables is None else cables[i]]
+        cables_ += [{"name": f"C{j + 1}{i + 1}", "exit": f"base{i + 1}.{p}",
+                     "attachment": points[(4 * i + j) % len(points)], "t_min": 5.0,
+                     "t_max": 45.0} for j, p in enumerate(used)]
     return {"name": f"{k} mobile bases", "bases": bases, "platform": fastkit["platform"],
-            "payload": fastkit["payload"], "cables": cables}
+            "payload": fastkit["payload"], "cables": cables_}
 
 
 @pytest.mark.parametrize("model, args", [
-    # one pose takes milliseconds for any real robot; the closed form fixes one cable a step,
-    # so 6,000 cables take ~5 s of CPU (and 1.3 GB; 9 s loaded: slow). qp_min_norm is no test:
-    # DAQP's solve holds the interpreter, Ctrl-C is answered when it returns (25 s for 1,500
-    # cables, loaded)
-    pytest.param(ring_of_cables(6000), ["tensions"], id="tensions", marks=pytest.mark.slow),
-    pytest.param(ring_of_cables(12), ["wrench-set"], id="wrench-set"),     # ~9 s of CPU
-    pytest.param(ring_of_bases(6), ["twist-set", "--moving", "base1", "--moving", "base2"],
-                 id="twist-set"),                                            # ~12 s of CPU
+    # the largest inputs the set budget (taut._validate.MAX_SET_NUMBERS) accepts run for
+    # seconds: a 6-DoF fixed ring of 12 cables (16.6 million numbers: ~9 s of CPU, 0.43 GB)
+    # and 10 cables on 4 moving bases (28 million: ~5 s of CPU beyond start-up, 0.5 GB)
+    pytest.param(ring_of_cables(12), ["wrench-set"], id="wrench-set"),
+    pytest.param(ring_of_bases(4, [3, 3, 2, 2]),
+                 ["twist-set", *(f"--moving=base{i}" for i in range(1, 5))], id="twist-set"),
 ])
 def test_cable_robot_pose_commands_interrupted(tmp_path, model, args):
     """The one-pose analyses, on models whose size makes them take seconds."""
     (tmp_path / "model.json").write_text(json.dumps(model))
     assert_interrupted(*interrupt(["cdpr", args[0], str(tmp_path / "model.json"), "--pose",
                                    "0", "0", "1.5", *args[1:]], f"taut: cdpr {args[0]}: working"))
+
+
+@pytest.mark.parametrize("model, args, field", [
+    # `tensions` takes milliseconds for any accepted model (at most MAX_CABLES cables), so
+    # it has no long input to interrupt: the 6,000-cable ring that used to take 5 s of CPU
+    # and 1.3 GB is refused at once, as are sets past their budget
+    (ring_of_cables(6000), ["tensions"], "cables"),
+    (ring_of_cables(16), ["wrench-set"], "cables"),
+    (ring_of_bases(6), ["twist-set", "--moving", "base1", "--moving", "base2"], "cables"),
+])
+def test_cable_robot_inputs_too_large_fail_fast(tmp_path, model, args, field):
+    """One line, exit 2, before any progress line (so long before 2 s of work)."""
+    (tmp_path / "model.json").write_text(json.dumps(model))
+    proc = subprocess.run([str(TAUT), "cdpr", args[0], str(tmp_path / "model.json"), "--pose",
+                           "0", "0", "1.5", *args[1:]], cwd=ROOT, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(f"taut: error: {field}: ")
 
 
 # IK of the largest team: at its first progress line it is verifying candidates with

@@ -93,7 +93,16 @@ BAD = {
                          "payload.mass"),
     "duplicate exit use": (lambda d: d["cables"][1].update(exit="active.A1"),
                            InvalidModelError, "cables[1].exit"),
+    "more cables than accepted": (lambda d: _cables(d, 101), InvalidModelError, "cables"),
 }
+
+
+def _cables(d, m):
+    """Give the model ``m`` cables from as many new exit points of its first base."""
+    base = d["bases"][0]
+    base["exit_points"].update({f"X{i}": [0.01 * i, 0.0, 2.0] for i in range(m)})
+    d["cables"] = [dict(d["cables"][0], name=f"X{i}", exit=f"{base['name']}.X{i}")
+                   for i in range(m)]
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
@@ -105,8 +114,19 @@ def test_bad_models_raise_typed_errors(fastkit_map, case):
     assert isinstance(e.value, InvalidInputError)
 
 
+def test_cable_count_limit(fastkit_map):
+    """At most MAX_CABLES cables: that many load, one more is refused naming both counts."""
+    from taut._validate import MAX_CABLES
+    assert cdpr_model_from_mapping(_broken(fastkit_map, lambda d: _cables(d, MAX_CABLES))
+                                   ).m == MAX_CABLES
+    with pytest.raises(InvalidModelError) as e:
+        cdpr_model_from_mapping(_broken(fastkit_map, lambda d: _cables(d, MAX_CABLES + 1)))
+    assert e.value.problem == f"{MAX_CABLES + 1} cables exceed the accepted range " \
+                              f"{MAX_CABLES} cables"
+
+
 @pytest.mark.parametrize("case", ["missing exit point", "min above max", "non-convex footprint",
-                                  "NaN", "unknown key"])
+                                  "NaN", "unknown key", "more cables than accepted"])
 def test_cli_reports_bad_model_in_one_line(tmp_path, capsys, fastkit_map, case):
     edit, _, field = BAD[case]
     p = tmp_path / "bad.yaml"

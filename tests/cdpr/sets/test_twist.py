@@ -279,3 +279,51 @@ def test_structured_facets_equal_generic(fastkit, moving):
         dist = np.abs(ref[:, None, :] - got[None, :, :]).max(axis=2)
         assert dist.min(axis=1).max() < 1e-7          # every generic facet is found
         assert dist.min(axis=0).max() < 1e-7          # and nothing else
+
+
+@pytest.mark.parametrize("moving, frozen", [(None, False), ((), False),
+                                            (("active", "passive"), False), (None, True)])
+def test_predicted_twist_facets_are_the_enumerated_rows(fastkit, moving, frozen):
+    """The closed-form count of the budget is the number of rows the task-mode set
+    builds, on the structured path and (one cable frozen) the generic one."""
+    from taut.cdpr.sets._budget import twist_work
+    lim = fastkit_motion_limits()
+    if frozen:
+        lo = np.full(fastkit.m, -2.0)
+        lo[0] = 0.0
+        lim = replace(lim, cable_min=lo, cable_max=np.where(lo == 0.0, 0.0, 2.0))
+    ats = available_twist_set(fastkit, POSES[0], lim, moving=moving)
+    nb = 3 * len(ats.mode.moving)
+    assert ats.H.shape[0] == twist_work(fastkit.m, nb, fastkit.m - int(frozen))[0]
+
+
+def test_twist_set_past_its_budget_is_refused_before_any_work(fastkit):
+    """FASTKIT's active base copied 5 times around the platform (20 cables) with two
+    moving bases: 1.3 million candidate facets, refused naming the cables and the moving
+    base joints; fixed bases, one moving base, and every preset with both moving pass."""
+    from taut._validate import MAX_SET_NUMBERS
+    from taut.cdpr.sets._budget import twist_work
+    from taut.io.cdpr_model import PRESETS, load_cdpr_model
+    act = fastkit.bases[0]
+    cables = [c for c in fastkit.cables if c.base == act.name]
+    bases, cab = [], []
+    for k in range(5):
+        phi = 2 * np.pi * k / 5
+        name = f"b{k}"
+        bases.append(replace(act, name=name, pose=(-3 * np.cos(phi), -3 * np.sin(phi), phi)))
+        cab += [replace(c, name=f"{c.name}{k}", base=name) for c in cables]
+    att = {f"{c.attachment}": fastkit.platform.attachment_points[c.attachment]
+           for c in cables}
+    robot = CableRobot(tuple(bases), replace(fastkit.platform, attachment_points=att),
+                       tuple(cab))
+    with pytest.raises(InvalidInputError) as e:
+        available_twist_set(robot, [0, 0, 1.5], moving=("b0", "b1"))
+    assert e.value.field == "cables"
+    assert "20 cables and 6 moving base joints give 1,315,600 candidate facets" \
+        in e.value.problem
+    with pytest.raises(InvalidInputError):
+        twist_capacities(robot, [0, 0, 1.5], moving=("b0", "b1"))
+    assert available_twist_set(robot, [0, 0, 1.5], moving=()).H.shape[0] == 40
+    assert twist_work(20, 3, 20)[1] <= MAX_SET_NUMBERS
+    for name in PRESETS:
+        assert twist_work(load_cdpr_model(name).m, 6, 8)[1] <= MAX_SET_NUMBERS

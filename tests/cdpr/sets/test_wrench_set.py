@@ -217,3 +217,67 @@ def test_three_redundant_cables_generic():
     b = axis_capacities(robot, P[:10], tipping=False, method="lp")
     np.testing.assert_allclose(a.positive, b.positive, atol=1e-6)
     np.testing.assert_allclose(a.negative, b.negative, atol=1e-6)
+
+
+def ring_robot(m, point_mass=False):
+    """A fixed frame with ``m`` cables from a ring of exits to a ring of anchors (6-DoF), or
+    to one point (3-DoF)."""
+    from taut.cdpr import Base, Cable, CableRobot, Platform
+    ang = 2 * np.pi * np.arange(m) / m
+    exits = {f"A{i}": (3 * np.cos(a), 3 * np.sin(a), 3.0 if i % 2 else 0.5)
+             for i, a in enumerate(ang)}
+    anchors = {f"B{i}": (0.0, 0.0, 0.0) if point_mass else
+               (0.4 * np.cos(a), 0.4 * np.sin(a), 0.2 if i % 2 else -0.2)
+               for i, a in enumerate(ang)}
+    return CableRobot((Base("frame", exits),), Platform(anchors, mass=10.0),
+                      tuple(Cable(f"C{i}", "frame", f"A{i}", f"B{i}", 5.0, 500.0)
+                            for i in range(m)))
+
+
+@pytest.mark.parametrize("robot, tipping", [("fastkit", True), ("fastkit", False),
+                                            ("ipanema", False), ("six point", False)])
+def test_predicted_candidates_are_the_enumerated_rows(request, robot, tipping):
+    """The closed-form count of the budget is the number of rows the AWS builds."""
+    from taut.cdpr.sets._budget import wrench_work
+    robot = ring_robot(6, point_mass=True) if robot == "six point" else \
+        request.getfixturevalue(robot)
+    aws = available_wrench_set(robot, [0, 0, 1.0], tipping=tipping)
+    assert aws.H.shape[0] == wrench_work(robot, tipping, robot.has_sliding)[0]
+
+
+def test_wrench_set_past_its_budget_is_refused_before_any_work():
+    """13 cables on a 6-DoF platform (1.56 million candidate facets) and 11 on a point
+    (3-DoF, r = 8) are refused, naming the cable count and the numbers; 12 cables (the
+    tests' twelve-cable model, 0.35 million) and every preset are accepted."""
+    from taut._validate import MAX_SET_NUMBERS
+    from taut.cdpr.sets._budget import wrench_work
+    from taut.errors import InvalidInputError
+    from taut.io.cdpr_model import PRESETS, load_cdpr_model
+    from cdpr_helpers import twelve_cable_robot
+    for robot, m in [(ring_robot(13), 13), (ring_robot(11, point_mass=True), 11)]:
+        for call in (lambda: available_wrench_set(robot, [0, 0, 1.5], tipping=False),
+                     lambda: wrench_feasible(robot, [[0, 0, 1.5]] * 3),
+                     lambda: capacity_margin(robot, [0, 0, 1.5]),
+                     lambda: axis_capacities(robot, [0, 0, 1.5])):
+            with pytest.raises(InvalidInputError) as e:
+                call()
+            assert e.value.field == "cables"
+            assert f"{m} cables give " in e.value.problem
+            assert f"at most {MAX_SET_NUMBERS:,} numbers" in e.value.problem
+    assert wrench_work(twelve_cable_robot(), True, True)[1] <= MAX_SET_NUMBERS
+    for name in PRESETS:
+        robot = load_cdpr_model(name)
+        assert wrench_work(robot, True, True)[1] <= MAX_SET_NUMBERS
+
+
+def test_capacity_margin_in_blocks_equals_one_set(fastkit, monkeypatch):
+    """capacity_margin enumerates the facets of a block of poses at a time; with blocks of
+    two poses it returns what the whole batch gives."""
+    import taut.cdpr.sets._budget as budget
+    P = random_poses(fastkit, 7, seed=3)
+    whole = capacity_margin(fastkit, P, tipping=True)
+    work = budget.wrench_work(fastkit, True, fastkit.has_sliding)
+    assert budget.block_size(work, 256) == 256
+    monkeypatch.setattr(budget, "MAX_SET_NUMBERS", 2 * work[1])
+    assert budget.block_size(work, 256) == 2
+    np.testing.assert_array_equal(capacity_margin(fastkit, P, tipping=True), whole)

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..._units import GRAVITY
-from ..._validate import MAX_TENSION_N, as_array, as_finite_scalar, check_range
+from ..._validate import MAX_CABLES, MAX_TENSION_N, as_array, as_finite_scalar, check_range
 from ...errors import InvalidModelError
 from .footprint import check_footprint
 from .parts import Base, Cable, Payload, Platform
@@ -40,7 +40,8 @@ class CableRobot(CompactRepr):
     bases : sequence of Base
     platform : Platform
     cables : sequence of Cable
-        Cable order defines the column order of the wrench matrix ``W`` (FASTKIT eq. 18).
+        Cable order defines the column order of the wrench matrix ``W`` (FASTKIT eq. 18);
+        at most :data:`taut._validate.MAX_CABLES`.
     payload : Payload, optional
     gravity : (3,), default (0, 0, -9.81)
         Gravity acceleration, m/s^2.
@@ -121,6 +122,9 @@ class CableRobot(CompactRepr):
         m = len(self.cables)
         if m == 0:
             raise InvalidModelError("cables", "at least one cable is required")
+        if m > MAX_CABLES:
+            raise InvalidModelError("cables", f"{m} cables exceed the accepted range "
+                                              f"{MAX_CABLES} cables")
         exits = np.empty((m, 3))
         attach = np.empty((m, 3))
         tmin = np.empty(m)

@@ -30,6 +30,7 @@ from ..kinematics.modes import (TWIST_LABELS, Mode, ModeName, MotionLimits, fast
     joint_bounds)
 from .polytope import HPolytopeBatch, lp_max_step
 from .zonotope import _facets_base_and_identity, zonotope_hrep
+from ._budget import block_size, check_set_work, twist_work
 from ..._validate import as_choice, as_count, require_instance
 from ..._repr import CompactRepr
 
@@ -68,22 +69,28 @@ class AvailableTwistSet(HPolytopeBatch, CompactRepr):
         return super()._points(x, "twist")
 
 
-def _task_set(fom: FirstOrderModel, lo: np.ndarray, hi: np.ndarray
+def _task_set(fom: FirstOrderModel, lo: np.ndarray, hi: np.ndarray, blk: int
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Task mode: ``{t : A t in Z}``, Z the joint-space zonotope ``B box`` (eq. 9)."""
+    """Task mode: ``{t : A t in Z}``, Z the joint-space zonotope ``B box`` (eq. 9); the
+    facets are enumerated for ``blk`` poses at a time."""
     Bn, m, n = fom.A.shape
     c = 0.5 * (lo + hi)
     half = 0.5 * (hi - lo)
     keep = half > 0
-    center = np.einsum("bmq,q->bm", fom.B, c)
     nb = fom.n_base_joints
-    if np.all(keep[nb:]):
-        kb = keep[:nb]
-        Hz, hz = _facets_base_and_identity(center, fom.B[:, :, :nb][:, :, kb] * half[:nb][kb],
-                                           half[nb:])
-    else:
-        Hz, hz = zonotope_hrep(center, fom.B[:, :, keep] * half[keep])
-    H = np.einsum("bsm,bmn->bsn", Hz, fom.A)
+    parts = []
+    for i in range(0, Bn, blk):
+        Bb = fom.B[i:i + blk]
+        center = np.einsum("bmq,q->bm", Bb, c)
+        if np.all(keep[nb:]):
+            kb = keep[:nb]
+            Hz, hz = _facets_base_and_identity(center, Bb[:, :, :nb][:, :, kb] * half[:nb][kb],
+                                               half[nb:])
+        else:
+            Hz, hz = zonotope_hrep(center, Bb[:, :, keep] * half[keep])
+        parts.append((np.einsum("bsm,bmn->bsn", Hz, fom.A[i:i + blk]), hz))
+    H = np.concatenate([p[0] for p in parts])
+    hz = np.concatenate([p[1] for p in parts])
     nrm = np.linalg.norm(H, axis=2)
     use = nrm > ZERO_ROW
     H = np.where(use[..., None], H / np.where(use, nrm, 1.0)[..., None], 0.0)
@@ -133,6 +140,13 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     mode, moving
         See :func:`taut.cdpr.resolve_mode`. ``mode="task", moving=()`` fixes every base.
 
+    Raises
+    ------
+    InvalidInputError
+        ``cables``: the task-mode facets would need more than
+        :data:`taut._validate.MAX_SET_NUMBERS` numbers per pose (e.g. 20 cables with two
+        moving bases).
+
     Returns
     -------
     AvailableTwistSet
@@ -152,8 +166,14 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     limits = fastkit_motion_limits() if limits is None else limits
     fom = first_order_model(robot, as_poses(robot, poses), mode, moving)
     lo, hi = joint_bounds(robot, limits, fom.mode)
-    build = _task_set if fom.mode.kind == "task" else _navigation_set
-    H, h, E, full = build(fom, lo, hi)
+    if fom.mode.kind == "task":
+        nb = fom.n_base_joints
+        moves = hi > lo
+        work = twist_work(robot.m, int(moves[:nb].sum()), int(moves[nb:].sum()))
+        check_set_work(work, robot, "twist set", f"{nb} moving base joints")
+        H, h, E, full = _task_set(fom, lo, hi, block_size(work, 256))
+    else:
+        H, h, E, full = _navigation_set(fom, lo, hi)
     ats = AvailableTwistSet(H=H, h=h, E=E, poses=fom.poses, mode=fom.mode, full_rank=full,
                             model=fom, limits=limits)
     if single:

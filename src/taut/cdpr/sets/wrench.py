@@ -42,6 +42,7 @@ from .._tol import CONTAINS_TOL, VERTEX_SLACK, ZERO_ROW
 from ..kinematics.cables import as_poses, cable_state, gravity_wrench
 from ..model.robot import CableRobot
 from .polytope import HPolytopeBatch, lp_max_step
+from ._budget import block_size, check_set_work, wrench_work
 from ..._repr import CompactRepr
 
 __all__ = ["AvailableWrenchSet", "available_wrench_set", "wrench_feasible",
@@ -115,6 +116,13 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool =
         Include the friction rows of the mobile bases that have a friction coefficient
         (:mod:`taut.cdpr.statics.sliding`); no effect on a model without one.
 
+    Raises
+    ------
+    InvalidInputError
+        ``cables``: the enumeration would build more than
+        :data:`taut._validate.MAX_SET_NUMBERS` numbers per pose (more than 12 cables for a
+        6-DoF platform on a fixed frame).
+
     Returns
     -------
     AvailableWrenchSet
@@ -134,8 +142,11 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool =
     single = is_single(poses)
     P = as_poses(robot, poses)
     slide = bool(sliding and robot.has_sliding)
-    parts = [_aws_block(robot, P[i:i + 256], tipping, slide)
-             for i in range(0, P.shape[0], 256)]
+    work = wrench_work(robot, tipping, slide)
+    check_set_work(work, robot, "wrench set")
+    blk = block_size(work, 256)
+    parts = [_aws_block(robot, P[i:i + blk], tipping, slide)
+             for i in range(0, P.shape[0], blk)]
     H, h, ok, nonempty_, wg = (np.concatenate(x) for x in zip(*parts))
     aws = AvailableWrenchSet(H=H, h=h, E=np.zeros((P.shape[0], 0, robot.dof)), poses=P,
                              full_rank=ok, nonempty=nonempty_,
@@ -203,7 +214,8 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
         :func:`external_wrench_box`), N and N m.
     chunk : int
         Poses per vectorised block (memory ~ chunk * 60 kB with tipping; 256 is
-        fastest here).
+        fastest here); fewer when a block would exceed the budget of
+        :data:`taut._validate.MAX_SET_NUMBERS`.
     sliding : bool, default True
         Also require the friction condition of :mod:`taut.cdpr.statics.sliding` (bases with a
         friction coefficient only).
@@ -226,6 +238,10 @@ def wrench_feasible(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     single = is_single(poses)
     P = as_poses(robot, poses)
     chunk = as_count(chunk, "chunk", minimum=1)
+    if robot.m - robot.dof > 2:                       # Farkas certificates (else vertices)
+        work = wrench_work(robot, tipping, sliding)
+        check_set_work(work, robot, "wrench set")
+        chunk = block_size(work, chunk)
     D = wrench_vertices(robot, external_wrench)
     out = np.empty(P.shape[0], dtype=bool)
     tol = feas_tol(robot)
@@ -355,10 +371,14 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     tipping = as_flag(tipping, "tipping")
     sliding = as_flag(sliding, "sliding")
     single = is_single(poses)
-    aws = available_wrench_set(robot, as_poses(robot, poses), tipping=tipping, sliding=sliding)
+    P = as_poses(robot, poses)
     D = wrench_vertices(robot, external_wrench)
-    w = -(aws.gravity_wrench[:, None, :] + D[None, :, :])        # required cable wrenches
-    hw = np.einsum("bsn,bvn->bsv", aws.H, w).max(axis=2)
-    margin = np.min(aws.h - hw, axis=1)
-    out = np.where(aws.full_rank & aws.nonempty, margin, -np.inf)
+    blk = block_size(wrench_work(robot, tipping, bool(sliding and robot.has_sliding)), 256)
+    out = np.empty(P.shape[0])
+    for i in range(0, P.shape[0], blk):             # the facets of one block at a time
+        aws = available_wrench_set(robot, P[i:i + blk], tipping=tipping, sliding=sliding)
+        w = -(aws.gravity_wrench[:, None, :] + D[None, :, :])    # required cable wrenches
+        hw = np.einsum("bsn,bvn->bsv", aws.H, w).max(axis=2)
+        margin = np.min(aws.h - hw, axis=1)
+        out[i:i + blk] = np.where(aws.full_rank & aws.nonempty, margin, -np.inf)
     return first(out) if single else out
