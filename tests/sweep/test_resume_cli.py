@@ -9,7 +9,6 @@ import sys
 import textwrap
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 pytest.importorskip("pyarrow")
@@ -26,19 +25,8 @@ def taut(*args):
     return proc.returncode, proc.stdout, proc.stderr
 
 
-def same_rows(a, b):
-    """Results of two folders are equal row for row (NaN equal to NaN)."""
-    a, b = read_results(a)[0], read_results(b)[0]
-    assert list(a) == list(b)
-    for k in a:
-        if a[k].dtype.kind == "f":
-            np.testing.assert_array_equal(a[k], b[k])
-        else:
-            assert list(a[k]) == list(b[k]), k
-
-
 @pytest.mark.slow                       # ~20 s loaded: three `taut` processes
-def test_resume_flag_recomputes_a_truncated_chunk(tmp_path):
+def test_resume_flag_recomputes_a_truncated_chunk(tmp_path, same_rows):
     sweep = tmp_path / "s.yaml"
     sweep.write_text(textwrap.dedent(f"""\
         task: fk_stability_map
@@ -61,4 +49,4 @@ def test_resume_flag_recomputes_a_truncated_chunk(tmp_path):
     # (the recomputed chunk's name is not printed)
     assert re.search(r"^8 rows -> .* \(1 chunks computed, 2 reused, ", stdout, re.M), stdout
     assert len(chunk.read_bytes()) > 100
-    same_rows(out, clean)
+    same_rows(read_results(out)[0], read_results(clean)[0])
