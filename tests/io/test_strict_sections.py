@@ -114,7 +114,8 @@ def test_every_file_model_is_reachable_from_a_file_kind():
     assert len(REACHABLE) >= 20
 
 
-@pytest.mark.parametrize("model", sorted(REACHABLE | DEFINED, key=lambda m: m.__qualname__),
+@pytest.mark.parametrize("model", sorted(REACHABLE | DEFINED,
+                                         key=lambda m: (m.__qualname__, m.__module__)),
                          ids=lambda m: f"{m.__module__.rsplit('.', 1)[1]}.{m.__qualname__}")
 def test_every_model_forbids_unknown_keys_and_holds_no_any(model):
     assert model.model_config.get("extra") == "forbid", f"{model.__qualname__} is not strict"
