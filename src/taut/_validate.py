@@ -105,6 +105,13 @@ MAX_SPEED = 1e3
 MAX_ACCELERATION = 1e3 * MAX_SPEED
 #: Largest number of robots in a team (FK is O(N^2) hull faces; planning far less).
 MAX_ROBOTS = 1000
+#: Largest team inverse kinematics takes. Its joint search (SLSQP over two unknowns a
+#: robot, dense) costs ~N^3 a step and holds the interpreter for the whole step, so Ctrl-C
+#: waits for it. Measured (`taut ik` of a regular team, object at half the hold height,
+#: load 4-10): N = 100 3.9 s; N = 200 50 s (30 s CPU, 146 MB; Ctrl-C answered 4-6 s after
+#: the signal mid-search); N = 400 one step over 10 min; N = 1000 1.3-1.6 GB, unfinished
+#: after 400 s.
+MAX_IK_ROBOTS = 200
 #: Largest number of cables of a cable robot (real CDPRs have 4 to a few tens; FASTKIT 8).
 MAX_CABLES = 100
 #: Largest count of numbers (candidate facets times the subset matrix and row each holds)

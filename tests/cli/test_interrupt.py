@@ -187,17 +187,27 @@ def test_cable_robot_inputs_too_large_fail_fast(tmp_path, model, args, field):
     assert proc.stderr.startswith(f"taut: error: {field}: ")
 
 
-# IK of the largest team: at its first progress line it is verifying candidates with
-# forward kinematics (short steps; Ctrl-C answered in 0.5 s, loaded). Later its SLSQP step
-# builds dense arrays of N(N-1)/2 pair constraints x 2N unknowns (8 GB each for N = 1,000)
-# and then runs SciPy's Fortran SLSQP, which holds the interpreter for minutes (N = 400):
-# there Ctrl-C waits for the current numpy operation or Fortran call (7-28 s measured,
-# loaded). Slow target.
+# IK of the largest team it takes (MAX_IK_ROBOTS, 200): Ctrl-C at its first progress line
+# is answered in 0.2 s; later, mid-search, it waits for the current SLSQP step (4-6 s
+# measured, load 3-5). Slow target (the team's IK runs ~50 s uninterrupted).
 @pytest.mark.slow
-def test_ik_of_a_large_team_interrupted(tmp_path):
-    (tmp_path / "team.json").write_text(json.dumps(big_team()))
+def test_ik_of_the_largest_team_interrupted(tmp_path):
+    from taut._validate import MAX_IK_ROBOTS
+    (tmp_path / "team.json").write_text(json.dumps(big_team(MAX_IK_ROBOTS)))
     assert_interrupted(*interrupt(["ik", str(tmp_path / "team.json"), "--object", "0", "0",
                                    "500"], "taut: ik: working"))
+
+
+def test_ik_of_a_team_past_its_limit_is_one_line(tmp_path):
+    """1,000 robots (FK's limit): IK refuses at once (it used to run for minutes and grow
+    past 14 GB), one line naming the field, exit 2."""
+    (tmp_path / "team.json").write_text(json.dumps(big_team()))
+    proc = subprocess.run([str(TAUT), "ik", str(tmp_path / "team.json"), "--object", "0", "0",
+                           "500"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        "taut: error: sheet: 1000 robots; inverse kinematics takes at most 200 (its search "
+        "grows as N^3 a step)"]
 
 
 def test_simulate_interrupted(tmp_path):

@@ -53,8 +53,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import (MAX_SHEET_LENGTH, as_array, as_bounded, as_finite_scalar,
-    as_nonnegative, check_range)
+from ..._validate import (MAX_IK_ROBOTS, MAX_SHEET_LENGTH, as_array, as_bounded,
+    as_finite_scalar, as_nonnegative, check_range)
 from ...errors import InvalidInputError
 from ._certificate import (IKCertificate, closure_branch_certificate, closure_lp_certificate,
     depth_certificate, radial_certificate, triangle_certificate)
@@ -462,7 +462,7 @@ def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
     ------
     InvalidInputError
         Bad shapes or values, object not above the ground, contact not strictly inside
-        the sheet.
+        the sheet, a team of more than :data:`taut._validate.MAX_IK_ROBOTS` robots.
 
     Examples
     --------
@@ -477,6 +477,9 @@ def inverse_kinematics(team: SheetTeam, object_position: ArrayLike, *,
     """
     team = require_team(team)
     sheet = team.sheet
+    if sheet.n > MAX_IK_ROBOTS:
+        raise InvalidInputError("sheet", f"{sheet.n} robots; inverse kinematics takes at "
+                                f"most {MAX_IK_ROBOTS} (its search grows as N^3 a step)")
     t = _target(team, object_position, contact)
     heading = as_finite_scalar(heading, "heading")
     budget = int(as_nonnegative(budget, "budget"))
