@@ -312,3 +312,29 @@ def test_parallel_sweep_interrupted_ends_its_workers_and_keeps_its_chunks(tmp_pa
     for chunk in chunks:
         digest = Path(f"{chunk}.sha256").read_text().split()[0]
         assert hashlib.sha256(chunk.read_bytes()).hexdigest() == digest, chunk.name
+
+
+def test_an_interrupt_inside_llvmlite_is_raised_again_outside(monkeypatch):
+    """Python drops an exception raised in a ctypes callback (llvmlite's object-cache
+    notification, while numba compiles) and prints 'Exception ignored' with a traceback
+    (seen in fresh-clone CI: Ctrl-C while `cdpr mission` compiled a kernel): there the
+    handler re-arms a 50 ms timer instead; anywhere else it raises at once."""
+    from taut import cli
+    armed = []
+    monkeypatch.setattr(signal, "setitimer", lambda which, seconds: armed.append(seconds))
+    ns: dict = {}
+    exec(compile("def notify(handler):\n    import sys\n    handler(2, sys._getframe())\n",
+                 "/site-packages/llvmlite/binding/executionengine.py", "exec"), ns)
+    try:
+        cli._interrupt.clear()
+        try:
+            ns["notify"](cli._on_sigint)              # returns: nothing raised in there
+        except KeyboardInterrupt:
+            pytest.fail("KeyboardInterrupt raised inside the ctypes callback")
+        assert armed == [0.05] and cli._interrupt.is_set()
+        cli._interrupt.clear()
+        with pytest.raises(KeyboardInterrupt):
+            cli._on_sigint(signal.SIGINT, sys._getframe())
+        assert armed == [0.05]
+    finally:
+        cli._interrupt.clear()

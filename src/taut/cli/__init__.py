@@ -113,8 +113,9 @@ def _on_sigint(signum: int, frame: Any) -> None:
     """First Ctrl-C: note it and raise KeyboardInterrupt at the next Python step (between
     kernel calls); a second one: leave at once.
 
-    Python ignores (prints and drops) an exception raised inside a finalizer, which numba
-    and llvmlite run while compiling; there the interrupt is raised again 50 ms later
+    Python ignores (prints and drops) an exception raised inside a finalizer or a ctypes
+    callback, which numba and llvmlite run while compiling (llvmlite's object-cache
+    notification is a ctypes callback); there the interrupt is raised again 50 ms later
     (SIGALRM), outside it."""
     if signum == signal.SIGINT and _interrupt.is_set():
         os.write(2, b"taut: interrupted\n")
@@ -122,7 +123,9 @@ def _on_sigint(signum: int, frame: Any) -> None:
     _interrupt.set()
     depth = 0
     while frame is not None and depth < 64:
-        if frame.f_code.co_name == "__del__" and hasattr(signal, "setitimer"):
+        code = frame.f_code
+        if ((code.co_name == "__del__" or "llvmlite" in code.co_filename)
+                and hasattr(signal, "setitimer")):
             signal.setitimer(signal.ITIMER_REAL, 0.05)
             return
         frame, depth = frame.f_back, depth + 1
