@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any, Optional
 
 import typer
 
-from .._validate import MAX_ROBOTS, as_count, as_mass
+from .._validate import as_mass
 from ..errors import ScenarioError
 from ..io.serialize import fk_result_to_dict, to_json
 from ._paths import FIGURE_SUFFIXES, output_path
@@ -17,10 +17,6 @@ from ._recordings import MCAP_HELP, RERUN_HELP, recording_paths, sheet_unit, wri
 
 if TYPE_CHECKING:
     from ..sheet.fk.results import FKResult
-
-#: Largest team the ``subsets`` method accepts: it tries every set of <= 5 cables, so its
-#: work grows as N**5 (N = 40: 760 000 systems, about a minute on one core).
-SUBSETS_MAX_ROBOTS = 40
 
 
 class FKMethod(str, Enum):
@@ -103,9 +99,6 @@ def register(app: typer.Typer) -> None:
                                 "robots' positions)")
         unit = sheet_unit(sc.units, mcap, rerun)
         team = sc.team if m is None else replace(sc.team, mass=m)
-        if method == FKMethod.subsets:
-            as_count(team.n, "sheet", maximum=SUBSETS_MAX_ROBOTS)
-        as_count(team.n, "sheet", maximum=MAX_ROBOTS)
         with working(f"fk ({method.value})"):
             result = forward_kinematics(team, sc.formation, method=method.value)
         if as_json:

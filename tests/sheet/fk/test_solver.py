@@ -91,6 +91,23 @@ def test_bad_solver_arguments():
         FKSolver(sheet)                          # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize("entry", ["solver", "forward_kinematics", "batch"])
+def test_subsets_method_takes_at_most_its_team_size(entry):
+    """The ``subsets`` limit is the library's (the CLI only reports it): one robot more
+    than ``SUBSETS_MAX_ROBOTS`` is refused naming the sheet, on every entry point, before
+    any table is built."""
+    big = Sheet.regular(solver.SUBSETS_MAX_ROBOTS + 1, 1.0)
+    team = SheetTeam(big, 1.0)
+    call = {"solver": lambda: FKSolver(team, method="subsets"),
+            "forward_kinematics": lambda: forward_kinematics(team, 0.8 * big.vertices,
+                                                             method="subsets"),
+            "batch": lambda: forward_kinematics_batch(team, [0.8 * big.vertices],
+                                                      method="subsets")}[entry]
+    with pytest.raises(InvalidInputError, match="at most 40") as exc:
+        call()
+    assert exc.value.field == "sheet"
+
+
 def test_without_numba_auto_falls_back_and_numba_is_refused(monkeypatch):
     """Without the compiled kernels ``auto`` answers with numpy and ``numba`` is refused,
     naming the field and saying why (taut._jit.not_compiled_reason)."""

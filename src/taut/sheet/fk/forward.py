@@ -92,7 +92,8 @@ def forward_kinematics(team: SheetTeam, formation: ArrayLike, *, method: Method 
     ------
     InvalidInputError
         ``team`` not a :class:`SheetTeam`, bad shapes, NaN/inf, robot count different
-        from the sheet's, unknown method, exhaustive search too large.
+        from the sheet's, unknown method, exhaustive search too large,
+        ``"subsets"`` for more than ``SUBSETS_MAX_ROBOTS`` (40) robots.
     InfeasibleFormationError
         Two robots farther apart than their sheet vertices (paper's FormationFeasible).
 

@@ -435,29 +435,30 @@ class FKResult:
                                         self.mass)
         return eqs
 
+    def _enumerated_stable(self) -> bool:
+        """The enumeration found a stable state (read from its rows, before any state is
+        built)."""
+        rows = self._rows
+        if rows is not None and len(rows):
+            return KIND_STABLE in rows[:, 0].tolist()   # (a list: ~10x quicker than np.any)
+        return any(e.stable for e in self._enum)
+
     def _no_stable_state(self) -> bool:
         """True when, before the states are built, no stable state can exist: the
         enumeration found none and the direct minimisation cannot supply one here
         (``_lowest.may_find_stable``; away from a similar copy it is not run for this)."""
-        if self._equilibria is not None:
-            return False
-        rows = self._rows
-        if rows is not None and len(rows):
-            if KIND_STABLE in rows[:, 0].tolist():      # (a list: ~10x quicker than np.any)
-                return False
-        elif any(e.stable for e in self._enum):
+        if self._equilibria is not None or self._enumerated_stable():
             return False
         return not may_find_stable(self.sheet.vertices, self.formation, self.sheet.size)
 
     @property
     def success(self) -> bool:
         """At least one stable state (the formation holds the object)."""
-        rows = self._rows
-        if self._equilibria is None and rows is not None and len(rows):
-            if KIND_STABLE in rows[:, 0].tolist():      # (a list: ~10x quicker than np.any)
+        if self._equilibria is None:
+            if self._enumerated_stable():
                 return True
-        if self._no_stable_state():
-            return False
+            if not may_find_stable(self.sheet.vertices, self.formation, self.sheet.size):
+                return False
         return any(e.stable for e in self.equilibria)
 
     @property

@@ -67,6 +67,9 @@ def _batch_kernel() -> ModuleType:
 COMPILED_MAX_N = 12
 #: Largest team the kernel handles at all (its sort keys pack a taut set in 64 bits).
 KERNEL_MAX_N = 30
+#: Largest team the ``"subsets"`` method accepts: it tries every set of at most five
+#: cables, so its work grows as N**5 (N = 40: 760 000 systems, about a minute on one core).
+SUBSETS_MAX_ROBOTS = 40
 
 
 class FKSolver:
@@ -126,6 +129,10 @@ class FKSolver:
         self.method = as_choice(method, METHODS, "method")
         backend = as_choice(backend, BACKENDS, "backend")  # type: ignore[assignment]
         N = sheet.n
+        if method == "subsets" and N > SUBSETS_MAX_ROBOTS:
+            raise InvalidInputError("sheet", f"{N} robots; method 'subsets' takes at most "
+                                    f"{SUBSETS_MAX_ROBOTS} (it tries every set of <= 5 "
+                                    "cables: N**5 work)")
         fits = method != "exhaustive" and N <= KERNEL_MAX_N
         if backend == "numba":
             if not HAVE_NUMBA:
