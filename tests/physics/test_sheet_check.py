@@ -147,6 +147,26 @@ def test_mass_does_not_change_the_answer():
         assert abs(a.sliding - b.sliding) <= 1e-6
 
 
+def test_tied_half_alone_reads_the_checks_pull():
+    # examples/physics/hold_resolution.py measures the held verdict's pull at other
+    # meshes with the check's tied half alone (_tied_run); it must read what the check does.
+    from taut.physics import _tol
+    from taut.physics._mesh import sheet_mesh
+    from taut.physics.sheet import _sliding, _tied_run
+
+    sheet = Sheet.regular(3, 600.0)
+    team = SheetTeam(sheet, 700.0, 2.0)
+    R = 0.75 * sheet.vertices + [30.0, -20.0]
+    check = replay_equilibria(team, R, mesh=7)
+    (eq,) = forward_kinematics(team, R).equilibria
+    m = sheet_mesh(sheet.vertices, 7, contact=eq.contact)
+    sim, outcome = _tied_run(sheet, R, team.hold_height, m, check.ball,
+                             corner_tendons=True, mass=2.0)
+    assert outcome == "settled"
+    assert _sliding(sim, 2.0) == pytest.approx(check.states[0].sliding, abs=1e-12)
+    assert check.states[0].sliding <= _tol.HOLD_FRACTION
+
+
 @pytest.mark.slow
 def test_issue31_sample_disagreements_explained():
     # Team 9: {1,4,5,6} is not an equilibrium 0.36 mm from the stable {1,4,6}; taut's own

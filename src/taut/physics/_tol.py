@@ -75,7 +75,12 @@ RELEASE_TIME = 6.0
 #: The object counts as held when the sheet's net sideways pull on it at the contact point
 #: is at most this fraction of its weight. Measured (mesh 10): 0.01-0.05 at the stable
 #: states of the FK paper's Example 1 (<= 0.02 with corner tendons), 0.33 at its
-#: not-an-equilibrium state; see the 20-team table in examples/physics/README.md.
+#: not-an-equilibrium state; see the 20-team table in examples/physics/README.md. On the
+#: 30-team sample (mesh 10) it has no margin: stable states up to 0.051 at rest (0.049 as
+#: the check reads it), resolved non-equilibria from 0.052. The stable states' pull it
+#: must cover does not shrink with a finer mesh: the largest stays 0.039-0.051 from mesh
+#: 10 to 28 ("Unresolved states and the mesh" in that README), so it is one constant,
+#: not a law in the spacing.
 HOLD_FRACTION = 0.05
 #: Weight of the force-balance rows (dimensionless, both sides in N) when the least pull of
 #: a statically indeterminate contact node is found by non-negative least squares

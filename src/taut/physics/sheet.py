@@ -21,7 +21,7 @@ from ..sheet import Equilibrium, Sheet, SheetTeam, check_formation, forward_kine
 from ..sheet.team import require_team
 from . import _run, _tol
 from ._mesh import SheetMesh, sheet_mesh, sheet_mesh_spacing
-from ._sheet_model import build_sheet_sim
+from ._sheet_model import SheetSim, build_sheet_sim
 from ._statics import barrier, model_pull
 from .._repr import CompactRepr
 
@@ -110,7 +110,10 @@ class StateCheck(CompactRepr):
         The held verdict can tell taut's verdict apart: false for a state that is not an
         equilibrium but whose model pull is at most ``hold_tolerance`` (it lies within the
         check's resolution of an equilibrium, usually a stable state a fraction of a
-        millimetre away), where held or not held is not evidence either way.
+        millimetre away), where held or not held is not evidence either way. A finer mesh
+        does not resolve such states: the stable states' pull, which sets the
+        resolution, does not fall with the spacing (measured to mesh 28,
+        examples/physics/README.md).
     difference : ndarray, shape (3,)
         ``settled - predicted`` (ball radius accounted for), scenario units (NaN when the
         run failed).
@@ -334,22 +337,38 @@ def _label(taut: tuple[int, ...]) -> str:
     return "{" + ",".join(str(i + 1) for i in taut) + "}"
 
 
+def _tied_run(sheet: Sheet, R: np.ndarray, z: float, m: SheetMesh, radius: float, *,
+              corner_tendons: bool, mass: float) -> tuple[SheetSim, str]:
+    """The tied half of a state's check: the object tied to ``m``'s contact node as a
+    point load (contacts off: the model's object), settled until it moves slower than
+    ``TIED_SETTLE_SPEED`` or ``MAX_SETTLE_TIME`` passes. Returns the simulation as it
+    stopped and the outcome of :func:`taut.physics._run.settle_phase`."""
+    sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=None,
+                          tie=True, corner_tendons=corner_tendons, ball_mass=mass)
+    _run.ramp(sim)
+    outcome, _ = _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
+    return sim, outcome
+
+
+def _sliding(sim: SheetSim, mass: float) -> float:
+    """The sheet's least net sideways pull on the tied contact node
+    (:func:`taut.physics._run.sliding_force`) over the object's weight (``mass``, kg)."""
+    return float(np.linalg.norm(_run.sliding_force(sim)) / (mass * GRAVITY))
+
+
 def _replay_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: int, radius: float,
                   tol: float, *, corner_tendons: bool, mass: float) -> StateCheck:
     import time
 
     t0 = time.perf_counter()
     m = sheet_mesh(sheet.vertices, div, contact=eq.contact)
-    # Tied: a point load at the contact node, contacts off (the model's object).
-    sim = build_sheet_sim(m, sheet.vertices, R, z, ball_radius=radius, ball_start=None,
-                          tie=True, corner_tendons=corner_tendons, ball_mass=mass)
-    _run.ramp(sim)
-    tied_run, _ = _run.settle_phase(sim, _tol.MAX_SETTLE_TIME, speed=_tol.TIED_SETTLE_SPEED)
+    sim, tied_run = _tied_run(sheet, R, z, m, radius, corner_tendons=corner_tendons,
+                              mass=mass)
     tied_at = _run.object_on_sheet(sim)
     assert tied_at is not None                                         # tied: always on
     tied = tied_at[0]
     nodes = _run.node_positions(sim) / sim.scale
-    sliding = float(np.linalg.norm(_run.sliding_force(sim)) / (mass * GRAVITY))
+    sliding = _sliding(sim, mass)
     pred = np.asarray(eq.object, dtype=float)
     model = model_pull(sheet.vertices, R, z, tuple(eq.taut), pred, np.asarray(eq.contact))
     # Released: a second model, the ball held over taut's object position while it presses
