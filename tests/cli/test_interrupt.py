@@ -59,10 +59,13 @@ def test_serial_sweep_interrupted_keeps_its_chunks(tmp_path):
     assert list((out / "chunks").glob("*.parquet")), "the finished chunks were lost"
 
 
+# The simulation case is in the slow target (CI runs it), to keep `make test` under its
+# budget; the workspace case keeps the command's interrupt in the fast suite, and
+# test_plan_interrupted_in_compiled_code an interrupt inside a compiled kernel.
 @pytest.mark.parametrize("args", [
     ["cdpr", "workspace", "fastkit", "--grid", "301", "1", "301"],
-    ["cdpr", "simulate", "fastkit", "--stabilisers", "--waypoints",    # ~10 s idle
-     "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 100)],
+    pytest.param(["cdpr", "simulate", "fastkit", "--stabilisers", "--waypoints",  # ~10 s idle
+                  "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 100)], marks=pytest.mark.slow),
 ], ids=lambda a: " ".join(a[:2]))
 def test_cable_robot_commands_interrupted(args):
     """A workspace grid (a loop of solver calls) and a control simulation (a compiled
@@ -159,7 +162,8 @@ def ring_of_bases(k, cables=None):
     # and 10 cables on 4 moving bases (28 million: ~5 s of CPU beyond start-up, 0.5 GB)
     pytest.param(ring_of_cables(12), ["wrench-set"], id="wrench-set"),
     pytest.param(ring_of_bases(4, [3, 3, 2, 2]),
-                 ["twist-set", *(f"--moving=base{i}" for i in range(1, 5))], id="twist-set"),
+                 ["twist-set", *(f"--moving=base{i}" for i in range(1, 5))], id="twist-set",
+                 marks=pytest.mark.slow),     # the slow target; wrench-set stays in the fast
 ])
 def test_cable_robot_pose_commands_interrupted(tmp_path, model, args):
     """The one-pose analyses, on models whose size makes them take seconds."""
@@ -171,10 +175,12 @@ def test_cable_robot_pose_commands_interrupted(tmp_path, model, args):
 @pytest.mark.parametrize("model, args, field", [
     # `tensions` takes milliseconds for any accepted model (at most MAX_CABLES cables), so
     # it has no long input to interrupt: the 6,000-cable ring that used to take 5 s of CPU
-    # and 1.3 GB is refused at once, as are sets past their budget
+    # and 1.3 GB is refused at once, as are sets past their budget (those two cases in the
+    # slow target; tests/cdpr/sets/ test the set budget's refusal in-process)
     (ring_of_cables(6000), ["tensions"], "cables"),
-    (ring_of_cables(16), ["wrench-set"], "cables"),
-    (ring_of_bases(6), ["twist-set", "--moving", "base1", "--moving", "base2"], "cables"),
+    pytest.param(ring_of_cables(16), ["wrench-set"], "cables", marks=pytest.mark.slow),
+    pytest.param(ring_of_bases(6), ["twist-set", "--moving", "base1", "--moving", "base2"],
+                 "cables", marks=pytest.mark.slow),
 ])
 def test_cable_robot_inputs_too_large_fail_fast(tmp_path, model, args, field):
     """One line, exit 2, before any progress line (so long before 2 s of work)."""
@@ -229,8 +235,9 @@ def test_physics_interrupted_in_mujoco(tmp_path):
 @pytest.mark.parametrize("args, ready", [
     (["cdpr", "deploy", "fastkit", "--workspace", "-0.5", "0.5", "-0.1", "0.1", "0.5", "1.0"],
      "taut: cdpr deploy: working"),                                   # ~2 min idle
-    (["cdpr", "mission", "examples/cdpr/warehouse.yaml"],
-     "taut: cdpr mission (8 tasks): working"),                        # ~25 s idle
+    pytest.param(["cdpr", "mission", "examples/cdpr/warehouse.yaml"],  # ~25 s idle
+                 "taut: cdpr mission (8 tasks): working",
+                 marks=pytest.mark.slow),               # the slow target; deploy stays fast
 ], ids=lambda a: " ".join(a[:2]) if isinstance(a, list) else None)
 def test_cable_robot_planners_interrupted(args, ready):
     assert_interrupted(*interrupt(args, ready))
@@ -338,3 +345,41 @@ def test_an_interrupt_inside_llvmlite_is_raised_again_outside(monkeypatch):
         assert armed == [0.05]
     finally:
         cli._interrupt.clear()
+
+
+@pytest.mark.parametrize("route", ["typer-exit-130", "outside-typer", "swallowed"])
+def test_an_interrupt_is_reported_in_one_line_whatever_catches_it(monkeypatch, capsys, route):
+    """typer turns a KeyboardInterrupt inside a command into ``Exit(130)``; one raised
+    outside typer (a deferred one, 50 ms after a compile callback) reaches ``_run``'s
+    handler; one a library swallowed is seen only by ``main``'s check. Each ends the
+    command with 130 and exactly one ``taut: interrupted`` (`cdpr mission` printed two when
+    the handler and ``main`` both reported it), and no timer outlives ``main``."""
+    import typer
+
+    from taut import cli
+    timers: list[float] = []
+    real_setitimer = signal.setitimer
+    monkeypatch.setattr(signal, "setitimer",
+                        lambda which, seconds: timers.append(seconds) or real_setitimer(
+                            which, seconds))
+
+    def command(argv):
+        cli._interrupt.set()                     # what _on_sigint does first
+        if route == "typer-exit-130":
+            raise typer.Exit(130)
+        if route == "outside-typer":
+            raise KeyboardInterrupt
+        return 0                                 # swallowed: the command returned
+
+    def run(argv):
+        try:
+            return command(argv)
+        except KeyboardInterrupt:
+            return cli._stopped()
+        except typer.Exit as exc:
+            return int(exc.exit_code)
+
+    monkeypatch.setattr(cli, "_run", run)
+    assert cli.main(["fk", "x.yaml"]) == cli.EXIT_INTERRUPTED
+    assert capsys.readouterr().err.splitlines() == ["taut: interrupted"]
+    assert timers[-1:] == [0]                    # any deferred interrupt cancelled

@@ -149,11 +149,19 @@ def _missing_extra(exc: ModuleNotFoundError) -> str | None:
     return str(MissingExtraError(top)) if top in EXTRAS else None
 
 
+#: Set once ``taut: interrupted`` is printed: an interrupt reaches several handlers (the
+#: command's, typer's ``Exit(130)``, :func:`main`'s check of ``_interrupt``) and is
+#: reported once.
+_reported = threading.Event()
+
+
 def _stopped() -> int:
-    try:
-        print("taut: interrupted", file=sys.stderr)
-    except (OSError, ValueError):
-        pass
+    if not _reported.is_set():
+        _reported.set()
+        try:
+            print("taut: interrupted", file=sys.stderr)
+        except (OSError, ValueError):
+            pass
     return EXIT_INTERRUPTED
 
 
@@ -196,6 +204,7 @@ def main(argv: list[str] | None = None) -> int:
     files a command writes are written whole or not at all.
     """
     _interrupt.clear()
+    _reported.clear()
     from ._paths import set_command_line
     set_command_line(sys.argv[1:] if argv is None else list(argv))
     installed = threading.current_thread() is threading.main_thread()
@@ -214,7 +223,8 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if installed:
             signal.signal(signal.SIGINT, previous)
-            if alarm is not None:
+            if alarm is not None:               # no deferred interrupt may outlive us
+                signal.setitimer(signal.ITIMER_REAL, 0)
                 signal.signal(signal.SIGALRM, alarm)
 
 
