@@ -89,3 +89,29 @@ def test_batch_with_a_torn_formation_flags_it(backend, n):
             np.testing.assert_allclose(x.tensions, y.tensions, rtol=1e-12)
     everything_torn = solver.solve_batch(forms[1:2] * 1.1)
     assert everything_torn.count.tolist() == [0] and not everything_torn.success[0]
+
+
+def test_batch_kernel_grows_its_output_and_stops_at_a_torn_formation():
+    """More rows than the batch kernel's first output holds (``max(16, 2 B)``), then a torn
+    formation: the rows and formation indices of the per-formation loop up to it, and its
+    index (the kernel returns to grow its output and resumes where it stopped)."""
+    from taut.sheet._kernels import batch as bk
+    from taut.sheet._kernels import small as sk
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        sheet, R = random_team(6, rng)
+        solver = FKSolver(SheetTeam(sheet, 2.0 * sheet.size))
+        k, _, _ = sk.solve_formation(R, *solver._args, np.empty((len(solver._table), 30)))
+        if k >= 3:
+            break
+    assert k >= 3
+    forms = np.repeat(R[None], 40, axis=0)
+    forms[30] *= 3.0                               # torn: rows of 0..29 only, 30 flagged
+    a = sk.solve_formations(forms, *solver._args)
+    b = bk.solve_formations_ws(forms, *solver._args)
+    assert a[2] == b[2] == 30
+    assert len(b[0]) == 30 * k > 2 * len(forms)     # the output grew on the way
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[1], b[1])
+    whole = bk.solve_formations_ws(np.ascontiguousarray(forms[:30]), *solver._args)
+    assert whole[2] == -1 and np.array_equal(whole[0], b[0])

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..._jit import jit
-from .small import (INFEASIBLE, append_rows, similar_fit, solve_carved, solve_into, work_floats,
-    work_views)
+from .small import (INFEASIBLE, append_rows, borrowed, similar_fit, solve_carved, solve_into,
+    work_floats, work_views)
 
 __all__ = ["solve_formations_ws", "solve_one", "pack", "out_rows", "decode", "snap_screen_batch",
            "HEADER", "FLAGS_SHIFT", "HAS_STABLE", "HAS_PENDING", "NEAR_COPY", "TORN"]
@@ -21,26 +21,57 @@ __all__ = ["solve_formations_ws", "solve_one", "pack", "out_rows", "decode", "sn
 def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     """As ``_small_kernel.solve_formations``: rows (M, width) of every formation of
     ``Rb`` (B, N, 2), their formation index (M,), and the first infeasible formation's
-    index (or -1)."""
+    index (or -1). One workspace for the whole batch; the formations are solved by
+    :func:`_solve_formations`, which returns here only to grow the output."""
     B, N = Rb.shape[0], Rb.shape[1]
     C = table.shape[0]
     W = 12 + 3 * N
     buf = np.empty((C, W))
-    Rn, P, G, bvec, ang, sol, lin, eig, key, order = work_views(
-        np.empty(work_floats(N, C)), np.empty(2 * C, dtype=np.int64), N, C)
+    fw = np.empty(work_floats(N, C))
+    iw = np.empty(2 * C, dtype=np.int64)
     taut = np.empty((C, N), dtype=np.bool_)
     cap = max(16, 2 * B)
     rows = np.empty((cap, W))
     form = np.empty(cap, dtype=np.int64)
     M = 0
-    for b in range(B):
+    b = 0
+    while True:
+        M, b, k = _solve_formations(Rb, b, Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf,
+                                    fw, iw, taut, rows, form, M)
+        if k <= 0:                                 # done, or formation b infeasible
+            return rows[:M], form[:M], (b if k < 0 else -1)
+        rows, form = append_rows(rows, form, M, buf, k, b)    # full: grow
+        M += k
+        b += 1
+
+
+@jit
+def _solve_formations(Rb, b0, Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf, fw, iw,
+                      taut, rows, form, M):
+    """Solve formations ``b0, b0 + 1, ...`` of ``Rb`` on the work arrays ``buf`` (C,
+    width), ``fw``, ``iw`` (``solve_into``) and ``taut`` (C, N), appending their rows to
+    ``rows`` / ``form`` after the first ``M``. Returns ``(M, b, k)``: ``k = 0`` all done;
+    ``k < 0`` formation ``b`` is infeasible; ``k > 0`` formation ``b``'s ``k`` rows are in
+    ``buf`` and do not fit. Every array is used borrowed (``borrowed``: no reference
+    counting in the per-formation loop; the caller owns them for the call)."""
+    Rb, Vn, table, sizes, lim2 = borrowed(Rb), borrowed(Vn), borrowed(table), borrowed(sizes), \
+        borrowed(lim2)
+    buf, fw, iw, taut = borrowed(buf), borrowed(fw), borrowed(iw), borrowed(taut)
+    rows, form = borrowed(rows), borrowed(form)
+    B, N = Rb.shape[0], Rb.shape[1]
+    W = rows.shape[1]
+    Rn, P, G, bvec, ang, sol, lin, eig, key, order = work_views(fw, iw, N, table.shape[0])
+    for b in range(b0, B):
         k, _, _ = solve_carved(Rb[b], Vn, table, sizes, scale, vcx, vcy, hold, lim2, buf, Rn,
                                P, G, bvec, ang, sol, lin, eig, key, order, taut)
-        if k < 0:
-            return rows[:M], form[:M], b
-        rows, form = append_rows(rows, form, M, buf, k, b)
+        if k < 0 or M + k > rows.shape[0]:
+            return M, b, k
+        for i in range(k):
+            for j in range(W):
+                rows[M + i, j] = buf[i, j]
+            form[M + i] = b
         M += k
-    return rows[:M], form[:M], -1
+    return M, B, 0
 
 
 #: Leading floats of a pack (:func:`pack`): N, C, scale, vcx, vcy, hold, three snap bounds.
@@ -103,6 +134,7 @@ def solve_one(R, solver, out):
     they are the answer (no state, or a stable one and no weight family, and not next to
     a similar copy), else ``-1 - (rows | flags << FLAGS_SHIFT)`` (:func:`decode`; the
     flag ``TORN`` for a torn or non-finite ``R``)."""
+    R, solver, out = borrowed(R), borrowed(solver), borrowed(out)   # see ``borrowed``
     N = R.shape[0]
     last = out.shape[0] - 1
     for i in range(N):

@@ -94,9 +94,20 @@ def _singular_extremes(W, n):
     return top, bottom
 
 
+#: Sines of the angular margins of :func:`_surely_outside`: another robot counts as
+#: strictly counter-clockwise of robot ``j`` within a quarter turn when the sine exceeds
+#: ``_CCW_SIN``, and beyond a quarter turn when it exceeds ``_ARC_SIN`` (so short of a
+#: half turn by more than 2e-6 rad). Both far above the rounding of the cross products
+#: (~1e-16 relative) and, for the latter, of ``atan2`` and ``ANGLE_TOL``.
+_CCW_SIN, _ARC_SIN = 1e-12, 2e-6
+
+
 @jit
 def _in_hull(Rn, taut, N, px, py, ang):
-    """The paper's projection test (``_kernel.in_hull_2d``) for the robots in ``taut``."""
+    """The paper's projection test (``_kernel.in_hull_2d``) for the robots in ``taut``:
+    True when the projected object ``(px, py)`` sits on a taut robot, else when no angular
+    gap between the taut robots seen from it exceeds pi (``ANGLE_TOL``). The gaps come
+    from ``atan2``, unless :func:`_surely_outside` already answers False."""
     m = 0
     scale2 = 1.0
     for j in range(N):
@@ -112,7 +123,11 @@ def _in_hull(Rn, taut, N, px, py, ang):
             dy = Rn[j, 1] - py
             if dx * dx + dy * dy <= COINCIDE_RTOL2 * scale2:
                 return True
-            ang[m] = math.atan2(dy, dx)
+    if _surely_outside(Rn, taut, N, px, py):
+        return False
+    for j in range(N):                             # none at the point (above)
+        if taut[j]:
+            ang[m] = math.atan2(Rn[j, 1] - py, Rn[j, 0] - px)
             m += 1
     a = ang[:m]
     for k in range(1, m):                          # insertion sort (m <= N is small)
@@ -127,6 +142,37 @@ def _in_hull(Rn, taut, N, px, py, ang):
         if a[k + 1] - a[k] > gap:
             gap = a[k + 1] - a[k]
     return gap <= math.pi + ANGLE_TOL
+
+
+@jit
+def _surely_outside(Rn, taut, N, px, py):
+    """True when the robots in ``taut`` (none at ``(px, py)``), seen from ``(px, py)``,
+    lie in a closed arc shorter than a half turn by more than 2e-6 rad: some taut robot
+    ``j`` has every other one strictly counter-clockwise of it and less than that far
+    round (cross and dot products against the margins ``_CCW_SIN``, ``_ARC_SIN``; no
+    square root, no ``atan2``). The complementary gap then exceeds pi + 2e-6, and
+    :func:`_in_hull`'s ``atan2`` gaps (rounding ~1e-15) would answer False as well: a
+    cheap sure answer, False when unsure (then ``atan2`` decides)."""
+    for j in range(N):
+        if not taut[j]:
+            continue
+        ax = Rn[j, 0] - px
+        ay = Rn[j, 1] - py
+        a2 = ax * ax + ay * ay
+        arc = True
+        for k in range(N):
+            if k == j or not taut[k]:
+                continue
+            bx = Rn[k, 0] - px
+            by = Rn[k, 1] - py
+            cross = ax * by - ay * bx
+            sin = _CCW_SIN if ax * bx + ay * by > 0.0 else _ARC_SIN
+            if not (cross > 0.0 and cross * cross > (sin * sin) * (a2 * (bx * bx + by * by))):
+                arc = False
+                break
+        if arc:
+            return True
+    return False
 
 
 #: Rows of the work array of :func:`_reduced_min_eig_ws` (4 columns).
