@@ -15,6 +15,7 @@ from taut.io import (cdpr_model_from_mapping, parse_mapping, plan_scenario_from_
                      warehouse_from_mapping)
 from taut.io.cdpr_dynamics import dynamics_from_mapping
 from taut.io.cdpr_model import preset_path
+from taut.io.robot_trajectories import robot_trajectories_from_mapping
 from taut.sweep import sweep_from_mapping
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -44,6 +45,19 @@ def _model() -> dict[str, Any]:
     return data
 
 
+def _trajectories() -> dict[str, Any]:
+    """A robot-trajectories JSON file (``taut plan --trajectories t.json``), every summary
+    number set."""
+    return {"success": True, "status": "ok", "message": "m", "drive": "differential",
+            "duration_s": 1.0, "plan_duration_s": 0.8, "turns_in_place": 1,
+            "limits": {"max_speed_mps": 0.2, "max_accel_mps2": 0.5,
+                       "max_yaw_rate_radps": 1.0, "reform_speed_mps": 0.05},
+            "peaks": {"speed_mps": 0.1, "accel_mps2": 0.2, "yaw_rate_radps": 0.3},
+            "times_s": [0.0, 0.5, 1.0],
+            "poses_m_rad": [[[0.0, 0.0, 0.1], [1.0, 0.0, 0.2]] for _ in range(3)],
+            "object_m": [[0.5, 0.0, 0.3] for _ in range(3)]}
+
+
 def _sweep(name: str) -> Callable[[dict[str, Any]], Any]:
     return lambda data: sweep_from_mapping(data, root=EXAMPLES / "sweeps")
 
@@ -66,6 +80,7 @@ KINDS: list[tuple[str, Callable[[], dict[str, Any]], Callable[[dict[str, Any]], 
      _sweep("random")),
     ("sweep, options", lambda: read_mapping(EXAMPLES / "sweeps" / "fastkit_coverage.yaml"),
      _sweep("options")),
+    ("robot trajectories", _trajectories, robot_trajectories_from_mapping),
 ]
 
 

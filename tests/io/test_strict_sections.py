@@ -12,7 +12,9 @@ Two halves:
   :class:`~taut.errors.TautError` whose field is the injected key's dotted path.
 
 CASPR models are XML read element by element (tests/io/test_loaders.py); trajectory CSV
-files are rows of numbers under a fixed header (tests/io/test_hostile_trajectory.py).
+files are rows of numbers under a fixed header (tests/io/test_hostile_trajectory.py). No
+robot-trajectories JSON file is shipped: a small one is built here (values:
+tests/io/test_robot_trajectories_file.py).
 """
 
 from __future__ import annotations
@@ -31,7 +33,8 @@ from pydantic import BaseModel
 from taut.errors import TautError
 from taut.io import (cdpr_model_from_mapping, plan_scenario_from_mapping, read_mapping,
                      sheet_scenario_from_mapping, warehouse_from_mapping)
-from taut.io import cdpr_dynamics, cdpr_model, plan_scenario, sheet_scenario, warehouse
+from taut.io import (cdpr_dynamics, cdpr_model, plan_scenario, robot_trajectories,
+                     sheet_scenario, warehouse)
 from taut.io.cdpr_dynamics import dynamics_from_mapping
 from taut.io.cdpr_model import PRESETS, preset_path
 from taut.sweep import file as sweep_file
@@ -50,11 +53,13 @@ ROOTS: dict[str, type[BaseModel]] = {
     "cdpr dynamics": cdpr_dynamics._Section,
     "warehouse": warehouse._WarehouseFile,
     "sweep": sweep_file._SweepFile,
+    "robot trajectories": robot_trajectories._TrajectoriesFile,
 }
 
 #: The modules that define file models (every module of taut.io that uses pydantic, and
 #: the sweep file's).
-MODULES = [sheet_scenario, plan_scenario, cdpr_model, cdpr_dynamics, warehouse, sweep_file]
+MODULES = [sheet_scenario, plan_scenario, cdpr_model, cdpr_dynamics, warehouse, sweep_file,
+           robot_trajectories]
 
 #: Mappings whose keys are names the user chooses (points, parameters), not schema keys:
 #: ``(model, field)`` -> what the keys are. Their values are still typed.
@@ -189,6 +194,20 @@ def _warehouse(path: Path) -> Callable[[dict], Any]:
     return lambda data: warehouse_from_mapping(data, path.parent)
 
 
+def _trajectories() -> dict[str, Any]:
+    """A robot-trajectories JSON file as ``taut plan --trajectories t.json`` writes it
+    (two samples of two robots; an unset limit is ``null``)."""
+    return {"success": True, "status": "ok", "message": "m", "drive": "holonomic",
+            "duration_s": 1.0, "plan_duration_s": 1.0, "turns_in_place": 0,
+            "limits": {"max_speed_mps": 0.2, "max_accel_mps2": 0.5,
+                       "max_yaw_rate_radps": 1.0, "reform_speed_mps": None},
+            "peaks": {"speed_mps": 0.1, "accel_mps2": 0.2, "yaw_rate_radps": 0.0},
+            "times_s": [0.0, 1.0],
+            "poses_m_rad": [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+                            [[0.1, 0.0, 0.0], [1.1, 0.0, 0.0]]],
+            "object_m": [[0.5, 0.0, 0.3], [0.6, 0.0, 0.3]]}
+
+
 def _inputs() -> list[tuple[str, str, Callable[[], dict], Callable[[dict], Any]]]:
     """(file, kind, its data, its loader) for every shipped input file."""
     out: list[tuple[str, str, Callable[[], dict], Callable[[dict], Any]]] = []
@@ -213,6 +232,8 @@ def _inputs() -> list[tuple[str, str, Callable[[], dict], Callable[[dict], Any]]
                 _sweep(corridor)))
     wh = EXAMPLES / "cdpr" / "warehouse.yaml"
     out.append((_rel(wh), "warehouse", lambda: read_mapping(wh), _warehouse(wh)))
+    out.append(("built robot trajectories", "robot trajectories", _trajectories,
+                robot_trajectories.robot_trajectories_from_mapping))
     for name in PRESETS:
         out.append((f"preset {name}", "cdpr model",
                     lambda name=name: read_mapping(preset_path(name)),

@@ -7,27 +7,35 @@ x m, y m, heading rad), ``object_m`` (T, 3) and the outcome (``success``, ``stat
 ``message``, ``drive``, durations, limits and measured peaks, each key with its unit).
 Numbers are written with 17 significant digits, so both read back exactly
 (:func:`load_robot_trajectories`).
+
+The JSON form is read with a strict schema (:func:`robot_trajectories_from_mapping`):
+unknown keys, a boolean or a string where a number is expected, and ``null`` or a
+non-finite number in ``times_s``, ``poses_m_rad`` or ``object_m`` are refused naming the
+key. ``null`` is accepted only where the writer puts it for a non-finite value: a failed
+outcome's durations and peaks, and limits that were not set (infinite).
 """
 
 from __future__ import annotations
 
 import csv
 import io
-import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, Optional
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict
 
-from ..errors import InvalidTrajectoryError
-from .files import read_text, write_text_atomic
+from .._outcome import Status
+from ..errors import InvalidTrajectoryError, ScenarioError
+from .files import Integer, Number, parse_mapping, read_text, validate_mapping, \
+    write_text_atomic
 
 if TYPE_CHECKING:
     from ..plan.execution.trajectories import RobotTrajectories
 
 __all__ = ["ExecutedTrajectories", "robot_trajectories_to_dict", "save_robot_trajectories",
-           "load_robot_trajectories"]
+           "load_robot_trajectories", "robot_trajectories_from_mapping"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,6 +46,75 @@ class ExecutedTrajectories:
     times: np.ndarray
     poses: np.ndarray
     object: np.ndarray
+
+
+# --- the JSON form's schema (written by robot_trajectories_to_dict) ----------------------
+
+Pose = tuple[Number, Number, Number]
+#: A summary number the writer may have written as ``null`` (non-finite: NaN or inf).
+MaybeNumber = Optional[Number]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class _Limits(_Strict):
+    max_speed_mps: MaybeNumber
+    max_accel_mps2: MaybeNumber
+    max_yaw_rate_radps: MaybeNumber
+    reform_speed_mps: MaybeNumber
+
+
+class _Peaks(_Strict):
+    speed_mps: MaybeNumber
+    accel_mps2: MaybeNumber
+    yaw_rate_radps: MaybeNumber
+
+
+class _TrajectoriesFile(_Strict):
+    success: bool
+    status: Status
+    message: str
+    # the choices of taut.plan.execution._drives.DRIVES (tests/io/test_robot_trajectories_file.py
+    # checks they agree; importing the planner here would slow every loader down)
+    drive: Literal["holonomic", "differential"]
+    duration_s: MaybeNumber
+    plan_duration_s: MaybeNumber
+    turns_in_place: Integer
+    limits: _Limits
+    peaks: _Peaks
+    times_s: list[Number]
+    poses_m_rad: list[list[Pose]]
+    object_m: list[Pose]
+
+
+def robot_trajectories_from_mapping(data: dict[str, Any]) -> ExecutedTrajectories:
+    """Executed trajectories from the parsed JSON form (module docstring).
+
+    Raises
+    ------
+    InvalidTrajectoryError
+        An unknown or missing key, a value of the wrong type (a boolean or a string for a
+        number, ``null`` in a sample), or samples whose counts disagree; the field is the
+        key's dotted path (``poses_m_rad[3][1][2]``).
+    """
+    try:
+        raw = validate_mapping(_TrajectoriesFile, data)
+    except ScenarioError as exc:
+        raise InvalidTrajectoryError(exc.field, exc.problem) from None
+    T = len(raw.times_s)
+    for key, rows in (("poses_m_rad", raw.poses_m_rad), ("object_m", raw.object_m)):
+        if len(rows) != T:
+            raise InvalidTrajectoryError(key, f"{len(rows)} samples; times_s has {T}")
+    n = len(raw.poses_m_rad[0]) if T else 0
+    for k, sample in enumerate(raw.poses_m_rad):
+        if len(sample) != n or n == 0:
+            raise InvalidTrajectoryError(f"poses_m_rad[{k}]", f"{len(sample)} robots; "
+                                         f"sample 0 has {n} (at least 1)")
+    return ExecutedTrajectories(np.array(raw.times_s, float).reshape(T),
+                                np.array(raw.poses_m_rad, float).reshape(T, n, 3),
+                                np.array(raw.object_m, float).reshape(T, 3))
 
 
 def robot_trajectories_to_dict(tr: RobotTrajectories) -> dict[str, Any]:
@@ -86,21 +163,15 @@ def load_robot_trajectories(path: str | Path) -> ExecutedTrajectories:
     Raises
     ------
     ScenarioError
-        Missing or unreadable file.
+        Missing, unreadable or too large file, or (JSON) invalid JSON, a key given twice
+        or a top level that is not a mapping.
     InvalidTrajectoryError
-        Malformed content (the message names the row or key).
+        Malformed content (CSV: the message names the row; JSON: the field is the key's
+        dotted path, :func:`robot_trajectories_from_mapping`).
     """
     text = read_text(path)
     if Path(path).suffix.lower() != ".csv":
-        try:
-            doc = json.loads(text)
-            times = np.asarray(doc["times_s"], float).reshape(-1)
-            poses = np.asarray(doc["poses_m_rad"], float).reshape(len(times), -1, 3)
-            obj = np.asarray(doc["object_m"], float).reshape(len(times), 3)
-        except (ValueError, KeyError, TypeError) as exc:
-            raise InvalidTrajectoryError(Path(path).name, f"not a trajectories file: {exc}"
-                                         ) from None
-        return ExecutedTrajectories(times, poses, obj)
+        return robot_trajectories_from_mapping(parse_mapping(text, str(path), suffix=".json"))
     rows = list(csv.reader(io.StringIO(text)))
     if not rows or (len(rows[0]) - 4) % 3 or rows[0] != _header((len(rows[0]) - 4) // 3):
         raise InvalidTrajectoryError(Path(path).name, "row 1: expected the header t_s, "
