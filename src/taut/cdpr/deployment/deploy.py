@@ -42,7 +42,7 @@ from .lift import LiftBound, lift_bound
 from ..model.robot import CableRobot
 from ..kinematics.modes import MotionLimits, fastkit_motion_limits
 from .placement import footprint_overlap, place_bases, workspace_box
-from ..sets.twist import available_twist_set
+from ..sets.twist import ats_blocks
 from ..workspace.wrench_feasible import grid_points
 from ..sets.wrench import capacity_margin, wrench_feasible
 from ..._validate import require_instance
@@ -176,8 +176,10 @@ def evaluate_deployment(robot: CableRobot, points: np.ndarray,
         if twists.ndim not in (1, 2) or twists.shape[-1] != robot.dof or not twists.size:
             raise InvalidInputError("twists", f"must be (T, {robot.dof}) required twists")
         twists = twists.reshape(-1, robot.dof)
-        ats = available_twist_set(robot, points, limits, "task", moving)
-        tm = min(float(ats.margin(t).min()) for t in twists)
+        tm = np.inf
+        for _, ats in ats_blocks(robot, points, limits, "task", moving):   # one block's
+            tm = min(tm, *(float(ats.margin(t).min()) for t in twists))  # facets at a time
+            del ats                     # before the next block is built, not after
     return float(pm.min()), pm, tm
 
 

@@ -8,6 +8,13 @@ zonotope generators), so their memory and time grow as binomial coefficients of 
 count: a model a few cables larger than a real robot would need tens of gigabytes. Memory
 is proportional to the candidates times the numbers each one holds (its subset matrix and
 its row), so that product is what the budget bounds.
+
+A batch of poses is bounded by the same count: the sets returned at once (each candidate
+facet a row of ``n`` numbers and its offset, for every pose) hold at most
+:data:`MAX_SET_NUMBERS` numbers (:func:`check_batch_sets`), and the functions that reduce
+each set to a few numbers (axis capacities, margins) build the sets
+:func:`batch_block` poses at a time, so any batch is accepted and only one block's sets are
+alive at once.
 """
 
 from __future__ import annotations
@@ -75,3 +82,22 @@ def block_size(work: tuple[int, int], block: int) -> int:
     """Poses per vectorised block (at most ``block``) so that one block holds at most
     :data:`MAX_SET_NUMBERS` numbers."""
     return max(1, min(block, MAX_SET_NUMBERS // max(work[1], 1)))
+
+
+def batch_block(facets: int, dim: int, block: int = 256) -> int:
+    """Poses per block (at most ``block``) whose sets of ``facets`` facets in ``dim``
+    dimensions (a row and an offset each) hold at most :data:`MAX_SET_NUMBERS` numbers."""
+    return max(1, min(block, MAX_SET_NUMBERS // max(facets * (dim + 1), 1)))
+
+
+def check_batch_sets(facets: int, dim: int, poses: int, what: str) -> None:
+    """Raise :class:`InvalidInputError` (field ``poses``) when the sets of ``poses`` poses,
+    ``facets`` facets each in ``dim`` dimensions, returned at once would hold more than
+    :data:`MAX_SET_NUMBERS` numbers (more than :func:`batch_block` poses)."""
+    most = batch_block(facets, dim, block=poses)
+    if poses > most:
+        raise InvalidInputError(
+            "poses", f"{poses:,} poses of the {what} ({facets:,} candidate facets each) "
+                     f"would hold {poses * facets * (dim + 1):,} numbers; at most "
+                     f"{MAX_SET_NUMBERS:,} ({most:,} poses here): pass fewer poses (axis "
+                     f"capacities and margins take any batch)")

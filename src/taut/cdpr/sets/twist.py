@@ -15,6 +15,7 @@ Twists are ``t = [v; w]`` (m/s, rad/s, world frame, at P).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any, Literal, Sequence
 
@@ -30,7 +31,8 @@ from ..kinematics.modes import (TWIST_LABELS, Mode, ModeName, MotionLimits, fast
     joint_bounds)
 from .polytope import HPolytopeBatch, lp_max_step
 from .zonotope import _facets_base_and_identity, zonotope_hrep
-from ._budget import block_size, check_set_work, twist_work
+from ._budget import (batch_block, block_size, check_batch_sets, check_set_work,
+                      twist_work)
 from ..._validate import as_choice, as_count, require_instance
 from ..._repr import CompactRepr
 
@@ -145,7 +147,8 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     InvalidInputError
         ``cables``: the task-mode facets would need more than
         :data:`taut._validate.MAX_SET_NUMBERS` numbers per pose (e.g. 20 cables with two
-        moving bases).
+        moving bases). ``poses``: the task-mode sets of the batch would hold more than
+        that many numbers together (:func:`twist_capacities` takes any batch).
 
     Returns
     -------
@@ -171,6 +174,7 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
         moves = hi > lo
         work = twist_work(robot.m, int(moves[:nb].sum()), int(moves[nb:].sum()))
         check_set_work(work, robot, "twist set", f"{nb} moving base joints")
+        check_batch_sets(work[0], robot.dof, fom.A.shape[0], "twist set")
         H, h, E, full = _task_set(fom, lo, hi, block_size(work, 256))
     else:
         H, h, E, full = _navigation_set(fom, lo, hi)
@@ -180,6 +184,19 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
         ats = replace(unbatch(ats, ("H", "h", "E", "poses", "full_rank"), True),
                       model=unbatch(fom, FOM_PER_POSE, True))
     return ats
+
+
+def ats_blocks(robot: CableRobot, P: np.ndarray, limits: MotionLimits, mode: ModeName,
+               moving: Sequence[str] | None) -> Iterator[tuple[slice, AvailableTwistSet]]:
+    """The ATS of poses ``P`` (B, 6) a block at a time (the first pose alone, which sizes
+    the blocks by :func:`batch_block`), so only one block's facets are alive at once:
+    ``(poses of the block, its sets)``."""
+    ats = available_twist_set(robot, P[:1], limits, mode, moving)
+    blk = batch_block(ats.H.shape[1], ats.H.shape[2])
+    yield slice(0, 1), ats
+    del ats
+    for i in range(1, P.shape[0], blk):
+        yield slice(i, i + blk), available_twist_set(robot, P[i:i + blk], limits, mode, moving)
 
 
 @dataclass(frozen=True, repr=False)
@@ -231,9 +248,13 @@ def twist_capacities(robot: CableRobot, poses: ArrayLike, limits: MotionLimits |
     if method == "lp":
         caps = _capacities_lp(robot, P, limits, mode, moving)
     else:
-        ats = available_twist_set(robot, P, limits, mode, moving)
-        pos, neg, reach = ats.axis_ray_lengths(None, tol=ZERO_ROW, zero=ZERO_ROW)
-        caps = TwistCapacities(pos, neg, reach, TWIST_LABELS[:ats.dim], ats.mode)
+        rays = []
+        for _, ats in ats_blocks(robot, P, limits, mode, moving):   # one block's facets
+            rays.append(ats.axis_ray_lengths(None, tol=ZERO_ROW, zero=ZERO_ROW))
+            dim, md = ats.dim, ats.mode
+            del ats                     # before the next block is built, not after
+        pos, neg, reach = (np.concatenate([r[k] for r in rays]) for k in range(3))
+        caps = TwistCapacities(pos, neg, reach, TWIST_LABELS[:dim], md)
     return unbatch(caps, ("positive", "negative", "feasible"), single)
 
 

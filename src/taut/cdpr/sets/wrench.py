@@ -25,6 +25,7 @@ Wrench units are mixed (N, N m); rows are normalised to unit Euclidean norm.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from itertools import product
 from typing import Any, Literal
@@ -42,7 +43,8 @@ from .._tol import CONTAINS_TOL, VERTEX_SLACK, ZERO_ROW
 from ..kinematics.cables import as_poses, cable_state, gravity_wrench
 from ..model.robot import CableRobot
 from .polytope import HPolytopeBatch, lp_max_step
-from ._budget import block_size, check_set_work, wrench_work
+from ._budget import (batch_block, block_size, check_batch_sets, check_set_work,
+                      wrench_work)
 from ..._repr import CompactRepr
 
 __all__ = ["AvailableWrenchSet", "available_wrench_set", "wrench_feasible",
@@ -121,7 +123,10 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool =
     InvalidInputError
         ``cables``: the enumeration would build more than
         :data:`taut._validate.MAX_SET_NUMBERS` numbers per pose (more than 12 cables for a
-        6-DoF platform on a fixed frame).
+        6-DoF platform on a fixed frame). ``poses``: the sets of the batch would hold more
+        than that many numbers together (e.g. more than 1,844 poses of FASTKIT, 12 of a
+        12-cable 6-DoF robot); :func:`axis_capacities`, :func:`capacity_margin` and
+        :func:`wrench_feasible` take any batch.
 
     Returns
     -------
@@ -144,6 +149,7 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool =
     slide = bool(sliding and robot.has_sliding)
     work = wrench_work(robot, tipping, slide)
     check_set_work(work, robot, "wrench set")
+    check_batch_sets(work[0], robot.dof, P.shape[0], "wrench set")
     blk = block_size(work, 256)
     parts = [_aws_block(robot, P[i:i + blk], tipping, slide)
              for i in range(0, P.shape[0], blk)]
@@ -154,6 +160,18 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool =
                              sliding=slide)
     return unbatch(aws, ("H", "h", "E", "poses", "full_rank", "nonempty", "gravity_wrench"),
                    single)
+
+
+def _aws_blocks(robot: CableRobot, P: np.ndarray, tipping: bool, sliding: bool
+                ) -> Iterator[tuple[slice, AvailableWrenchSet]]:
+    """The AWS of ``P`` (B, 6) a block of poses at a time (:func:`batch_block`), so only
+    one block's facets are alive at once: ``(poses of the block, its sets)``."""
+    work = wrench_work(robot, tipping, bool(sliding and robot.has_sliding))
+    check_set_work(work, robot, "wrench set")
+    blk = batch_block(work[0], robot.dof)
+    for i in range(0, P.shape[0], blk):
+        yield slice(i, i + blk), available_wrench_set(robot, P[i:i + blk], tipping=tipping,
+                                                      sliding=sliding)
 
 
 def _aws_block(robot: CableRobot, P: np.ndarray, tipping: bool, sliding: bool
@@ -313,13 +331,17 @@ def axis_capacities(robot: CableRobot, poses: ArrayLike, *, tipping: bool = True
     if method == "lp":
         caps = _axis_lp(robot, P, tipping, labels, sliding)
     else:
-        aws = available_wrench_set(robot, P, tipping=tipping, sliding=sliding)
-        pos, neg, reach = aws.axis_ray_lengths(-aws.gravity_wrench, tol=feas_tol(robot),
-                                               sign=-1.0, zero=ZERO_ROW)
-        ok = (aws.full_rank & aws.nonempty)[:, None]
-        reach &= ok[..., None]
-        caps = AxisCapacities(np.where(ok, pos, 0.0), np.where(ok, neg, 0.0), reach, labels,
-                              aws.tipping)
+        pos = np.zeros((P.shape[0], n))
+        neg = np.zeros((P.shape[0], n))
+        reach = np.zeros((P.shape[0], n, 2), dtype=bool)
+        for sl, aws in _aws_blocks(robot, P, tipping, sliding):
+            p, q, r = aws.axis_ray_lengths(-aws.gravity_wrench, tol=feas_tol(robot),
+                                           sign=-1.0, zero=ZERO_ROW)
+            ok = (aws.full_rank & aws.nonempty)[:, None]
+            pos[sl], neg[sl], reach[sl] = np.where(ok, p, 0.0), np.where(ok, q, 0.0), \
+                r & ok[..., None]
+            del aws                     # before the next block is built, not after
+        caps = AxisCapacities(pos, neg, reach, labels, bool(tipping and robot.has_tipping))
     return unbatch(caps, ("positive", "negative", "feasible"), single)
 
 
@@ -373,12 +395,11 @@ def capacity_margin(robot: CableRobot, poses: ArrayLike,
     single = is_single(poses)
     P = as_poses(robot, poses)
     D = wrench_vertices(robot, external_wrench)
-    blk = block_size(wrench_work(robot, tipping, bool(sliding and robot.has_sliding)), 256)
     out = np.empty(P.shape[0])
-    for i in range(0, P.shape[0], blk):             # the facets of one block at a time
-        aws = available_wrench_set(robot, P[i:i + blk], tipping=tipping, sliding=sliding)
+    for sl, aws in _aws_blocks(robot, P, tipping, sliding):   # one block's facets at a time
         w = -(aws.gravity_wrench[:, None, :] + D[None, :, :])    # required cable wrenches
         hw = np.einsum("bsn,bvn->bsv", aws.H, w).max(axis=2)
         margin = np.min(aws.h - hw, axis=1)
-        out[i:i + blk] = np.where(aws.full_rank & aws.nonempty, margin, -np.inf)
+        out[sl] = np.where(aws.full_rank & aws.nonempty, margin, -np.inf)
+        del aws, hw                     # before the next block is built, not after
     return first(out) if single else out
