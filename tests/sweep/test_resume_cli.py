@@ -45,8 +45,10 @@ def test_resume_flag_recomputes_a_truncated_chunk(tmp_path, same_rows):
                                 "--resume")
     assert code == 0, stderr
     assert "Traceback" not in stderr and "ArrowInvalid" not in stderr, stderr
-    # the summary line says one chunk was recomputed and the two intact ones reused
-    # (the recomputed chunk's name is not printed)
+    # the summary line says one chunk was recomputed and the two intact ones reused, and
+    # stderr names it and why
     assert re.search(r"^8 rows -> .* \(1 chunks computed, 2 reused, ", stdout, re.M), stdout
+    assert "taut: sweep: chunks/chunk-0000001.parquet recomputed (truncated)\n" in stderr, \
+        stderr
     assert len(chunk.read_bytes()) > 100
     same_rows(read_results(out)[0], read_results(clean)[0])

@@ -1,5 +1,6 @@
 """Sweeps that cannot mix or silently lose (issue 24): one writer per folder (a lock naming
-its holder), checksummed chunks with a damaged one recomputed on resume, a damaged
+its holder), checksummed chunks with a damaged one recomputed on resume (and named, with
+why), a damaged
 results file a one-line error, ``options:`` validated per task, and two different sweeps
 started together on one folder: one runs, the other is refused."""
 
@@ -83,6 +84,7 @@ def test_a_damaged_chunk_is_recomputed_on_resume(tmp_path, same_rows):
     chunk.write_bytes(chunk.read_bytes()[:100])             # truncated
     res = run_sweep(spec, tmp_path / "run", workers=0, resume=True)
     assert res.success and res.chunks_run == 1 and res.chunks_reused == 2
+    assert res.damaged == (("chunk-0000001.parquet", "truncated"),)
     same_rows(read_results(tmp_path / "run")[0], good)
     # a flipped byte with the length kept is caught by the checksum too
     data = bytearray(chunk.read_bytes())
@@ -90,7 +92,49 @@ def test_a_damaged_chunk_is_recomputed_on_resume(tmp_path, same_rows):
     chunk.write_bytes(bytes(data))
     res = run_sweep(spec, tmp_path / "run", workers=0, resume=True)
     assert res.success and res.chunks_run == 1
+    assert res.damaged == (("chunk-0000001.parquet", "checksum mismatch"),)
     same_rows(read_results(tmp_path / "run")[0], good)
+
+
+def test_resume_names_each_damaged_chunk_and_why(fk_spec, tmp_path, capsys, same_rows):
+    """``taut sweep run --resume`` names every chunk it recomputes (file and reason) on
+    stderr, one line each; chunks never written are only counted, and an intact folder
+    gives no such line."""
+    spec_file = tmp_path / "s.yaml"
+    spec_file.write_text(textwrap.dedent(f"""\
+        task: fk_stability_map
+        base: {ROOT / 'examples/sheet/example2_r2_r4_353mm.yaml'}
+        chunk_size: 2
+        parameters: {{scale: {{range: [0.6, 1.0], num: 10}}}}
+        """))
+    out = tmp_path / "run"
+    assert main(["sweep", "run", str(spec_file), "--out", str(out), "--workers", "0",
+                 "--limit", "8"]) == 0                    # chunk 4 never written
+    good, _ = read_results(out)
+    chunks = out / "chunks"
+    (chunks / "chunk-0000000.parquet").unlink()                          # missing
+    (chunks / "chunk-0000001.parquet.sha256").unlink()                   # no checksum
+    two = chunks / "chunk-0000002.parquet"
+    two.write_bytes(two.read_bytes()[:-10])                              # truncated
+    three = bytearray((chunks / "chunk-0000003.parquet").read_bytes())
+    three[len(three) // 2] ^= 0xFF                                        # bytes changed
+    (chunks / "chunk-0000003.parquet").write_bytes(bytes(three))
+    capsys.readouterr()
+    assert main(["sweep", "run", str(spec_file), "--out", str(out), "--workers", "0",
+                 "--resume"]) == 0
+    captured = capsys.readouterr()
+    named = [line for line in captured.err.splitlines() if "recomputed" in line]
+    assert named == ["taut: sweep: chunks/chunk-0000000.parquet recomputed (missing)",
+                     "taut: sweep: chunks/chunk-0000001.parquet recomputed (no checksum)",
+                     "taut: sweep: chunks/chunk-0000002.parquet recomputed (truncated)",
+                     "taut: sweep: chunks/chunk-0000003.parquet recomputed "
+                     "(checksum mismatch)"]
+    assert "(5 chunks computed, 0 reused" in captured.out
+    cols, _ = read_results(out)
+    same_rows({k: v[:8] for k, v in cols.items()}, good)
+    assert main(["sweep", "run", str(spec_file), "--out", str(out), "--workers", "0",
+                 "--resume"]) == 0
+    assert "recomputed" not in capsys.readouterr().err
 
 
 def test_a_damaged_results_file_is_one_line_in_sweep_plot(fk_spec, tmp_path, capsys):

@@ -32,6 +32,10 @@ class _DefaultRun(TyperGroup):
         return super().resolve_command(ctx, args)
 
 
+#: Damaged chunks named one per line after a resumed run; past these, one line counts the
+#: rest (a folder of a million damaged chunks prints a dozen lines).
+DAMAGED_NAMED = 10
+
 sweep_app = typer.Typer(cls=_DefaultRun, no_args_is_help=True, add_completion=False,
                         help="Parameter studies: `taut sweep SPEC --out DIR` runs one, "
                              "`taut sweep plot DIR --x P --value C` draws it.")
@@ -104,12 +108,23 @@ def run_command(
                            limit=limit, progress=report)
     if result.status == "interrupted" and result.message.startswith("interrupted"):
         raise KeyboardInterrupt             # Ctrl-C: the one line `taut: interrupted`
+    _report_damaged(result.damaged, result.success)
     if not result.success:
         print(f"taut: sweep: {result.message}", file=sys.stderr)
         return 1
     print(f"{result.rows} rows -> {result.path} ({result.chunks_run} chunks computed, "
           f"{result.chunks_reused} reused, {result.seconds:.1f} s)")
     return 0
+
+
+def _report_damaged(damaged: tuple[tuple[str, str], ...], done: bool) -> None:
+    """Name on stderr the chunks found damaged in the folder (and so computed again)."""
+    verb = "recomputed" if done else "found damaged, to recompute"
+    for name, why in damaged[:DAMAGED_NAMED]:
+        print(f"taut: sweep: chunks/{name} {verb} ({why})", file=sys.stderr)
+    if len(damaged) > DAMAGED_NAMED:
+        print(f"taut: sweep: and {len(damaged) - DAMAGED_NAMED} more damaged chunks {verb}",
+              file=sys.stderr)
 
 
 @sweep_app.command("plot", help="Draw a heat map (--x and --y) or a curve (--x only) of a "

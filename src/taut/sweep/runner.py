@@ -76,6 +76,11 @@ class SweepResult:
         Chunks computed in this run / found finished in the folder.
     seconds : float
         Wall time of the run, s.
+    damaged : tuple of (str, str)
+        The chunks found in the folder but not finished, so computed again: ``(file name,
+        why)`` with why ``"missing"``, ``"no checksum"``, ``"truncated"`` or ``"checksum
+        mismatch"`` (:meth:`taut.sweep.store.Store.state`), in chunk order. Chunks never
+        written are not listed (they are in ``chunks_run``).
     """
 
     success: bool
@@ -86,6 +91,7 @@ class SweepResult:
     chunks_run: int
     chunks_reused: int
     seconds: float
+    damaged: tuple[tuple[str, str], ...] = ()
 
 
 def chunk_size_of(spec: SweepSpec) -> int:
@@ -230,7 +236,10 @@ def _run(spec: SweepSpec, store: Store, limit: int | None, total: int,
          workers: int | None, scheduler: str | None, progress: Any,
          t0: float) -> SweepResult:
     bounds = [b for b in chunk_bounds(spec.size, chunk_size_of(spec)) if b[0] < total]
-    todo = [not store.has(k) for k in range(len(bounds))]
+    stored = [store.state(k) for k in range(len(bounds))]
+    todo = [st != "finished" for st in stored]
+    damaged = tuple((store.chunk_path(k).name, st) for k, st in enumerate(stored)
+                    if st not in ("finished", "not computed"))
     n_todo = sum(todo)
     done = sum(min(hi, total) - lo for (lo, hi), run in zip(bounds, todo) if not run)
     try:
@@ -243,12 +252,12 @@ def _run(spec: SweepSpec, store: Store, limit: int | None, total: int,
         msg = "interrupted" if isinstance(exc, KeyboardInterrupt) else str(exc)
         return SweepResult(False, "interrupted", f"{msg}: {done} of {total} points done; run "
                            "again with --resume to continue", None, 0, n_todo,
-                           len(bounds) - n_todo, time.perf_counter() - t0)
+                           len(bounds) - n_todo, time.perf_counter() - t0, damaged)
     meta = {"taut_version": __version__, "sweep_digest": spec.digest,
             "sweep_task": spec.task, "sweep_source": spec.source}
     path = store.assemble(len(bounds), total, meta)
     return SweepResult(True, "ok", f"{total} points", path, total, n_todo,
-                       len(bounds) - n_todo, time.perf_counter() - t0)
+                       len(bounds) - n_todo, time.perf_counter() - t0, damaged)
 
 
 class _WorkerFailure(Exception):

@@ -36,6 +36,8 @@ METADATA_KEYS = ("taut_version", "sweep_digest", "sweep_task", "sweep_source")
 #: Rows per row group of ``results.parquet``: the unit in which it is written and read back
 #: (about 5 MB for ten float columns).
 ROW_GROUP_ROWS = 1 << 16
+#: First and last bytes of every Parquet file (a file without them at its end was cut).
+_PARQUET_MAGIC = b"PAR1"
 
 
 def _pa() -> Any:
@@ -216,13 +218,34 @@ class Store:
 
     def has(self, index: int) -> bool:
         """Whether chunk ``index`` is finished: its file matches its checksum."""
+        return self.state(index) == "finished"
+
+    def state(self, index: int) -> str:
+        """What is stored of chunk ``index``: ``"finished"`` (its file matches its
+        checksum), ``"not computed"`` (neither file nor checksum), or why it must be
+        recomputed: ``"missing"`` (a checksum without its file), ``"no checksum"`` (a
+        file without one, e.g. written by an older taut), ``"truncated"`` (not a whole
+        Parquet file: its first or last 4 bytes are not ``PAR1``) or ``"checksum
+        mismatch"`` (a whole file whose bytes changed)."""
         path = self.chunk_path(index)
         check = path.with_name(path.name + ".sha256")
+        if not path.is_file():
+            return "missing" if check.exists() else "not computed"
         try:
-            return path.is_file() and check.read_text(encoding="ascii").strip() == \
-                _sha256(path)
+            expected = check.read_text(encoding="ascii").strip()
         except (OSError, ValueError):
-            return False
+            return "no checksum"
+        try:
+            if expected == _sha256(path):
+                return "finished"
+            with open(path, "rb") as fh:
+                head = fh.read(4)
+                fh.seek(max(path.stat().st_size - 4, 0))
+                tail = fh.read(4)
+        except OSError:
+            return "truncated"
+        whole = head == tail == _PARQUET_MAGIC and path.stat().st_size > 8
+        return "checksum mismatch" if whole else "truncated"
 
     def _check_manifest(self) -> None:
         try:
