@@ -14,8 +14,9 @@ from typing import Literal, get_args
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import (MAX_ACCELERATION, MAX_DURATION_S, MAX_RATE_HZ, MAX_SPEED,
-                          as_array, as_bounded, as_choice, as_nonnegative, as_positive)
+from ..._validate import (MAX_ACCELERATION, MAX_CONTROL_STEPS, MAX_DURATION_S,
+                          MAX_RATE_HZ, MAX_SPEED, as_array, as_bounded, as_choice,
+                          as_nonnegative, as_positive)
 from ...errors import InvalidInputError, InvalidTrajectoryError
 from .._tol import MAX_REFERENCE_SPEED, WAYPOINT_SAME
 from ..kinematics.cables import as_poses
@@ -77,20 +78,33 @@ def euler_rate_matrices(rpy: np.ndarray) -> np.ndarray:
     return E
 
 
+def _segment_time(d: float, speed: float, acceleration: float, profile: str) -> float:
+    """Duration (s) of one segment of length ``d`` (m) of :func:`_profile`."""
+    if profile == "quintic":
+        return 15.0 * d / (8.0 * speed)                # peak of s_dot is 15/8 d/T
+    v = min(speed, np.sqrt(d * acceleration))          # triangular when too short
+    ta = v / acceleration
+    return float(2 * ta + (d - v * ta) / v)
+
+
+def _samples(T: float, rate: float) -> int:
+    """Samples of a segment of ``T`` s at ``rate`` Hz, both ends included."""
+    return max(int(np.ceil(T * rate)), 1) + 1
+
+
 def _profile(d: float, speed: float, acceleration: float, profile: str,
              rate: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Path parameter s (m), s_dot, s_ddot of one segment of length d at the given rate."""
+    T = _segment_time(d, speed, acceleration, profile)
     if profile == "quintic":
-        T = 15.0 * d / (8.0 * speed)                   # peak of s_dot is 15/8 d/T
-        tau = np.linspace(0.0, 1.0, max(int(np.ceil(T * rate)), 1) + 1)
+        tau = np.linspace(0.0, 1.0, _samples(T, rate))
         s = d * (10 * tau**3 - 15 * tau**4 + 6 * tau**5)
         sd = d / T * (30 * tau**2 - 60 * tau**3 + 30 * tau**4)
         sdd = d / T**2 * (60 * tau - 180 * tau**2 + 120 * tau**3)
         return s, sd, sdd
     v = min(speed, np.sqrt(d * acceleration))          # triangular when too short
     ta = v / acceleration
-    T = 2 * ta + (d - v * ta) / v
-    t = np.linspace(0.0, T, max(int(np.ceil(T * rate)), 1) + 1)
+    t = np.linspace(0.0, T, _samples(T, rate))
     acc = t < ta
     dec = t > T - ta
     s = np.where(acc, 0.5 * acceleration * t**2,
@@ -147,7 +161,10 @@ def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, 
         A waypoint outside the frame box.
     InvalidInputError
         Fewer than two waypoints, a zero-length segment, NaN, non-positive speed, rate or
-        acceleration, unknown profile.
+        acceleration, unknown profile; ``dwell`` (or ``speed``, whichever gives more of
+        them): more than :data:`taut._validate.MAX_CONTROL_STEPS` samples (more than a
+        simulation may step through), refused before any is allocated (a day's dwell at
+        1 kHz took ``taut cdpr simulate`` past 3 GB before its step count was refused).
 
     Examples
     --------
@@ -165,11 +182,22 @@ def pick_and_place(robot: CableRobot, waypoints: ArrayLike, speed: float = 1.0, 
     if wp.ndim != 2 or wp.shape[1] != 3 or wp.shape[0] < 2:
         raise InvalidInputError("waypoints", "must be at least two (x, y, z) positions, m")
     as_poses(robot, wp, "waypoints")
+    segments = waypoint_segments(wp)
     dt = 1.0 / rate
     n_dwell = int(round(dwell * rate))
+    # the sample count in closed form, refused before any array is allocated
+    moving = sum(_samples(_segment_time(d, speed, acceleration, profile), rate) - 1
+                 for d, _ in segments)
+    resting = n_dwell * len(wp) + 1
+    if moving + resting > MAX_CONTROL_STEPS:
+        raise InvalidInputError(
+            "dwell" if resting > moving else "speed",
+            f"the reference would hold {moving + resting:.3g} samples at {rate:g} Hz "
+            f"({(moving + resting - 1) * dt:.3g} s: {resting * dt:.3g} s resting), more "
+            f"than {MAX_CONTROL_STEPS}")
     pos, vel, acc = [np.repeat(wp[:1], n_dwell + 1, axis=0)], [np.zeros((n_dwell + 1, 3))], \
         [np.zeros((n_dwell + 1, 3))]
-    for k, (d, e) in enumerate(waypoint_segments(wp)):
+    for k, (d, e) in enumerate(segments):
         s, sd, sdd = _profile(d, speed, acceleration, profile, rate)
         pos.append(wp[k] + s[1:, None] * e)
         vel.append(sd[1:, None] * e)

@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._jit import HAVE_NUMBA, not_compiled_reason
-from ..._validate import (MAX_BATCH, MAX_DURATION_S, MAX_RATE_HZ, as_array, as_bounded,
-    as_choice, as_positive, require_instances)
+from ..._validate import (MAX_CONTROL_STEPS, MAX_DURATION_S, MAX_RATE_HZ, as_array,
+    as_bounded, as_choice, as_positive, require_instances)
 from ...errors import InvalidInputError
 from .._tol import DIVERGENCE_MARGIN, STABILITY_OMEGA_H, STEP_COUNT_SLACK
 from ..kinematics.forward import rpy_from_matrices
@@ -106,13 +106,14 @@ def _prepare(robot: CableRobot, reference: Reference, controller: Controller,
                                             f"{MAX_SUBSTEPS} substeps per control step")
     dur = reference.duration if duration is None else \
         as_bounded(duration, "duration", MAX_DURATION_S, "s")
-    if dur * rate > MAX_BATCH:
+    if dur * rate > MAX_CONTROL_STEPS:
         raise InvalidInputError("duration", f"{dur:g} s at {rate:g} Hz is {dur * rate:.3g} "
-                                f"control steps, more than {MAX_BATCH}")
+                                f"control steps, more than {MAX_CONTROL_STEPS}")
     settle_s = as_bounded(settle, "settle", MAX_DURATION_S, "s", positive=False)
-    if settle_s * rate > MAX_BATCH:
-        raise InvalidInputError("settle", f"{settle_s:g} s at {rate:g} Hz is "
-                                f"{settle_s * rate:.3g} control steps, more than {MAX_BATCH}")
+    if (dur + settle_s) * rate > MAX_CONTROL_STEPS:
+        raise InvalidInputError("settle", f"{settle_s:g} s at {rate:g} Hz makes "
+                                f"{(dur + settle_s) * rate:.3g} control steps with the "
+                                f"{dur:g} s run, more than {MAX_CONTROL_STEPS}")
     dt = 1.0 / rate
     n = max(int(np.ceil(dur * rate - STEP_COUNT_SLACK)), 1)
     k0 = int(round(settle_s * rate))
