@@ -9,6 +9,7 @@ aliases are listed in :data:`NOT_CALLED` with the reason.
 
 from __future__ import annotations
 
+import copy
 import functools
 import importlib
 import inspect
@@ -99,10 +100,16 @@ def _carry() -> Any:
                         base_accel=0.25)
 
 
-def _warehouse_map() -> dict[str, Any]:
-    """The example warehouse file, parsed."""
+@functools.lru_cache(maxsize=None)
+def _parsed_warehouse() -> dict[str, Any]:
+    """The example warehouse file, parsed once (valid_arguments runs twice per fuzz case)."""
     from taut.io import read_mapping
     return read_mapping(WAREHOUSE)
+
+
+def _warehouse_map() -> dict[str, Any]:
+    """The example warehouse file, parsed: a fresh copy for each call."""
+    return copy.deepcopy(_parsed_warehouse())
 
 
 class _Point(BaseModel):
@@ -110,12 +117,18 @@ class _Point(BaseModel):
     x: float
 
 
-def _recording_arguments(suffix: str) -> dict[str, Any]:
-    """A sheet FK result to record, its unit and a file in the test's folder."""
+@functools.lru_cache(maxsize=None)
+def _fk_result() -> Any:
+    """The sheet FK result the recorders write (solved once, as the other fixtures:
+    valid_arguments runs twice per fuzz case; the recorders only read it)."""
     from taut.sheet import forward_kinematics
     f = fixtures()
-    return {"result": forward_kinematics(f["sheet_team"], f["formation"]),
-            "path": f"{{tmp}}/recording.{suffix}", "length_unit": "m"}
+    return forward_kinematics(f["sheet_team"], f["formation"])
+
+
+def _recording_arguments(suffix: str) -> dict[str, Any]:
+    """A sheet FK result to record, its unit and a file in the test's folder."""
+    return {"result": _fk_result(), "path": f"{{tmp}}/recording.{suffix}", "length_unit": "m"}
 
 
 def valid_arguments(module: str, name: str) -> dict[str, Any]:

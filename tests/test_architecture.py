@@ -7,6 +7,7 @@ anything. Imports under ``if TYPE_CHECKING:`` do not count (they never run)."""
 from __future__ import annotations
 
 import ast
+import functools
 import importlib
 import re
 from pathlib import Path
@@ -72,7 +73,12 @@ def _targets(name: str, path: Path) -> set[str]:
     return out
 
 
-GRAPH = {name: _targets(name, path) for name, path in MODULES.items()}
+@functools.lru_cache(maxsize=None)
+def _graph() -> dict[str, set[str]]:
+    """Module -> the taut modules it imports; built when a test first asks (parsing every
+    module takes about a second of CPU, which each test process would otherwise pay when it
+    collects this file)."""
+    return {name: _targets(name, path) for name, path in MODULES.items()}
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -117,7 +123,7 @@ def test_cycle_finder_finds_a_cycle():
 
 
 def test_no_import_cycles():
-    assert _cycles(GRAPH) == []
+    assert _cycles(_graph()) == []
 
 
 #: Modules at the package root that drive the families (the command line, the warmup that
@@ -127,7 +133,7 @@ ROOT_DRIVERS = {"taut.__main__", "taut._warmup"}
 
 def _family_imports(name: str) -> set[str]:
     """The modules of family folders (``taut.sheet``, ``taut.cdpr``, ...) ``name`` imports."""
-    return {t for t in GRAPH[name] if t.count(".") >= 1
+    return {t for t in _graph()[name] if t.count(".") >= 1
             and (PACKAGE / t.split(".")[1]).is_dir()}
 
 

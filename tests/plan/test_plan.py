@@ -135,12 +135,18 @@ def test_must_bypass_tall_obstacle():
     assert r.path_length > 4.4 + 1e-3
 
 
-def test_must_fail_with_reason_blocked_by_tall_obstacle():
-    # Gaps of 0.55 m beside the obstacle: a robot fits (no certificate), the team does not.
-    # (With gaps of 0.85 m it does: the hull may reach the obstacle and the wall, only the
-    # robot centres keep the clearance.)
-    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
-    r = plan(sc, iterations=200, time_budget=600)
+@pytest.fixture(scope="module")
+def blocked_plan():
+    """A failed plan (searched for seconds), shared by the tests of its message and JSON.
+    Gaps of 0.55 m beside the obstacle: a robot fits (no certificate), the team does not.
+    (With gaps of 0.85 m it does: the hull may reach the obstacle and the wall, only the
+    robot centres keep the clearance.)"""
+    return plan(corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)]),
+                iterations=200, time_budget=600)
+
+
+def test_must_fail_with_reason_blocked_by_tall_obstacle(blocked_plan):
+    r = blocked_plan
     assert not r.success and r.status == "budget_exhausted" and r.certificate is None
     assert "'wall-ish' (0.9 m tall) cannot be crossed" in r.message
     assert "not found within the budget" in r.message
@@ -350,13 +356,12 @@ def test_cli_plan_json_and_figures(tmp_path, capsys):
     assert rc == 1 and "no plan (" in capsys.readouterr().out
 
 
-def test_failed_plan_json():
+def test_failed_plan_json(blocked_plan):
     from taut.io.serialize import plan_to_dict
-    r = plan(corridor([Obstacle("big", 0.9, center=[3.0, 0.0], radius=0.45)]), iterations=100)
-    d = json.loads(json.dumps(plan_to_dict(r)))
+    d = json.loads(json.dumps(plan_to_dict(blocked_plan)))
     assert d["success"] is False and d["message"] and d["times"] == [] and d["robots"] == []
     assert d["status"] == "budget_exhausted" and "reason" not in d
-    assert d["duration"] is None and d["bypassed"] == ["big"]
+    assert d["duration"] is None and d["bypassed"] == ["wall-ish"]
 
 
 def test_cli_bad_file_is_typed_error(tmp_path):

@@ -86,6 +86,10 @@ def test_crossing_between_two_robots_off_the_old_grid(tilted):
     assert abs((heading + 7.5) % 15.0 - 7.5) > 1.0
 
 
+# The slow target (CI runs it): two full plans (crossing and bypass searches), the costliest
+# test of `make test` (~20 s of a loaded run); test_lattice_plan_changes_formation_and_is_verified
+# (test_lattice.py) keeps a planned formation change in the fast suite.
+@pytest.mark.slow
 def test_reformation_needed_mid_route():
     team = corridor_team()
     world = World([[0, -1], [4, -1], [4, -0.525], [8, -0.525], [8, 0.525], [4, 0.525],

@@ -37,7 +37,12 @@ def verified_by_fk(sheet, formation, p, vo, z=1.0, tol=1e-6):
                for e in forward_kinematics(SheetTeam(sheet, z), formation).equilibria)
 
 
-@pytest.mark.parametrize("case", DATA["targets"], ids=lambda c: f"bench{c['bench_index']}")
+# bench299, whose proof costs several times the others' (7 s of a loaded suite run), runs in
+# the slow target (CI runs it); the other three keep the proofs in the fast suite.
+@pytest.mark.parametrize("case", [
+    pytest.param(c, id=f"bench{c['bench_index']}",
+                 marks=[pytest.mark.slow] if c["bench_index"] == 299 else [])
+    for c in DATA["targets"]])
 def test_formerly_missed_targets_are_proved_unreachable(case):
     """The four budget_exhausted answers of the last 1,000-target benchmark: each target is
     a stable FK state with three cables taut (checked here), and no all-taut formation
