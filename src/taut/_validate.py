@@ -126,11 +126,12 @@ MAX_SET_NUMBERS = 30_000_000
 #: Largest number of poses / formations / grid points in one call.
 MAX_BATCH = 10_000_000
 #: Most control steps of one cable-robot control simulation (``duration`` and ``settle``
-#: times the control rate) and samples of a pick-and-place reference: 100 s at FASTKIT's
+#: times the control rate) and samples of a pick-and-place reference: 60 s at FASTKIT's
 #: 1 kHz. Memory grows ~3.8 kB a step, ~12 kB with the JSON result (`taut cdpr simulate
 #: fastkit --dwell 100`, 201,900 steps, `/usr/bin/time`, loaded: 0.91 GB; with `--out`
-#: 2.45 GB, 118 s; --dwell 400 with --out 8.6 GB), so MAX_BATCH steps would need ~40 GB.
-MAX_CONTROL_STEPS = 100_000
+#: 2.45 GB, 118 s; --dwell 400 with --out 8.6 GB), so MAX_BATCH steps would need ~40 GB;
+#: peak RSS with `--out` at 99,676 steps 1.32 GB, at 59,876 steps (`--dwell 29`) 0.90 GB.
+MAX_CONTROL_STEPS = 60_000
 #: Largest control or sampling rate, Hz (1 MHz; FASTKIT's controller runs at 1 kHz).
 MAX_RATE_HZ = 1e6
 #: Longest simulated or dwelt time, s (one day).

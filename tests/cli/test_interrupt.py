@@ -64,9 +64,9 @@ def test_serial_sweep_interrupted_keeps_its_chunks(tmp_path):
 # test_plan_interrupted_in_compiled_code an interrupt inside a compiled kernel.
 @pytest.mark.parametrize("args", [
     ["cdpr", "workspace", "fastkit", "--grid", "301", "1", "301"],
-    pytest.param(["cdpr", "simulate", "fastkit", "--stabilisers",   # 87 s simulated: ~1 min
+    pytest.param(["cdpr", "simulate", "fastkit", "--stabilisers",   # 56 s simulated: ~40 s
                   "--controller", "computed_torque", "--waypoints",
-                  "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 20)], marks=pytest.mark.slow),
+                  "; ".join(["-0.5,0,1.0", "0.5,0,1.0"] * 13)], marks=pytest.mark.slow),
 ], ids=lambda a: " ".join(a[:2]))
 def test_cable_robot_commands_interrupted(args):
     """A workspace grid (a loop of solver calls) and a control simulation (a compiled
