@@ -14,11 +14,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import Delaunay
+from scipy.spatial import Delaunay, cKDTree
 
 from . import _tol
 
-__all__ = ["SheetMesh", "sheet_mesh", "sheet_mesh_spacing"]
+__all__ = ["SheetMesh", "sheet_mesh", "sheet_mesh_spacing", "sheet_model_size"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,8 +107,44 @@ def sheet_mesh_spacing(vertices: np.ndarray, divisions: int) -> float:
     return float(np.max(np.linalg.norm(V[:, None] - V[None], axis=2))) / divisions
 
 
+def sheet_model_size(vertices: np.ndarray, divisions: int, *, corner_tendons: bool
+                     ) -> tuple[int, int]:
+    """Nodes and tendons of the sheet model, counted without building it (issue 24).
+
+    Nodes: those of :func:`sheet_mesh` without a contact node, plus one for it. Tendons:
+    the node pairs within ``TENDON_REACH`` spacings and, with ``corner_tendons``, one from
+    every corner to every other node, as
+    :func:`taut.physics._sheet_model.build_sheet_sim` adds them (it skips only the pairs
+    already kept, so two corners farther apart than the reach get two tendons). An upper
+    bound up to the contact node's few pairs: pairs with a third node on their segment
+    are not dropped here. Takes O(nodes x neighbours) time and memory (a k-d tree), not
+    the O(nodes^2) of the mesh itself.
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (N, 2)
+        The sheet polygon, robot order (any length unit).
+    divisions : int
+        Mesh spacings across the sheet's widest vertex pair.
+    corner_tendons : bool
+        Count a tendon from every node to every corner.
+
+    Returns
+    -------
+    nodes, tendons : int
+    """
+    V = np.asarray(vertices, dtype=float)
+    h = sheet_mesh_spacing(V, divisions)
+    bnd, corners = _boundary(V, h)
+    nodes = np.vstack([bnd, _interior(V, h)])
+    M, N, r = len(nodes), len(corners), _tol.TENDON_REACH * h
+    tree = cKDTree(nodes)
+    near = (int(tree.count_neighbors(tree, r)) - M) // 2        # ordered, self included
+    return M + 1, near + (N * (M - 1) if corner_tendons else 0)
+
+
 def sheet_mesh(vertices: np.ndarray, divisions: int, *, contact: np.ndarray | None = None,
-               reach: float = 4.5) -> SheetMesh:
+               reach: float = _tol.TENDON_REACH) -> SheetMesh:
     """Mesh a convex sheet with about ``divisions`` spacings across its widest pair.
 
     Parameters

@@ -16,6 +16,23 @@ CONTACT_CLEARANCE = 0.5
 SNAP = 0.05
 #: Triangles with a smaller area (spacings squared) are dropped (collinear boundary nodes).
 SLIVER = 1e-6
+#: Node pairs at most this far apart in the flat sheet (spacings) get an inextensibility
+#: tendon.
+TENDON_REACH = 4.5
+#: Most tendons a sheet model may have (issue 24), counted before it is built
+#: (:func:`taut.physics._mesh.sheet_model_size`: pairs within ``TENDON_REACH`` plus the
+#: corner tendons; an upper bound, 0.6-1x the built count). Peak memory of ``taut
+#: physics`` is ~0.15 GB plus ~3.3-4.2 kB a counted tendon over its first states, whether
+#: robots (corner tendons) or the mesh dominate, and creeps up over later states (370
+#: robots, mesh 10: 0.79 GB after 90 s, 0.98 GB after 300 s), hence the margin below
+#: 1 GB. Measured (`/usr/bin/time`, peak RSS, regular n-gon teams, runs capped at 90-120
+#: s, i.e. the first 1-6 states; load 2-3.5): 300 robots mesh 10 (135,283 tendons)
+#: 0.67 GB; 12 robots mesh 60 (146,588) 0.70 GB; 350 robots mesh 10 (177,857) 0.80 GB;
+#: 370 robots mesh 10 (196,065) 0.79 GB; 400 robots mesh 10 (225,833) 0.89 GB; 30 robots
+#: mesh 58 (198,884) 0.87 GB; 30 robots mesh 60 (212,014) 0.91 GB; before the limit, 600
+#: robots mesh 10 (475,927) 1.94 GB and 1,000 robots over 3 GB. Near the limit, longer:
+#: 310 robots mesh 11 (148,688) 0.84 GB over 240 s (15 of 318 states, ~15 s a state).
+MAX_SHEET_TENDONS = 150_000
 
 #: The sheet's largest vertex distance in the simulation, m (the scenario is scaled to it).
 SIM_DIAMETER = 1.0

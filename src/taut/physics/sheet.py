@@ -20,7 +20,7 @@ from ..errors import InvalidInputError, require_extra
 from ..sheet import Equilibrium, Sheet, SheetTeam, check_formation, forward_kinematics
 from ..sheet.team import require_team
 from . import _run, _tol
-from ._mesh import SheetMesh, sheet_mesh, sheet_mesh_spacing
+from ._mesh import SheetMesh, sheet_mesh, sheet_mesh_spacing, sheet_model_size
 from ._sheet_model import SheetSim, build_sheet_sim
 from ._statics import barrier, model_pull
 from .._repr import CompactRepr
@@ -202,13 +202,42 @@ def _mass(team: SheetTeam) -> float:
     return _tol.BALL_MASS if team.mass is None else float(team.mass)
 
 
-def _check_inputs(team: SheetTeam, formation: object, mesh: int, ball: float | None
-                  ) -> tuple[np.ndarray, int, float]:
+#: Coarsest and finest mesh accepted (spacings across the sheet).
+_MIN_MESH, _MAX_MESH = 4, 60
+
+
+def _check_size(sheet: Sheet, div: int, corner_tendons: bool) -> None:
+    """Refuse a sheet model of more than ``MAX_SHEET_TENDONS`` tendons before anything is
+    built (issue 24: its memory grows with them). Names ``mesh`` and the finest coarser
+    mesh that fits when one does, else ``sheet``. The count is not monotonic in the mesh
+    (at a coarse mesh every boundary node of a many-sided sheet is within reach of every
+    other), so coarser meshes are tried in turn; with corner tendons no mesh fits when
+    the corner-to-corner ones alone are too many."""
+    def tendons(d: int) -> tuple[int, int]:
+        return sheet_model_size(sheet.vertices, d, corner_tendons=corner_tendons)
+
+    nodes, count = tendons(div)
+    limit = _tol.MAX_SHEET_TENDONS
+    if count <= limit:
+        return
+    n = len(sheet.vertices)
+    what = (f"the MuJoCo sheet model would have {nodes} nodes and about {count} tendons "
+            f"at mesh {div}, more than the {limit} taut simulates (about 1 GB of memory)")
+    if not (corner_tendons and n * (n - 1) > limit):
+        for d in range(div - 1, _MIN_MESH - 1, -1):
+            if tendons(d)[1] <= limit:
+                raise InvalidInputError("mesh", f"{what}; mesh {d} fits")
+    raise InvalidInputError("sheet", f"{n} robots: {what}, and no coarser mesh fits")
+
+
+def _check_inputs(team: SheetTeam, formation: object, mesh: int, ball: float | None, *,
+                  corner_tendons: bool) -> tuple[np.ndarray, int, float]:
     sheet = require_team(team).sheet
     R = check_formation(sheet, as_array(formation, "formation", ndim=2))
-    if not isinstance(mesh, (int, np.integer)) or not 4 <= mesh <= 60:
-        raise InvalidInputError("mesh", f"must be an integer from 4 to 60 (spacings across "
-                                        f"the sheet), got {mesh!r}")
+    if not isinstance(mesh, (int, np.integer)) or not _MIN_MESH <= mesh <= _MAX_MESH:
+        raise InvalidInputError("mesh", f"must be an integer from {_MIN_MESH} to {_MAX_MESH} "
+                                        f"(spacings across the sheet), got {mesh!r}")
+    _check_size(sheet, int(mesh), corner_tendons)
     D = float(np.max(sheet.side_lengths()))
     r = (_tol.BALL_RADIUS * sheet_mesh_spacing(sheet.vertices, int(mesh)) if ball is None
          else as_positive(ball, "ball"))
@@ -232,7 +261,10 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
     start : array_like, shape (3,), optional
         Initial ball centre; default above the robots' centroid, just over the hold height.
     mesh : int
-        Mesh spacings across the sheet's widest vertex pair (spacing = width / mesh).
+        Mesh spacings across the sheet's widest vertex pair (spacing = width / mesh), 4 to
+        60. A model of more than ``MAX_SHEET_TENDONS`` tendons is refused before it is
+        built (:class:`taut.errors.InvalidInputError` naming ``mesh``, or ``sheet`` when
+        no coarser mesh fits).
     ball : float, optional
         Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings).
     max_time : float
@@ -255,7 +287,7 @@ def settle(team: SheetTeam, formation: object, *, start: object = None,
     """
     require_extra("mujoco")
     trace = as_flag(trace, "trace")
-    R, div, radius = _check_inputs(team, formation, mesh, ball)
+    R, div, radius = _check_inputs(team, formation, mesh, ball, corner_tendons=False)
     sheet, z = team.sheet, team.hold_height
     p0 = None if start is None else as_array(start, "start", shape=(3,))
     max_t = as_positive(max_time, "max_time")
@@ -369,6 +401,7 @@ def _replay_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: i
     tied = tied_at[0]
     nodes = _run.node_positions(sim) / sim.scale
     sliding = _sliding(sim, mass)
+    del sim                 # freed before the released run's model is built (issue 24)
     pred = np.asarray(eq.object, dtype=float)
     model = model_pull(sheet.vertices, R, z, tuple(eq.taut), pred, np.asarray(eq.contact))
     # Released: a second model, the ball held over taut's object position while it presses
@@ -452,7 +485,9 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
         As for :func:`taut.sheet.forward_kinematics` (scenario units; the team's mass,
         kg, is the ball's, 1 kg when it has none).
     mesh : int
-        Mesh spacings across the sheet's widest vertex pair.
+        Mesh spacings across the sheet's widest vertex pair, 4 to 60; refused above
+        ``MAX_SHEET_TENDONS`` tendons, as for :func:`settle` (regular teams: 12 robots
+        up to mesh 60, 100 up to 34, 310 up to 11; 330 or more at none).
     ball : float, optional
         Ball radius, scenario units (default ``BALL_RADIUS`` = 0.05 spacings; a sheet
         scenario's ``object.radius``, :attr:`taut.io.SheetScenario.object_radius`).
@@ -472,7 +507,8 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     """
     require_extra("mujoco")
     corner_tendons = as_flag(corner_tendons, "corner_tendons")
-    R, div, radius = _check_inputs(team, formation, mesh, ball)
+    R, div, radius = _check_inputs(team, formation, mesh, ball,
+                                   corner_tendons=corner_tendons)
     sheet, z = team.sheet, team.hold_height
     tol = _tol.HOLD_FRACTION if hold_tolerance is None else as_positive(
         hold_tolerance, "hold_tolerance")
