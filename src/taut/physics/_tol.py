@@ -31,7 +31,8 @@ TENDON_REACH = 4.5
 #: 370 robots mesh 10 (196,065) 0.79 GB; 400 robots mesh 10 (225,833) 0.89 GB; 30 robots
 #: mesh 58 (198,884) 0.87 GB; 30 robots mesh 60 (212,014) 0.91 GB; before the limit, 600
 #: robots mesh 10 (475,927) 1.94 GB and 1,000 robots over 3 GB. Near the limit, longer:
-#: 310 robots mesh 11 (148,688) 0.84 GB over 240 s (15 of 318 states, ~15 s a state).
+#: 310 robots mesh 11 (148,688) 0.84 GB over 240 s (15 of 318 states, ~15 s a state);
+#: 12 robots mesh 60 (146,588) 0.87 GB over 420 s (1 of 15 states: minutes a state).
 MAX_SHEET_TENDONS = 150_000
 
 #: The sheet's largest vertex distance in the simulation, m (the scenario is scaled to it).
