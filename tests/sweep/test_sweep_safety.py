@@ -19,6 +19,8 @@ from taut.errors import SweepError
 from taut.sweep import read_results, run_sweep, sweep_from_mapping
 from taut.sweep.store import Store
 
+EXAMPLE2 = "examples/sheet/example2_r2_r4_353mm.yaml"
+
 ROOT = Path(__file__).parents[2]
 TAUT = Path(sys.executable).with_name("taut")
 
@@ -218,3 +220,33 @@ def test_a_chunk_write_stops_when_the_folder_holds_another_sweeps_manifest(fk_sp
             store.write_chunk(1, cols)
         assert err.value.field == "out" and "another sweep's manifest" in err.value.problem
         assert not store.has(1) and store.has(0)
+
+
+def test_a_sweep_of_too_many_chunks_is_refused_before_any_work(examples_dir, tmp_path,
+                                                             monkeypatch):
+    """10^9 points in chunks of one point made a list of 10^9 chunks before any work; a
+    run of more than ``MAX_CHUNKS`` chunks is refused naming ``chunk_size`` and the
+    smallest that fits, and ``--limit`` counts: only the chunks it reaches are listed."""
+    from taut.sweep import runner
+    monkeypatch.setattr(runner, "MAX_CHUNKS", 3)
+    spec = sweep_from_mapping({"task": "fk_stability_map", "base": EXAMPLE2,
+                               "chunk_size": 2,
+                               "parameters": {"scale": {"range": [0.6, 1.0], "num": 7}}},
+                              examples_dir.parent)
+    with pytest.raises(SweepError) as err:
+        run_sweep(spec, tmp_path / "run", workers=0)
+    assert err.value.field == "chunk_size"
+    assert "4 chunks, more than 3" in err.value.problem and "at least 3" in err.value.problem
+    assert not (tmp_path / "run").exists()
+    res = run_sweep(spec, tmp_path / "part", workers=0, limit=5)    # 3 chunks: accepted
+    assert res.success and res.rows == 5
+    assert len(list((tmp_path / "part" / "chunks").glob("*.parquet"))) == 3
+
+
+def test_chunk_size_is_bounded_in_the_file(examples_dir):
+    from taut.sweep.file import MAX_CHUNK
+    with pytest.raises(SweepError) as err:
+        sweep_from_mapping({"task": "fk_stability_map", "base": EXAMPLE2,
+                            "chunk_size": MAX_CHUNK + 1, "parameters": {"scale": [0.8]}},
+                           examples_dir.parent)
+    assert err.value.field == "chunk_size"

@@ -83,9 +83,12 @@ def _generator(state: Mapping[str, Any]) -> np.random.Generator:
     return np.random.Generator(bits)
 
 
-def chunk_bounds(total: int, chunk_size: int) -> list[tuple[int, int]]:
-    """``(start, stop)`` of every chunk of ``total`` points."""
-    return [(lo, min(lo + chunk_size, total)) for lo in range(0, total, chunk_size)]
+def chunk_bounds(total: int, chunk_size: int, stop: int | None = None
+                 ) -> list[tuple[int, int]]:
+    """``(start, stop)`` of every chunk of ``total`` points (only those starting before
+    ``stop`` when given: a run limited to its first points lists no other chunk)."""
+    end = total if stop is None else min(stop, total)
+    return [(lo, min(lo + chunk_size, total)) for lo in range(0, end, chunk_size)]
 
 
 def chunk_streams(spec: SweepSpec, bounds: Iterable[tuple[int, int]]

@@ -54,6 +54,10 @@ DASK_LOG_ENTRIES = 50
 #: log-length``, default 7,200: an hour at its 0.5 s interval, ~10 series) for the
 #: dashboard: 60 s here.
 DASK_MONITOR_SAMPLES = 120
+#: Most chunks one run may make (points over ``chunk_size``): each is a file, a checksum
+#: and an entry in the run's chunk list (~100 bytes in memory); a 10^9-point sweep in
+#: chunks of one point would have held 10^9 before any work.
+MAX_CHUNKS = 1_000_000
 
 _CONTEXTS: dict[str, Any] = {}
 
@@ -228,6 +232,11 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     total = spec.size if limit is None else min(int(limit), spec.size)
     if total < 1:
         raise SweepError("limit" if limit is not None else "parameters", "selects no points")
+    size = chunk_size_of(spec)
+    if -(-total // size) > MAX_CHUNKS:
+        raise SweepError("chunk_size", f"{total} points in chunks of {size} make "
+                         f"{-(-total // size)} chunks, more than {MAX_CHUNKS}; use a "
+                         f"chunk_size of at least {-(-total // MAX_CHUNKS)}")
     with Store(out, spec.digest, resume=resume) as store:
         return _run(spec, store, limit, total, workers, scheduler, progress, t0)
 
@@ -235,7 +244,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
 def _run(spec: SweepSpec, store: Store, limit: int | None, total: int,
          workers: int | None, scheduler: str | None, progress: Any,
          t0: float) -> SweepResult:
-    bounds = [b for b in chunk_bounds(spec.size, chunk_size_of(spec)) if b[0] < total]
+    bounds = chunk_bounds(spec.size, chunk_size_of(spec), stop=total)
     stored = [store.state(k) for k in range(len(bounds))]
     todo = [st != "finished" for st in stored]
     damaged = tuple((store.chunk_path(k).name, st) for k, st in enumerate(stored)
