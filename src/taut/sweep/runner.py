@@ -233,10 +233,11 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     if total < 1:
         raise SweepError("limit" if limit is not None else "parameters", "selects no points")
     size = chunk_size_of(spec)
-    if -(-total // size) > MAX_CHUNKS:
-        raise SweepError("chunk_size", f"{total} points in chunks of {size} make "
-                         f"{-(-total // size)} chunks, more than {MAX_CHUNKS}; use a "
-                         f"chunk_size of at least {-(-total // MAX_CHUNKS)}")
+    chunks = -(-total // size)
+    if chunks > MAX_CHUNKS:
+        raise SweepError("chunk_size", f"{total} points in chunks of {size} make {chunks} "
+                         f"chunks, more than {MAX_CHUNKS}; use a chunk_size of at least "
+                         f"{-(-total // MAX_CHUNKS)}")
     with Store(out, spec.digest, resume=resume) as store:
         return _run(spec, store, limit, total, workers, scheduler, progress, t0)
 

@@ -87,7 +87,7 @@ def block_size(work: tuple[int, int], block: int) -> int:
 def batch_block(facets: int, dim: int, block: int = 256) -> int:
     """Poses per block (at most ``block``) whose sets of ``facets`` facets in ``dim``
     dimensions (a row and an offset each) hold at most :data:`MAX_SET_NUMBERS` numbers."""
-    return max(1, min(block, MAX_SET_NUMBERS // max(facets * (dim + 1), 1)))
+    return block_size((facets, facets * (dim + 1)), block)
 
 
 def check_batch_sets(facets: int, dim: int, poses: int, what: str) -> None:

@@ -150,28 +150,36 @@ def available_wrench_set(robot: CableRobot, poses: ArrayLike, *, tipping: bool =
     work = wrench_work(robot, tipping, slide)
     check_set_work(work, robot, "wrench set")
     check_batch_sets(work[0], robot.dof, P.shape[0], "wrench set")
-    blk = block_size(work, 256)
-    parts = [_aws_block(robot, P[i:i + blk], tipping, slide)
-             for i in range(0, P.shape[0], blk)]
-    H, h, ok, nonempty_, wg = (np.concatenate(x) for x in zip(*parts))
-    aws = AvailableWrenchSet(H=H, h=h, E=np.zeros((P.shape[0], 0, robot.dof)), poses=P,
-                             full_rank=ok, nonempty=nonempty_,
-                             tipping=bool(tipping and robot.has_tipping), gravity_wrench=wg,
-                             sliding=slide)
+    aws = _wrench_sets(robot, P, tipping, slide, work)
     return unbatch(aws, ("H", "h", "E", "poses", "full_rank", "nonempty", "gravity_wrench"),
                    single)
 
 
+def _wrench_sets(robot: CableRobot, P: np.ndarray, tipping: bool, slide: bool,
+                 work: tuple[int, int]) -> AvailableWrenchSet:
+    """The AWS of the checked poses ``P`` (B, 6), enumerated :func:`block_size` poses at a
+    time (``work``: :func:`wrench_work`, already checked)."""
+    blk = block_size(work, 256)
+    parts = [_aws_block(robot, P[i:i + blk], tipping, slide)
+             for i in range(0, P.shape[0], blk)]
+    H, h, ok, nonempty_, wg = (np.concatenate(x) for x in zip(*parts))
+    return AvailableWrenchSet(H=H, h=h, E=np.zeros((P.shape[0], 0, robot.dof)), poses=P,
+                              full_rank=ok, nonempty=nonempty_,
+                              tipping=bool(tipping and robot.has_tipping), gravity_wrench=wg,
+                              sliding=slide)
+
+
 def _aws_blocks(robot: CableRobot, P: np.ndarray, tipping: bool, sliding: bool
                 ) -> Iterator[tuple[slice, AvailableWrenchSet]]:
-    """The AWS of ``P`` (B, 6) a block of poses at a time (:func:`batch_block`), so only
-    one block's facets are alive at once: ``(poses of the block, its sets)``."""
-    work = wrench_work(robot, tipping, bool(sliding and robot.has_sliding))
+    """The AWS of the checked poses ``P`` (B, 6) a block of poses at a time
+    (:func:`batch_block`), so only one block's facets are alive at once: ``(poses of the
+    block, its sets)``."""
+    slide = bool(sliding and robot.has_sliding)
+    work = wrench_work(robot, tipping, slide)
     check_set_work(work, robot, "wrench set")
     blk = batch_block(work[0], robot.dof)
     for i in range(0, P.shape[0], blk):
-        yield slice(i, i + blk), available_wrench_set(robot, P[i:i + blk], tipping=tipping,
-                                                      sliding=sliding)
+        yield slice(i, i + blk), _wrench_sets(robot, P[i:i + blk], tipping, slide, work)
 
 
 def _aws_block(robot: CableRobot, P: np.ndarray, tipping: bool, sliding: bool
