@@ -40,6 +40,7 @@ from ..statics._common import wrench_vertices
 from .._tol import DEPLOY_DE_TOL, DEPLOY_NM_FATOL, DEPLOY_NM_XATOL, FIXED_COORD_WIDTH
 from .lift import LiftBound, lift_bound
 from ..model.robot import CableRobot
+from ..kinematics.cables import as_poses
 from ..kinematics.modes import MotionLimits, fastkit_motion_limits
 from .placement import footprint_overlap, place_bases, workspace_box
 from ..sets.twist import ats_blocks
@@ -177,7 +178,8 @@ def evaluate_deployment(robot: CableRobot, points: np.ndarray,
             raise InvalidInputError("twists", f"must be (T, {robot.dof}) required twists")
         twists = twists.reshape(-1, robot.dof)
         tm = np.inf
-        for _, ats in ats_blocks(robot, points, limits, "task", moving):   # one block's
+        poses = as_poses(robot, points, "points", check_bounds=False)  # checked above
+        for _, ats in ats_blocks(robot, poses, limits, "task", moving):    # one block's
             tm = min(tm, *(float(ats.margin(t).min()) for t in twists))  # facets at a time
             del ats                     # before the next block is built, not after
     return float(pm.min()), pm, tm

@@ -162,7 +162,13 @@ def first_order_model(robot: CableRobot, poses: ArrayLike, mode: ModeName = "tas
     """
     single = is_single(poses)
     md = resolve_mode(robot, mode, moving)
-    P = as_poses(robot, poses)
+    fom = first_order(robot, as_poses(robot, poses), md)
+    return unbatch(fom, FOM_PER_POSE, single)
+
+
+def first_order(robot: CableRobot, P: np.ndarray, md: Mode) -> FirstOrderModel:
+    """:func:`first_order_model` of checked poses ``P`` (B, 6) in a resolved mode, a batch
+    always: the engine behind it, for callers that validated their inputs once."""
     st = cable_state(robot, P, validated=True)
     n = robot.dof
     A6 = -np.concatenate([st.unit, np.cross(st.r, st.unit)], axis=2)       # (B, m, 6)
@@ -181,6 +187,5 @@ def first_order_model(robot: CableRobot, poses: ArrayLike, mode: ModeName = "tas
         jn = jn + tuple(c.name for c in robot.cables)
     else:
         Bsel = Bb[:, :, cols]
-    fom = FirstOrderModel(P, A6[:, :, :n].copy(), Bb, T[:, :, :n].copy(), md, Bsel, jn,
-                          st.lengths)
-    return unbatch(fom, FOM_PER_POSE, single)
+    return FirstOrderModel(P, A6[:, :, :n].copy(), Bb, T[:, :, :n].copy(), md, Bsel, jn,
+                           st.lengths)

@@ -25,10 +25,10 @@ from numpy.typing import ArrayLike
 from .._batching import is_single, unbatch
 from .._tol import RANK_TOL, ZERO_ROW
 from ..kinematics.cables import as_poses
-from ..kinematics.first_order import FOM_PER_POSE, FirstOrderModel, first_order_model
+from ..kinematics.first_order import FOM_PER_POSE, FirstOrderModel, first_order
 from ..model.robot import CableRobot
 from ..kinematics.modes import (TWIST_LABELS, Mode, ModeName, MotionLimits, fastkit_motion_limits,
-    joint_bounds)
+    joint_bounds, resolve_mode)
 from .polytope import HPolytopeBatch, lp_max_step
 from .zonotope import _facets_base_and_identity, zonotope_hrep
 from ._budget import (batch_block, block_size, check_batch_sets, check_set_work,
@@ -167,36 +167,48 @@ def available_twist_set(robot: CableRobot, poses: ArrayLike, limits: MotionLimit
     """
     single = is_single(poses)
     limits = fastkit_motion_limits() if limits is None else limits
-    fom = first_order_model(robot, as_poses(robot, poses), mode, moving)
+    md = resolve_mode(robot, mode, moving)
+    ats = _twist_sets(robot, as_poses(robot, poses), md, limits)
+    if single:
+        ats = replace(unbatch(ats, ("H", "h", "E", "poses", "full_rank"), True),
+                      model=unbatch(ats.model, FOM_PER_POSE, True))
+    return ats
+
+
+def _twist_sets(robot: CableRobot, P: np.ndarray, md: Mode, limits: MotionLimits, *,
+                batch_checked: bool = False) -> AvailableTwistSet:
+    """The ATS of checked poses ``P`` (B, 6) in a resolved mode, a batch always. A task-mode
+    batch is refused past the set budget unless ``batch_checked`` (the caller builds it a
+    block at a time)."""
+    fom = first_order(robot, P, md)
     lo, hi = joint_bounds(robot, limits, fom.mode)
     if fom.mode.kind == "task":
         nb = fom.n_base_joints
         moves = hi > lo
         work = twist_work(robot.m, int(moves[:nb].sum()), int(moves[nb:].sum()))
         check_set_work(work, robot, "twist set", f"{nb} moving base joints")
-        check_batch_sets(work[0], robot.dof, fom.A.shape[0], "twist set")
+        if not batch_checked:
+            check_batch_sets(work[0], robot.dof, fom.A.shape[0], "twist set")
         H, h, E, full = _task_set(fom, lo, hi, block_size(work, 256))
     else:
         H, h, E, full = _navigation_set(fom, lo, hi)
-    ats = AvailableTwistSet(H=H, h=h, E=E, poses=fom.poses, mode=fom.mode, full_rank=full,
-                            model=fom, limits=limits)
-    if single:
-        ats = replace(unbatch(ats, ("H", "h", "E", "poses", "full_rank"), True),
-                      model=unbatch(fom, FOM_PER_POSE, True))
-    return ats
+    return AvailableTwistSet(H=H, h=h, E=E, poses=fom.poses, mode=fom.mode, full_rank=full,
+                             model=fom, limits=limits)
 
 
 def ats_blocks(robot: CableRobot, P: np.ndarray, limits: MotionLimits, mode: ModeName,
                moving: Sequence[str] | None) -> Iterator[tuple[slice, AvailableTwistSet]]:
-    """The ATS of poses ``P`` (B, 6) a block at a time (the first pose alone, which sizes
-    the blocks by :func:`batch_block`), so only one block's facets are alive at once:
-    ``(poses of the block, its sets)``."""
-    ats = available_twist_set(robot, P[:1], limits, mode, moving)
+    """The ATS of checked poses ``P`` (B, 6) a block at a time (the first pose alone, which
+    sizes the blocks by :func:`batch_block`), so only one block's facets are alive at once:
+    ``(poses of the block, its sets)``. The mode is resolved once."""
+    md = resolve_mode(robot, mode, moving)
+    ats = _twist_sets(robot, P[:1], md, limits)
     blk = batch_block(ats.H.shape[1], ats.H.shape[2])
     yield slice(0, 1), ats
     del ats
     for i in range(1, P.shape[0], blk):
-        yield slice(i, i + blk), available_twist_set(robot, P[i:i + blk], limits, mode, moving)
+        yield slice(i, i + blk), _twist_sets(robot, P[i:i + blk], md, limits,
+                                             batch_checked=True)
 
 
 @dataclass(frozen=True, repr=False)
@@ -258,9 +270,9 @@ def twist_capacities(robot: CableRobot, poses: ArrayLike, limits: MotionLimits |
     return unbatch(caps, ("positive", "negative", "feasible"), single)
 
 
-def _capacities_lp(robot: CableRobot, poses: ArrayLike, limits: MotionLimits,
+def _capacities_lp(robot: CableRobot, P: np.ndarray, limits: MotionLimits,
                    mode: ModeName, moving: Sequence[str] | None) -> TwistCapacities:
-    fom = first_order_model(robot, poses, mode, moving)
+    fom = first_order(robot, P, resolve_mode(robot, mode, moving))
     lo, hi = joint_bounds(robot, limits, fom.mode)
     Bn, m, n = fom.A.shape
     pos = np.zeros((Bn, n))
