@@ -117,3 +117,37 @@ def test_files_that_are_not_trajectories_are_one_error(tmp_path, text, error, fi
         load_robot_trajectories(path)
     if field is not None:
         assert err.value.field == field, str(err.value)
+
+
+@pytest.mark.parametrize("success, T", [(True, 4), (False, 0)])
+def test_the_csv_form_reads_back_exactly(tmp_path, success, T):
+    tr = _executed(T, success=success)
+    path = tmp_path / "t.csv"
+    save_robot_trajectories(path, tr)
+    back = load_robot_trajectories(path)
+    np.testing.assert_array_equal(back.times, tr.times)
+    np.testing.assert_array_equal(back.poses, tr.poses)
+    np.testing.assert_array_equal(back.object, tr.object)
+
+
+@pytest.mark.parametrize("cell, problem", [
+    ("nan", "row 3: a cell is NaN or infinite"),
+    ("-inf", "row 3: a cell is NaN or infinite"),
+    ("1e309", "row 3: a cell is NaN or infinite"),          # overflows to inf
+    ("one", "row 3: a cell is not a number"),
+    (None, "row 3: 12 cells; the header has 13"),           # a cell missing
+])
+def test_the_csv_form_refuses_a_bad_cell_naming_its_row(tmp_path, cell, problem):
+    path = tmp_path / "t.csv"
+    save_robot_trajectories(path, _executed())
+    lines = path.read_text().splitlines()
+    cells = lines[2].split(",")
+    if cell is None:
+        cells.pop()
+    else:
+        cells[5] = cell
+    lines[2] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InvalidTrajectoryError) as err:
+        load_robot_trajectories(path)
+    assert problem in str(err.value) and "t.csv" in str(err.value)

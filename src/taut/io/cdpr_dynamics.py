@@ -16,17 +16,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict
 
 from ..cdpr.control.dynamics import DynamicsModel
 from .cdpr_model import _Dynamics, preset_path
-from .files import read_mapping, validate_mapping
+from .files import StrictModel, read_mapping, validate_mapping
 
 __all__ = ["load_cdpr_dynamics", "dynamics_from_mapping"]
 
 
-class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _Section(StrictModel):
     dynamics: _Dynamics
 
 

@@ -25,12 +25,12 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from .._units import GRAVITY
 from ..cdpr.model.robot import Base, Cable, CableRobot, Payload, Platform
 from ..errors import InvalidModelError, ScenarioError, TautError
-from .files import Number, read_mapping, validate_mapping
+from .files import Number, StrictModel, read_mapping, validate_mapping
 from .._validate import MAX_CDPR_LENGTH_M, MAX_MASS_KG, as_path, check_range
 
 __all__ = ["PRESETS", "load_cdpr_model", "cdpr_model_from_mapping", "preset_path"]
@@ -41,16 +41,12 @@ Vec3 = tuple[Number, Number, Number]
 Vec2 = tuple[Number, Number]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-class _Stabilisers(_Strict):
+class _Stabilisers(StrictModel):
     footprint: list[Vec2]
     deployed: bool = False
 
 
-class _Base(_Strict):
+class _Base(StrictModel):
     name: str
     mobile: bool = False
     pose: Vec3 = (0.0, 0.0, 0.0)
@@ -62,20 +58,20 @@ class _Base(_Strict):
     friction: Number | None = None       # ground friction coefficient (sliding condition)
 
 
-class _Platform(_Strict):
+class _Platform(StrictModel):
     mass: Number = 0.0
     com: Vec3 = (0.0, 0.0, 0.0)
     inertia: Vec3 | tuple[Vec3, Vec3, Vec3] = (0.0, 0.0, 0.0)
     attachment_points: dict[str, Vec3] = Field(min_length=1)
 
 
-class _Payload(_Strict):
+class _Payload(StrictModel):
     mass: Number = 0.0
     com: Vec3 = (0.0, 0.0, 0.0)
     inertia: Vec3 | tuple[Vec3, Vec3, Vec3] = (0.0, 0.0, 0.0)
 
 
-class _Cable(_Strict):
+class _Cable(StrictModel):
     name: str
     exit: str
     attachment: str
@@ -83,12 +79,12 @@ class _Cable(_Strict):
     t_max: Number
 
 
-class _Box(_Strict):
+class _Box(StrictModel):
     min: Vec3
     max: Vec3
 
 
-class _Dynamics(_Strict):
+class _Dynamics(StrictModel):
     """The ``dynamics:`` section (keys: :mod:`taut.io.cdpr_dynamics`; SI, motor side)."""
     # Defaults live in DynamicsModel only: a key left out keeps its default there; an
     # explicit null reaches DynamicsModel and is refused by its own checks.
@@ -112,7 +108,7 @@ class _Dynamics(_Strict):
     routing_length: Optional[Union[Number, list[Number]]] = None
 
 
-class _ModelFile(_Strict):
+class _ModelFile(StrictModel):
     name: str = "cable robot"
     gravity: Vec3 = (0.0, 0.0, -GRAVITY)
     bases: list[_Base] = Field(min_length=1)

@@ -31,14 +31,14 @@ from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
 import yaml
-from pydantic import BaseModel, Strict, ValidationError
+from pydantic import BaseModel, ConfigDict, Strict, ValidationError
 
 from ..errors import InvalidInputError, ScenarioError
 from .._validate import as_path, require_instance
 
 __all__ = ["read_text", "read_mapping", "parse_mapping", "validate_mapping", "write_json",
            "write_text_atomic", "atomic_path", "MAX_FILE_BYTES", "MAX_YAML_VALUES",
-           "MAX_YAML_CHARS", "Number", "Integer"]
+           "MAX_YAML_CHARS", "Number", "Integer", "StrictModel"]
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -47,6 +47,15 @@ M = TypeVar("M", bound=BaseModel)
 Number = Annotated[float, Strict()]
 #: An integer in a file model; never a boolean, a float or a string.
 Integer = Annotated[int, Strict()]
+
+
+class StrictModel(BaseModel):
+    """Base of every section of an input file: an unknown key and a NaN or infinite
+    number are refused (the error names the dotted key, :func:`validate_mapping`)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
 #: Error types of :data:`Number` and :data:`Integer` given a boolean: reported as
 #: "must be a number, got a boolean", the wording of :mod:`taut._validate` for the API.
 _NUMBER_ERRORS = frozenset({"float_type", "int_type"})

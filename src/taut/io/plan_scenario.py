@@ -26,12 +26,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from ..errors import ScenarioError, TautError
 from ..plan.world import MAX_TEAM_ROBOTS, Obstacle, Scenario, Team, World
 from ..sheet import Sheet, SheetTeam
-from .files import Integer, Number, read_mapping, validate_mapping
+from .files import Integer, Number, StrictModel, read_mapping, validate_mapping
 from .._validate import require_instance
 
 __all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to_mapping"]
@@ -39,24 +39,22 @@ __all__ = ["load_plan_scenario", "plan_scenario_from_mapping", "plan_scenario_to
 Point = tuple[Number, Number]
 
 
-class _Regular(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _Regular(StrictModel):
     n: Integer = Field(ge=3)
-    circumradius: Number = Field(gt=0, allow_inf_nan=False)
-    phase: Number = Field(default=0.0, allow_inf_nan=False)
+    circumradius: Number = Field(gt=0)
+    phase: Number = 0.0
 
 
-class _Team(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _Team(StrictModel):
     sheet: list[Point] | None = None
     regular: _Regular | None = None
-    hold_height: Number = Field(gt=0, allow_inf_nan=False)
-    robot_radius: Number = Field(gt=0, allow_inf_nan=False)
-    height_safety: Number = Field(ge=0, allow_inf_nan=False)
-    lateral_safety: Number = Field(ge=0, allow_inf_nan=False)
-    speed: Number = Field(gt=0, allow_inf_nan=False)
-    rotation_speed: Number = Field(gt=0, allow_inf_nan=False)
-    mass: Number | None = Field(default=None, gt=0, allow_inf_nan=False)
+    hold_height: Number = Field(gt=0)
+    robot_radius: Number = Field(gt=0)
+    height_safety: Number = Field(ge=0)
+    lateral_safety: Number = Field(ge=0)
+    speed: Number = Field(gt=0)
+    rotation_speed: Number = Field(gt=0)
+    mass: Number | None = Field(default=None, gt=0)
 
     @model_validator(mode="after")
     def _one_sheet(self):
@@ -65,12 +63,11 @@ class _Team(BaseModel):
         return self
 
 
-class _Obstacle(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _Obstacle(StrictModel):
     id: Integer | str
-    height: Number = Field(gt=0, allow_inf_nan=False)
+    height: Number = Field(gt=0)
     center: Point | None = None
-    radius: Number | None = Field(default=None, gt=0, allow_inf_nan=False)
+    radius: Number | None = Field(default=None, gt=0)
     polygon: list[Point] | None = None
 
     @model_validator(mode="after")
@@ -82,8 +79,7 @@ class _Obstacle(BaseModel):
         return self
 
 
-class _PlanFile(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _PlanFile(StrictModel):
     name: str | None = None
     units: str | None = None
     free_space: list[Point]

@@ -24,11 +24,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
 
 from .._outcome import Status
 from ..errors import InvalidTrajectoryError, ScenarioError
-from .files import Integer, Number, parse_mapping, read_text, validate_mapping, \
+from .files import Integer, Number, StrictModel, parse_mapping, read_text, validate_mapping, \
     write_text_atomic
 
 if TYPE_CHECKING:
@@ -55,24 +54,20 @@ Pose = tuple[Number, Number, Number]
 MaybeNumber = Optional[Number]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-class _Limits(_Strict):
+class _Limits(StrictModel):
     max_speed_mps: MaybeNumber
     max_accel_mps2: MaybeNumber
     max_yaw_rate_radps: MaybeNumber
     reform_speed_mps: MaybeNumber
 
 
-class _Peaks(_Strict):
+class _Peaks(StrictModel):
     speed_mps: MaybeNumber
     accel_mps2: MaybeNumber
     yaw_rate_radps: MaybeNumber
 
 
-class _TrajectoriesFile(_Strict):
+class _TrajectoriesFile(StrictModel):
     success: bool
     status: Status
     message: str
@@ -157,6 +152,20 @@ def save_robot_trajectories(path: str | Path, tr: RobotTrajectories) -> None:
     write_text_atomic(path, fh.getvalue())
 
 
+def _csv_row(name: str, row: int, cells: list[str], width: int) -> list[float]:
+    """One CSV sample: ``width`` finite numbers (the writer never writes NaN or inf)."""
+    if len(cells) != width:
+        raise InvalidTrajectoryError(name, f"row {row}: {len(cells)} cells; the header has "
+                                     f"{width}")
+    try:
+        values = [float(v) for v in cells]
+    except ValueError:
+        raise InvalidTrajectoryError(name, f"row {row}: a cell is not a number") from None
+    if not np.all(np.isfinite(values)):
+        raise InvalidTrajectoryError(name, f"row {row}: a cell is NaN or infinite")
+    return values
+
+
 def load_robot_trajectories(path: str | Path) -> ExecutedTrajectories:
     """Read a file written by :func:`save_robot_trajectories`.
 
@@ -176,10 +185,8 @@ def load_robot_trajectories(path: str | Path) -> ExecutedTrajectories:
     if not rows or (len(rows[0]) - 4) % 3 or rows[0] != _header((len(rows[0]) - 4) // 3):
         raise InvalidTrajectoryError(Path(path).name, "row 1: expected the header t_s, "
                                      "x_1_m, y_1_m, heading_1_rad, ..., object_z_m")
-    try:
-        data = np.array([[float(v) for v in r] for r in rows[1:] if r], float)
-    except ValueError as exc:
-        raise InvalidTrajectoryError(Path(path).name, f"a row is not numeric: {exc}") from None
+    data = np.array([_csv_row(Path(path).name, k, r, len(rows[0]))
+                     for k, r in enumerate(rows[1:], start=2) if r], float)
     data = data.reshape(-1, len(rows[0]))
     n = (data.shape[1] - 4) // 3
     return ExecutedTrajectories(data[:, 0], data[:, 1:1 + 3 * n].reshape(-1, n, 3),

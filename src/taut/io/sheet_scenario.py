@@ -15,13 +15,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from .._validate import MAX_ROBOTS, MAX_SHEET_LENGTH, check_range
 from ..errors import ScenarioError, TautError
 from ..sheet.model import Sheet, check_formation
 from ..sheet.team import SheetTeam
-from .files import Number, read_mapping, validate_mapping
+from .files import Number, StrictModel, read_mapping, validate_mapping
 from .._repr import CompactRepr
 
 __all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"]
@@ -29,19 +29,17 @@ __all__ = ["SheetScenario", "load_sheet_scenario", "sheet_scenario_from_mapping"
 Point = tuple[Number, Number]
 
 
-class _ObjectFile(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=False)
+class _ObjectFile(StrictModel):
 
-    radius: Number = Field(gt=0, allow_inf_nan=False)
+    radius: Number = Field(gt=0)
 
 
-class _SheetScenarioFile(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=False)
+class _SheetScenarioFile(StrictModel):
 
     name: str | None = None
     units: str | None = None
-    hold_height: Number = Field(allow_inf_nan=False)
-    mass: Number | None = Field(default=None, allow_inf_nan=False)
+    hold_height: Number
+    mass: Number | None = None
     sheet: list[Point]
     formation: list[Point] | None = None
     object: _ObjectFile | None = None

@@ -22,12 +22,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Optional
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from ..cdpr.mission.warehouse import SHELF_HEIGHT, Shelf, Task, Warehouse
 from ..errors import ScenarioError, TautError
 from .cdpr_model import load_cdpr_model
-from .files import Number, read_mapping, validate_mapping
+from .files import Number, StrictModel, read_mapping, validate_mapping
 from .._validate import as_path
 
 __all__ = ["load_warehouse", "warehouse_from_mapping"]
@@ -36,24 +36,20 @@ Vec3 = tuple[Number, Number, Number]
 Vec2 = tuple[Number, Number]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-class _Shelf(_Strict):
+class _Shelf(StrictModel):
     name: str = Field(min_length=1)
     footprint: list[Vec2] = Field(min_length=3)
     height_m: Number = SHELF_HEIGHT
 
 
-class _Task(_Strict):
+class _Task(StrictModel):
     name: str = Field(min_length=1)
     pick: Vec3
     place: Vec3
     mass: Number
 
 
-class _WarehouseFile(_Strict):
+class _WarehouseFile(StrictModel):
     name: str = "warehouse"
     robot: str = Field(min_length=1)
     floor: list[Vec2] = Field(min_length=3)

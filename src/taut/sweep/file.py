@@ -35,11 +35,11 @@ from pathlib import Path
 from typing import Annotated, Any, Literal, Union, cast
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Strict, Tag
+from pydantic import Discriminator, Field, Strict, Tag
 
 from .._validate import MAX_CDPR_LENGTH_M, as_path
 from ..errors import ScenarioError, SweepError
-from ..io.files import Integer, Number, read_mapping, read_text, validate_mapping
+from ..io.files import Integer, Number, StrictModel, read_mapping, read_text, validate_mapping
 from .registry import TASKS
 from .spec import DISTRIBUTIONS, Parameter, SweepSpec, _choice
 
@@ -66,10 +66,6 @@ TASK_OPTIONS: dict[str, dict[str, str]] = {
 
 # --- The file's shape, as pydantic models (strict: a boolean or a string is no number) ---
 
-#: A finite number (an integer is accepted as a float; a boolean is not).
-_Number = Annotated[Number, Field(allow_inf_nan=False)]
-
-
 def _shape(value: Any) -> str:
     """Which form a parameter's value takes; the tags are the ones
     :func:`taut.io.files.validate_mapping` leaves out of an error's field."""
@@ -78,44 +74,40 @@ def _shape(value: Any) -> str:
     return "list[float]" if isinstance(value, list) else "float"
 
 
-class _Axis(BaseModel):
+class _Axis(StrictModel):
     """A grid axis: ``{range: [lo, hi], num: n}``, ``{range, step}`` or ``{values: [...]}``."""
 
-    model_config = ConfigDict(extra="forbid")
-    range: list[_Number] | None = None
+    range: list[Number] | None = None
     num: Annotated[Integer, Field(ge=1, le=MAX_AXIS)] | None = None
-    step: _Number | None = None
-    values: Annotated[list[_Number], Field(min_length=1)] | None = None
+    step: Number | None = None
+    values: Annotated[list[Number], Field(min_length=1)] | None = None
 
 
-class _Law(BaseModel):
+class _Law(StrictModel):
     """A random distribution (random mode): one of its keys, with its numbers."""
 
-    model_config = ConfigDict(extra="forbid")
-    uniform: list[_Number] | None = None
-    normal: list[_Number] | None = None
-    integers: list[_Number] | None = None
-    choice: list[_Number] | None = None
+    uniform: list[Number] | None = None
+    normal: list[Number] | None = None
+    integers: list[Number] | None = None
+    choice: list[Number] | None = None
 
 
 _Value = Annotated[Union[
-    Annotated[_Number, Tag("float")],
-    Annotated[Annotated[list[_Number], Field(min_length=1)], Tag("list[float]")],
+    Annotated[Number, Tag("float")],
+    Annotated[Annotated[list[Number], Field(min_length=1)], Tag("list[float]")],
     Annotated[_Axis, Tag("dict[axis]")],
     Annotated[_Law, Tag("dict[law]")]], Discriminator(_shape)]
 
 
-class _Options(BaseModel):
+class _Options(StrictModel):
     """Task options (every option any task takes; an unknown key is refused here, which
     of them a task takes is checked against :data:`TASK_OPTIONS`)."""
 
-    model_config = ConfigDict(extra="forbid")
     grid: list[Annotated[Integer, Field(ge=1, le=MAX_GRID_POINTS)]] | None = None
-    box: list[list[_Number]] | None = None
+    box: list[list[Number]] | None = None
 
 
-class _SweepFile(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _SweepFile(StrictModel):
     task: Annotated[str, Strict()]
     base: Annotated[str, Strict()] | None = None
     mode: Literal["grid", "random"] = "grid"
