@@ -125,6 +125,11 @@ MAX_CABLES = 100
 MAX_SET_NUMBERS = 30_000_000
 #: Largest number of poses / formations / grid points in one call.
 MAX_BATCH = 10_000_000
+#: Most platform poses (positions x orientations) of one wrench-feasible workspace
+#: (:func:`taut.cdpr.wrench_feasible_workspace`, its grid, a sweep task's grid): `taut cdpr
+#: workspace fastkit --grid 1000 1 1000` at the limit peaked at 565 MB, 76 s
+#: (`/usr/bin/time`, loaded).
+MAX_WORKSPACE_POSES = 1_000_000
 #: Most control steps of one cable-robot control simulation (``duration`` and ``settle``
 #: times the control rate) and samples of a pick-and-place reference: 60 s at FASTKIT's
 #: 1 kHz. Memory grows ~3.8 kB a step, ~12 kB with the JSON result (`taut cdpr simulate

@@ -25,10 +25,6 @@ from .cdpr_mission import add_mission
 
 __all__ = ["register"]
 
-#: Largest workspace grid (points x orientations) one command evaluates.
-MAX_GRID_POINTS = 1_000_000
-
-
 _POSE_HELP = "Platform position X Y Z in m."
 _RPY_HELP = "Platform orientation ROLL PITCH YAW in rad (Rz(yaw) Ry(pitch) Rx(roll))."
 
@@ -167,9 +163,6 @@ def _workspace(model: str, grid: Any, box: Any, rpy: Any, plot: Optional[Path],
 
     nx, ny, nz = (as_count(n, "grid", minimum=1) for n in grid)
     ori = _orientations(rpy, sweep)
-    if nx * ny * nz * len(ori) > MAX_GRID_POINTS:
-        raise InvalidInputError("grid", f"{nx}x{ny}x{nz} points x {len(ori)} orientations "
-                                f"exceeds {MAX_GRID_POINTS} evaluations")
     region = None if box is None else as_box(box, "box", limit=MAX_CDPR_LENGTH_M)
     robot = load_robot(model, stabilisers)
     if region is None:

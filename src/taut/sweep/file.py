@@ -37,7 +37,7 @@ from typing import Annotated, Any, Literal, Union, cast
 import numpy as np
 from pydantic import Discriminator, Field, Strict, Tag
 
-from .._validate import MAX_CDPR_LENGTH_M, as_path
+from .._validate import MAX_CDPR_LENGTH_M, MAX_WORKSPACE_POSES, as_path
 from ..errors import ScenarioError, SweepError
 from ..io.files import Integer, Number, StrictModel, read_mapping, read_text, validate_mapping
 from .registry import TASKS
@@ -49,8 +49,6 @@ __all__ = ["load_sweep", "sweep_from_mapping", "base_model"]
 MAX_POINTS = 10**9
 #: Most values one grid axis may hold.
 MAX_AXIS = 10**7
-#: Most points of a task's workspace grid (``options.grid``), per sweep point.
-MAX_GRID_POINTS = 10**6
 #: Largest ``chunk_size`` (points per task): a chunk's rows are held in memory while it
 #: is computed, ~1.9 kB a point (the FK octagon map, 8 outputs: 291 MB peak at chunks of
 #: 5,000 points, 378 MB at 50,000; `/usr/bin/time`), so 10^5 points stay near 0.5 GB
@@ -103,7 +101,7 @@ class _Options(StrictModel):
     """Task options (every option any task takes; an unknown key is refused here, which
     of them a task takes is checked against :data:`TASK_OPTIONS`)."""
 
-    grid: list[Annotated[Integer, Field(ge=1, le=MAX_GRID_POINTS)]] | None = None
+    grid: list[Annotated[Integer, Field(ge=1, le=MAX_WORKSPACE_POSES)]] | None = None
     box: list[list[Number]] | None = None
 
 
@@ -159,8 +157,8 @@ def _options(value: _Options, task: str) -> dict[str, Any]:
     if value.grid is not None:
         if len(value.grid) != 3:
             raise SweepError("options.grid", "must be three integers [nx, ny, nz]")
-        if int(np.prod(value.grid)) > MAX_GRID_POINTS:
-            raise SweepError("options.grid", f"makes more than {MAX_GRID_POINTS} points")
+        if int(np.prod(value.grid)) > MAX_WORKSPACE_POSES:
+            raise SweepError("options.grid", f"makes more than {MAX_WORKSPACE_POSES} points")
         out["grid"] = list(value.grid)
     if value.box is not None:
         rows = value.box

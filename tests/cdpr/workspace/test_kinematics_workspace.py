@@ -133,3 +133,21 @@ def test_cli_sweep_and_capacity_plot(tmp_path, capsys):
     assert main(["cdpr", "wrench-set", "fastkit", "--pose", "-1.5", "0", "0.8", "--plot",
                  str(png)]) == 0
     assert png.stat().st_size > 5_000 and "figure written" in capsys.readouterr().out
+
+
+def test_the_workspace_pose_limit_is_the_librarys(fastkit):
+    """MAX_WORKSPACE_POSES bounds a grid and the points x orientations of one workspace, in
+    the library (the CLI and the sweep file read the same constant), before any work."""
+    from taut._validate import MAX_WORKSPACE_POSES
+    from taut.cdpr import wrench_feasible_workspace
+    from taut.errors import InvalidInputError
+
+    box = fastkit.desired_workspace
+    side = int(round(MAX_WORKSPACE_POSES ** 0.5))
+    pts, _ = grid_points(box, (side, 1, MAX_WORKSPACE_POSES // side))     # at the limit
+    assert len(pts) == MAX_WORKSPACE_POSES
+    with pytest.raises(InvalidInputError, match="grid"):
+        grid_points(box, (side, 1, MAX_WORKSPACE_POSES // side + 1))
+    few = pts[: MAX_WORKSPACE_POSES // 6]
+    with pytest.raises(InvalidInputError, match="orientations"):
+        wrench_feasible_workspace(fastkit, few, orientations=np.zeros((7, 3)))

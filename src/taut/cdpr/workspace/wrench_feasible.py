@@ -9,7 +9,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._validate import MAX_BATCH, as_array
+from ..._validate import MAX_WORKSPACE_POSES, as_array
 from ...errors import InvalidInputError
 from .._tol import BOX_REL, CLOSURE_TOL
 from .closure import closure_pass, inside_pass
@@ -31,9 +31,9 @@ def grid_points(box: ArrayLike, shape: ArrayLike) -> tuple[np.ndarray, tuple[int
     sh = as_array(shape, "grid")
     if sh.shape != (3,) or np.any(sh < 1) or np.any(sh != np.round(sh)):
         raise InvalidInputError("grid", "must be three positive integers nx ny nz")
-    if float(np.prod(sh)) > MAX_BATCH:
-        raise InvalidInputError("grid", f"{float(np.prod(sh)):g} points exceed the accepted "
-                                        f"range {MAX_BATCH:g} grid points")
+    if float(np.prod(sh)) > MAX_WORKSPACE_POSES:
+        raise InvalidInputError("grid", f"{' x '.join(f'{n:g}' for n in sh)} points exceeds "
+                                        f"{MAX_WORKSPACE_POSES:,} workspace poses")
     nx, ny, nz = (int(n) if b[1, k] > b[0, k] else 1 for k, n in enumerate(sh))
     eff = (nx, ny, nz)
     axes = [np.linspace(b[0, k], b[1, k], eff[k]) if eff[k] > 1 else
@@ -143,6 +143,10 @@ def wrench_feasible_workspace(robot: CableRobot, points: ArrayLike, *,
     ori = np.zeros((1, 3)) if orientations is None else \
         as_array(orientations, "orientations", shape=(None, 3))
     Pn, On = pts.shape[0], ori.shape[0]
+    if Pn * On > MAX_WORKSPACE_POSES:
+        raise InvalidInputError("orientations" if On > 1 else "points",
+                                f"{Pn:,} points x {On} orientations exceeds "
+                                f"{MAX_WORKSPACE_POSES:,} workspace poses")
     poses = np.hstack([np.repeat(pts, On, axis=0), np.tile(ori, (Pn, 1))])
     passes = [("limits", False, False)]
     if robot.has_tipping:
