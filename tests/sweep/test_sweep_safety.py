@@ -139,6 +139,32 @@ def test_resume_names_each_damaged_chunk_and_why(fk_spec, tmp_path, capsys, same
     assert "recomputed" not in capsys.readouterr().err
 
 
+def test_resume_names_at_most_ten_damaged_chunks_then_counts(tmp_path, capsys):
+    """Past ``DAMAGED_NAMED`` damaged chunks, ``--resume`` names the first ten and counts
+    the rest in one line (a folder of thousands of damaged chunks is not thousands of
+    lines)."""
+    from taut.cli.sweep import DAMAGED_NAMED
+
+    spec_file = tmp_path / "s.yaml"
+    spec_file.write_text(textwrap.dedent(f"""\
+        task: fk_stability_map
+        base: {ROOT / 'examples/sheet/example2_r2_r4_353mm.yaml'}
+        chunk_size: 1
+        parameters: {{scale: {{range: [0.6, 1.0], num: {DAMAGED_NAMED + 3}}}}}
+        """))
+    out = tmp_path / "run"
+    assert main(["sweep", "run", str(spec_file), "--out", str(out), "--workers", "0"]) == 0
+    for k in range(DAMAGED_NAMED + 3):
+        (out / "chunks" / f"chunk-{k:07d}.parquet.sha256").unlink()
+    capsys.readouterr()
+    assert main(["sweep", "run", str(spec_file), "--out", str(out), "--workers", "0",
+                 "--resume"]) == 0
+    lines = [line for line in capsys.readouterr().err.splitlines() if "recomputed" in line]
+    assert len(lines) == DAMAGED_NAMED + 1
+    assert lines[0] == "taut: sweep: chunks/chunk-0000000.parquet recomputed (no checksum)"
+    assert lines[-1] == "taut: sweep: and 3 more damaged chunks recomputed"
+
+
 def test_a_damaged_results_file_is_one_line_in_sweep_plot(fk_spec, tmp_path, capsys):
     spec = fk_spec(scale=[0.8, 0.9])
     run_sweep(spec, tmp_path / "run", workers=0)
