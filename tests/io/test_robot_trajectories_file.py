@@ -34,15 +34,18 @@ def _data() -> dict[str, Any]:
     return json.loads(to_json(robot_trajectories_to_dict(_executed()), indent=None))
 
 
+@pytest.mark.parametrize("suffix", [".json", ".csv"])
 @pytest.mark.parametrize("success, T", [(True, 4), (False, 0)])
-def test_a_file_taut_writes_reads_back_exactly(tmp_path, success, T):
+def test_a_file_taut_writes_reads_back_exactly(tmp_path, success, T, suffix):
+    """Both forms; a failed plan's JSON has no sample to count its robots by, its CSV
+    header does."""
     tr = _executed(T, success=success)
-    path = tmp_path / "t.json"
+    path = tmp_path / f"t{suffix}"
     save_robot_trajectories(path, tr)
     back = load_robot_trajectories(path)
     np.testing.assert_array_equal(back.times, tr.times)
     np.testing.assert_array_equal(back.object, tr.object)
-    assert back.poses.shape == ((T, 3, 3) if T else (0, 0, 3))
+    assert back.poses.shape == ((T, 3, 3) if T or suffix == ".csv" else (0, 0, 3))
     if T:
         np.testing.assert_array_equal(back.poses, tr.poses)
 
@@ -117,17 +120,6 @@ def test_files_that_are_not_trajectories_are_one_error(tmp_path, text, error, fi
         load_robot_trajectories(path)
     if field is not None:
         assert err.value.field == field, str(err.value)
-
-
-@pytest.mark.parametrize("success, T", [(True, 4), (False, 0)])
-def test_the_csv_form_reads_back_exactly(tmp_path, success, T):
-    tr = _executed(T, success=success)
-    path = tmp_path / "t.csv"
-    save_robot_trajectories(path, tr)
-    back = load_robot_trajectories(path)
-    np.testing.assert_array_equal(back.times, tr.times)
-    np.testing.assert_array_equal(back.poses, tr.poses)
-    np.testing.assert_array_equal(back.object, tr.object)
 
 
 @pytest.mark.parametrize("cell, problem", [
