@@ -1,4 +1,5 @@
-"""How the held verdict's pull changes with the mesh (the unresolved states of README.md).
+"""How the held verdict's pull changes with the mesh, read two ways (README.md, "Hold
+resolution").
 
 Usage::
 
@@ -15,11 +16,15 @@ skipped.
 
 Prints one Markdown row per state and mesh: taut's verdict and its own pull (fraction of
 the weight, ``model_pull``), spacing (mm), the tied run's outcome, ``sliding`` as the
-check reads it, the same pull after ``--extra`` more simulated seconds (where the tied
-sheet is at rest: the difference is residual motion at the check's settle threshold),
-and the wall time of the tied run as the check does it (mesh, build, ramp, settle; s).
-The default states are the 10 unresolved non-equilibria and the 8 stable states with the
-largest pull at mesh 10 in the 30-team sample (seed 2026).
+check reads it (the corner tendons the simulation has taut, read as rigid cables), the
+pull of MuJoCo's own tendon forces (``_force_pull``: the check's reading before issue
+31 was resolved, still its reading without corner tendons), the latter again after
+``--extra`` more simulated seconds (where the tied sheet is at rest: the difference is
+residual motion at the check's settle threshold), and the wall time of the tied run as
+the check does it (mesh, build, ramp, settle; s). The default states are the 10
+non-equilibria that the force reading could not resolve (model pull below its 0.05
+tolerance) and the 8 stable states with the largest force pull at mesh 10 in the
+30-team sample (seed 2026).
 """
 
 from __future__ import annotations
@@ -30,7 +35,8 @@ import time
 import mujoco
 import numpy as np
 
-from taut.physics import _tol
+from taut._units import GRAVITY
+from taut.physics import _run, _tol
 from taut.physics._mesh import sheet_mesh, sheet_mesh_spacing
 from taut.physics._statics import model_pull
 from taut.physics.sheet import _sliding, _tied_run
@@ -67,11 +73,12 @@ def row(team: SheetTeam, R: np.ndarray, name: str, want: tuple[int, ...], mesh: 
     sim, outcome = _tied_run(sheet, R, z, m, radius, corner_tendons=True, mass=mass)
     read = _sliding(sim, mass)
     wall = time.perf_counter() - t0
+    force = float(np.linalg.norm(_run._force_pull(sim))) / (mass * GRAVITY)
     for _ in range(int(round(extra / sim.model.opt.timestep))):
         mujoco.mj_step(sim.model, sim.data)
-    later = _sliding(sim, mass)
-    return (f"| {name} | {label(want)} | {eq.kind} | {model:.3f} | {mesh} | {m.spacing:.0f} "
-            f"| {outcome} | {read:.3f} | {later:.3f} | {wall:.1f} |")
+    later = float(np.linalg.norm(_run._force_pull(sim))) / (mass * GRAVITY)
+    return (f"| {name} | {label(want)} | {eq.kind} | {model:.2e} | {mesh} | {m.spacing:.0f} "
+            f"| {outcome} | {read:.2e} | {force:.3f} | {later:.3f} | {wall:.1f} |")
 
 
 def main() -> None:
@@ -87,8 +94,8 @@ def main() -> None:
              for t, c in (s.split(":") for s in a.states)]
     teams = sample(a.seed, max(t for t, _ in picks) + 1)
     print("| team | state | taut says | taut's pull / mg | mesh | spacing [mm] | tied run "
-          f"| pull / mg (check) | pull / mg (+{a.extra:g} s) | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|", flush=True)
+          f"| pull / mg (check) | force pull / mg | force pull (+{a.extra:g} s) | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for t, want in picks:
         team, R = teams[t]
         for mesh in (int(s) for s in a.meshes.split(",")):

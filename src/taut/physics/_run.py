@@ -7,7 +7,7 @@ import numpy as np
 from .._units import GRAVITY
 from . import _tol
 from ._sheet_model import SheetSim
-from ._statics import least_pull
+from ._statics import least_pull, lowest_point_load
 from ._surface import surface_below
 
 __all__ = ["ramp", "settle_phase", "ball_position", "node_positions", "release",
@@ -193,25 +193,80 @@ def _contact_tendons(sim: SheetSim) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
 def sliding_force(sim: SheetSim) -> np.ndarray:
-    r"""Least net pull of the sheet's tendons on the contact node resolved in the flat
-    sheet, :math:`\sum_j T_j (\mathbf{v}_j - \mathbf{v}_o) / |\mathbf{v}_j - \mathbf{v}_o|`,
-    N, shape (2,), over the tendon forces that hold the node as MuJoCo's solver found.
+    r"""Least net pull on the tied contact node resolved in the flat sheet,
+    :math:`\sum_j T_j (\mathbf{v}_j - \mathbf{v}_o) / |\mathbf{v}_j - \mathbf{v}_o|`,
+    N, shape (2,).
 
     A frictionless object at the contact point is in equilibrium on the sheet only when
     this vanishes: with taut's weights it is :math:`(mg/d) \sum_i w_i (\mathbf{v}_i -
     \mathbf{v}_o) = 0` (docs/sheet_kinematics.md §3); a non-zero value means the sheet
     slides under the object.
 
-    With four or more taut straight tendons from the contact node to held corners (a
-    state with four or more taut cables), the point load is statically indeterminate:
-    the corner tensions :math:`T_J` that balance it form a family :math:`T_J + N s \ge 0`
-    (:math:`N` spans the null space of their unit directions in space, read from the
-    simulated positions), and which member the solver returns is set by the soft
-    limits' compliance, not by the object. The object is held when *some* member pulls
-    it nowhere, so the pull returned is the least over the family (non-negative least
-    squares, :func:`taut.physics._statics.least_pull`). With three or fewer the family is
-    the measured forces alone.
+    With a straight tendon from the contact node to every corner (``corner_tendons``),
+    it is the pull of the rigid taut cables the simulation found
+    (:func:`_taut_cable_pull`): the corner tendons at their limit, with the node at the
+    lowest point they let it hang. MuJoCo's soft limits stretch each tendon by an amount
+    that grows with its force (0.2-0.5 mm on the 1 m simulated sheet), which moves the node
+    0.4-2 mm (scenario) off the point where those cables hang; at that point a stable
+    state's cables pull sideways with up to 0.05 of the weight, a floor that does not
+    fall with the mesh (it is set by the limits' softness, in metres) and that hid
+    non-equilibria pulled by 0.001-0.04 (issue 31). Moved back onto the cables, stable
+    states read below 1e-12 and those non-equilibria their model pull
+    (examples/physics/README.md, "Hold resolution").
+
+    Otherwise, or when those cables cannot carry the weight with non-negative tensions
+    (other tendons at the node carry part of it), it is the pull of the tendon forces
+    MuJoCo's solver found (:func:`_force_pull`).
     """
+    pull = _taut_cable_pull(sim)
+    return _force_pull(sim) if pull is None else pull
+
+
+def _taut_cable_pull(sim: SheetSim) -> np.ndarray | None:
+    """Least pull (N, (2,)) on the contact node of the corner tendons the simulation has
+    at their limit, read as rigid cables: the lowest point where the node can hang on
+    them (:func:`lowest_point_load` from the node's simulated position, over those
+    cables only), and the tensions of the ones taut there (within ``TAUT_LENGTH``) that
+    carry the object's weight with the least sideways pull (:func:`least_pull`). None
+    without a tendon from the node to every corner, with none at its limit, or when they
+    cannot carry the weight."""
+    k = sim.mesh.contact
+    corners = sim.mesh.corners
+    ends = sim.tendon_pairs[(sim.tendon_pairs == k).any(axis=1)].ravel()
+    if k in corners or not np.isin(corners, ends).all():
+        return None
+    _, other, _ = _contact_tendons(sim)
+    at = other[np.isin(other, corners)]
+    if len(at) == 0:
+        return None
+    anchors = np.asarray(sim.data.mocap_pos[sim.corner_mocap])[
+        [int(np.flatnonzero(corners == o)[0]) for o in at]]
+    plan = sim.mesh.nodes * sim.scale
+    p = lowest_point_load(plan[at], anchors[:, :2], float(anchors[0, 2]), plan[k],
+                          node_positions(sim)[k])
+    flat = plan[at] - plan[k]
+    rest = np.linalg.norm(flat, axis=1)
+    space = anchors - p
+    length = np.linalg.norm(space, axis=1)
+    taut = length >= rest * (1 - _tol.TAUT_LENGTH)
+    if not taut.any():
+        return None
+    pull, residual = least_pull(np.zeros(2), flat[taut] / rest[taut, None],
+                                space[taut] / length[taut, None], np.array([0.0, 0.0, 1.0]))
+    return None if residual > _tol.BALANCE_SLACK else pull * sim.ball_mass * GRAVITY
+
+
+def _force_pull(sim: SheetSim) -> np.ndarray:
+    r"""Least pull (N, (2,)) of the tendon forces MuJoCo's solver found at the contact node.
+
+    With four or more taut straight tendons from the contact node to held corners, the
+    point load is statically indeterminate: the corner tensions :math:`T_J` that balance
+    it form a family :math:`T_J + N s \ge 0` (:math:`N` spans the null space of their
+    unit directions in space, read from the simulated positions), and which member the
+    solver returns is set by the soft limits' compliance, not by the object. The object
+    is held when *some* member pulls it nowhere, so the pull returned is the least over
+    the family (:func:`least_pull`). With three or fewer the family is the measured
+    forces alone."""
     k = sim.mesh.contact
     force, other, _ = _contact_tendons(sim)
     u = sim.mesh.nodes[other] - sim.mesh.nodes[k]

@@ -98,10 +98,13 @@ class StateCheck(CompactRepr):
         on the tied contact node, resolved in the flat sheet, is at most ``hold_tolerance``
         times the object's weight (a frictionless object is pulled sideways otherwise).
     sliding : float
-        That net pull divided by the object's weight (0 at an exact equilibrium). At a
-        state with four or more taut cables the point load is statically indeterminate
-        and this is the least pull over the tensions that hold it (see
-        :func:`taut.physics._run.sliding_force`).
+        That net pull divided by the object's weight (0 at an exact equilibrium). With
+        corner tendons (the default) it is the pull of the corner tendons the tied
+        simulation has taut, read as rigid cables at the lowest point they let the object
+        hang (MuJoCo's own tendon forces, from soft limits, pull stable states sideways by
+        up to 0.05 of the weight at any mesh); at a state with four or more taut cables
+        the point load is statically indeterminate and this is the least pull over the
+        tensions that hold it (see :func:`taut.physics._run.sliding_force`).
     predicted_sliding : float
         The least sideways pull taut's own model exerts on the object there, as a
         fraction of its weight (0 at an equilibrium; ``inf`` when the taut cables cannot
@@ -109,11 +112,12 @@ class StateCheck(CompactRepr):
     resolved : bool
         The held verdict can tell taut's verdict apart: false for a state that is not an
         equilibrium but whose model pull is at most ``hold_tolerance`` (it lies within the
-        check's resolution of an equilibrium, usually a stable state a fraction of a
-        millimetre away), where held or not held is not evidence either way. A finer mesh
-        does not resolve such states: the stable states' pull, which sets the
-        resolution, does not fall with the spacing (measured to mesh 28,
-        examples/physics/README.md).
+        check's resolution of an equilibrium), where held or not held is not evidence
+        either way. With the default tolerance and corner tendons (``HOLD_FRACTION`` =
+        1e-4, stable states reading below 1e-12) every non-equilibrium of issue 31's
+        30-team sample is resolved (smallest model pull 0.001); with
+        ``corner_tendons=False`` (``FORCE_HOLD_FRACTION`` = 0.05) those pulled by 0.001-0.04
+        are not.
     difference : ndarray, shape (3,)
         ``settled - predicted`` (ball radius accounted for), scenario units (NaN when the
         run failed).
@@ -125,8 +129,9 @@ class StateCheck(CompactRepr):
     agrees : bool
         ``held`` for a stable state, not held for a non-equilibrium (saddles and
         unresolved states: always).
-        Read from the tied run: it stands when only the release failed, not when the
-        tied run itself did not settle (``message`` says which).
+        Read from the tied run: it stands when only the release failed; when the tied
+        run itself did not settle, the pull of a moving sheet is no verdict and this is
+        true (``status`` and ``message`` say the run failed).
     time : float
         Wall-clock seconds spent on this state (build and simulation).
     reached : tuple of int or None
@@ -413,7 +418,8 @@ def _replay_state(sheet: Sheet, R: np.ndarray, z: float, eq: Equilibrium, div: i
     held = sliding <= tol
     kind = str(eq.kind)
     resolved = kind != "not_equilibrium" or model > tol
-    agrees = kind == "saddle" or not resolved or held == (kind == "stable")
+    agrees = (kind == "saddle" or not resolved or tied_run != "settled"
+              or held == (kind == "stable"))
     status, message = _run_status(_label(tuple(eq.taut)), tied_run, outcome, t_rel)
     ok = status == "ok"
     if ok:
@@ -494,7 +500,9 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     hold_tolerance : float, optional
         The object counts as held when the sheet's net sideways pull on the tied object is
         at most this fraction of its weight (dimensionless; default ``HOLD_FRACTION`` =
-        0.05).
+        1e-4 with corner tendons, whose taut set is read as rigid cables, and
+        ``FORCE_HOLD_FRACTION`` = 0.05 without them, where MuJoCo's soft tendon forces are
+        read; see :func:`taut.physics._run.sliding_force`).
     corner_tendons : bool
         Add a tendon from every node to every held corner (makes the tied point load
         nearly exact; see the README's table).
@@ -510,8 +518,8 @@ def replay_equilibria(team: SheetTeam, formation: object, *, mesh: int = DEFAULT
     R, div, radius = _check_inputs(team, formation, mesh, ball,
                                    corner_tendons=corner_tendons)
     sheet, z = team.sheet, team.hold_height
-    tol = _tol.HOLD_FRACTION if hold_tolerance is None else as_positive(
-        hold_tolerance, "hold_tolerance")
+    default = _tol.HOLD_FRACTION if corner_tendons else _tol.FORCE_HOLD_FRACTION
+    tol = default if hold_tolerance is None else as_positive(hold_tolerance, "hold_tolerance")
     fk = forward_kinematics(team, R)
     states = []
     for k, eq in enumerate(fk.equilibria):
