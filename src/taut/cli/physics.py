@@ -30,7 +30,7 @@ def format_check(check: Any, *, name: str | None, units: str | None) -> str:
         held = "held" if s.held else "not held"
         rows.append(("{" + ",".join(str(i + 1) for i in s.taut) + "}",
                      s.kind.replace("_", " "), held if s.resolved else f"{held} (unresolved)",
-                     f"{s.sliding:.3f}", f"{s.predicted_sliding:.3f}",
+                     f"{s.sliding:.2g}", f"{s.predicted_sliding:.2g}",
                      ", ".join(f"{v:+.1f}" for v in s.tied_difference),
                      released, "yes" if s.agrees else "NO", f"{s.time:.1f}"))
     widths = [max(len(r[c]) for r in rows) for c in range(len(head))]

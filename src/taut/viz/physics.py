@@ -63,7 +63,7 @@ def plot_equilibria_check(check: EquilibriaCheck, formation: np.ndarray, hold_he
         label = "{" + ",".join(str(i + 1) for i in s.taut) + "}"
         verdict = ("held" if s.held else "not held") + ("" if s.resolved else " (unresolved)")
         ax.set_title(f"{label} taut: {s.kind.replace('_', ' ')}; physics: {verdict}\n"
-                     f"tied dz = {s.tied_difference[2]:+.1f}{u}, pull {s.sliding:.2f} mg\n"
+                     f"tied dz = {s.tied_difference[2]:+.1f}{u}, pull {s.sliding:.2g} mg\n"
                      f"{released}", fontsize=8, color="k" if s.success else "tab:red")
         ax.tick_params(labelsize=6)
     if title:
