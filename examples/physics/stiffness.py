@@ -5,7 +5,7 @@ Usage::
 
     python examples/physics/stiffness.py [--steps 0.004,0.002,0.001,0.0005]
                                          [--dmin 0.99,0.9999] [--mass fixed|per-dt2]
-                                         [--mesh 10] [--seed 2026]
+                                         [--mesh 10] [--seed 2026] [--extra 1]
                                          [--states 10:2,5,6 13:1,5,7,8 ...]
 
 Draws issue 31's random sample with ``--seed`` as ``hold_resolution.py`` does and runs,
@@ -25,10 +25,13 @@ stretch falls like the step squared. The node masses are gravity-compensated, so
 neither changes the statics.
 
 Prints one Markdown row per state and setting: taut's pull (fraction of the weight,
-``model_pull``), the check's rigid reading (``_taut_cable_pull``), MuJoCo's force
-reading (``_force_pull``), their difference, the largest stretch of the contact node's
-corner tendons at their limit (mm, scenario units), the tied run's outcome and its wall
-time (mesh, build, ramp, settle; s). The module constants are patched for the run only.
+``model_pull``); the check's rigid reading (``_taut_cable_pull``) and MuJoCo's force
+reading (``_force_pull``) where the check reads them (the ball slower than
+``TIED_SETTLE_SPEED``), then both again after ``--extra`` more simulated seconds, with
+their difference and the largest stretch of the contact node's corner tendons at their
+limit there (mm, scenario units: the sheet's own unit); the tied run's outcome and its
+wall time as the check does it (mesh, build, ramp, settle; s) and with the extra
+seconds. The module constants are patched for the run only.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ import argparse
 import time
 from functools import partial
 
+import mujoco
 import numpy as np
 
 from hold_resolution import label, sample
@@ -62,8 +66,17 @@ def corner_stretch(sim: SheetSim) -> float:
     return float(over.max()) / sim.scale
 
 
+def pulls(sim: SheetSim) -> tuple[np.ndarray | None, np.ndarray]:
+    """The rigid reading (None where the check falls back) and the force reading, N."""
+    return _run._taut_cable_pull(sim), _run._force_pull(sim)
+
+
+def fmt(pull: np.ndarray | None, weight: float) -> str:
+    return "-" if pull is None else f"{np.linalg.norm(pull) / weight:.2e}"
+
+
 def row(team: SheetTeam, R: np.ndarray, name: str, want: tuple[int, ...], mesh: int,
-        dt: float, dmin: float) -> str:
+        dt: float, dmin: float, extra: float) -> str:
     eq = next((e for e in forward_kinematics(team, R).equilibria if tuple(e.taut) == want),
               None)
     if eq is None:
@@ -79,13 +92,16 @@ def row(team: SheetTeam, R: np.ndarray, name: str, want: tuple[int, ...], mesh: 
     sim, outcome = sheet_check._tied_run(sheet, R, z, m, radius, corner_tendons=True,
                                          mass=mass)
     wall = time.perf_counter() - t0
-    rigid = _run._taut_cable_pull(sim)
-    force = _run._force_pull(sim)
-    rigid_s = "-" if rigid is None else f"{np.linalg.norm(rigid) / weight:.2e}"
-    diff = ("-" if rigid is None else f"{np.linalg.norm(force - rigid) / weight:.2e}")
+    rigid0, force0 = pulls(sim)
+    for _ in range(int(round(extra / sim.model.opt.timestep))):
+        mujoco.mj_step(sim.model, sim.data)
+    rigid, force = pulls(sim)
+    total = time.perf_counter() - t0
+    diff = None if rigid is None else force - rigid
     return (f"| {name} | {label(want)} | {eq.kind} | {model:.2e} | {dt * 1e3:g} | {dmin:g} "
-            f"| {rigid_s} | {np.linalg.norm(force) / weight:.2e} | {diff} "
-            f"| {corner_stretch(sim):.3g} | {outcome} | {wall:.1f} |")
+            f"| {fmt(rigid0, weight)} | {fmt(force0, weight)} | {fmt(rigid, weight)} "
+            f"| {fmt(force, weight)} | {fmt(diff, weight)} | {corner_stretch(sim):.2g} "
+            f"| {outcome} | {wall:.1f} | {total:.1f} |")
 
 
 def main() -> None:
@@ -98,16 +114,20 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=2026)
     ap.add_argument("--states", nargs="+", default=DEFAULT_STATES.split(),
                     help="team:cables, 0-based team index, 1-based robot numbers")
+    ap.add_argument("--extra", type=float, default=1.0,
+                    help="simulated seconds after the check's reading, s")
     a = ap.parse_args()
     picks = [(int(t), tuple(sorted(int(i) - 1 for i in c.split(","))))
              for t, c in (s.split(":") for s in a.states)]
     teams = sample(a.seed, max(t for t, _ in picks) + 1)
     saved = (sheet_check.build_sheet_sim, _tol.SOLREF, _tol.SOLIMP, _tol.NODE_MASS_PER_DT2)
     build, solref, solimp, per_dt2 = saved
+    later = f"+{a.extra:g} s"
     print("| team | state | taut says | taut's pull / mg | step [ms] | dmin "
-          "| rigid pull / mg (check) | force pull / mg | |force - rigid| / mg "
-          "| corner stretch [mm] | tied run | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
+          "| rigid pull / mg (check) | force pull / mg | "
+          f"rigid ({later}) | force ({later}) | |force - rigid| ({later}) "
+          f"| corner stretch [mm] ({later}) | tied run | wall s | wall s ({later}) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     try:
         for t, want in picks:
             team, R = teams[t]
@@ -118,7 +138,7 @@ def main() -> None:
                     _tol.SOLIMP = (dmin, *solimp[1:])
                     _tol.NODE_MASS_PER_DT2 = (per_dt2 * (_tol.TIMESTEP / dt) ** 2
                                               if a.mass == "fixed" else per_dt2)
-                    print(row(team, R, str(t), want, a.mesh, dt, dmin), flush=True)
+                    print(row(team, R, str(t), want, a.mesh, dt, dmin, a.extra), flush=True)
     finally:
         (sheet_check.build_sheet_sim, _tol.SOLREF, _tol.SOLIMP,
          _tol.NODE_MASS_PER_DT2) = saved

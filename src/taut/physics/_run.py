@@ -212,7 +212,12 @@ def sliding_force(sim: SheetSim) -> np.ndarray:
     fall with the mesh (it is set by the limits' softness, in metres) and that hid
     non-equilibria pulled by 0.001-0.04 (issue 31). Moved back onto the cables, stable
     states read below 1e-12 and those non-equilibria their model pull
-    (examples/physics/README.md, "Hold resolution").
+    (examples/physics/README.md, "Hold resolution"). The rigid reading is the stiff limit
+    of the force reading: with stiffer limits (SOLIMP ``dmin`` 0.9999, time step 4 to
+    0.5 ms at a fixed node mass) the stretch fell to 1e-4 mm and, at rest, the force
+    reading's difference from the rigid one fell with it, to 2.2e-5 of the weight at the
+    worst stable state of issue 31's sample (0.051 with the defaults; same README,
+    "The rigid reading is the stiff limit of the force reading").
 
     Otherwise, or when those cables cannot carry the weight with non-negative tensions
     (other tendons at the node carry part of it), it is the pull of the tendon forces
