@@ -42,7 +42,9 @@ TIMESTEP = 0.004
 #: Node mass per squared time step, kg/s^2: node mass 3 g at 4 ms for a ball of
 #: ``BALL_MASS``. Kept constant when the step changes so the constraint impedance (set by
 #: mass / dt^2) stays the same; scaled with the ball's mass so the motion does not depend
-#: on the load.
+#: on the load. It also keeps the soft limits' stretch under a given force (set by the
+#: time constant squared over the node mass) when the step changes: halving the step
+#: alone does not stiffen them (examples/physics/stiffness.py).
 NODE_MASS_PER_DT2 = 0.003 / 0.004 ** 2
 #: Damping time constant of the nodes' slide joints, s (light: much slower than a step).
 NODE_DAMPING_TIME = 0.02
