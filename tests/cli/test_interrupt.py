@@ -3,6 +3,7 @@ exit code 130 and the one line ``taut: interrupted`` on stderr, whatever was run
 (numba kernels included), and a sweep keeps the chunks it had written."""
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -16,11 +17,16 @@ ROOT = Path(__file__).parents[2]
 TAUT = Path(sys.executable).with_name("taut")
 
 
-def interrupt(args, ready, cwd=ROOT, limit=60.0):
+def interrupt(args, ready, cwd=ROOT, limit=60.0, after=0.2):
     """Start ``taut args``, wait until stderr shows ``ready`` (a progress line: the
-    command is computing), send SIGINT; returns (exit code, stderr lines)."""
+    command is computing; the first comes ``after`` seconds into the work,
+    ``TAUT_PROGRESS_AFTER_S``, None: the default), send SIGINT; returns (exit code,
+    stderr lines)."""
+    env = dict(os.environ)
+    if after is not None:
+        env["TAUT_PROGRESS_AFTER_S"] = str(after)
     proc = subprocess.Popen([str(TAUT), *args], cwd=cwd, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, env=env)
     lines = []
     deadline = time.monotonic() + limit
     while time.monotonic() < deadline:
@@ -42,7 +48,7 @@ def interrupt(args, ready, cwd=ROOT, limit=60.0):
 
 def test_plan_interrupted_in_compiled_code():
     code, lines = interrupt(["plan", "examples/plan/turned_corridor_5.yaml"],
-                            "taut: plan: working")
+                            "taut: plan: working", after=None)   # 2 s in: the lattice search
     assert code == 130
     assert lines[-1] == "taut: interrupted"
     assert not any("Traceback" in x or "SystemError" in x for x in lines), lines
@@ -109,6 +115,10 @@ def swaying(tmp_path, team, steps):
     return tmp_path / "team.json", tmp_path / "walk.csv"
 
 
+# The slow target (CI runs it; ~2 s of CPU, a process started and run to its progress line):
+# test_plan_interrupted_in_compiled_code keeps an interrupt inside a compiled kernel, and
+# test_simulate_interrupted a sheet command's, in the fast suite.
+@pytest.mark.slow
 def test_fk_exhaustive_interrupted(tmp_path):
     """The paper's Algorithm 1 over every taut set of a 20-robot team (2^20 sets, 11 s of
     CPU): `taut fk` of the largest team answers before its first progress line, this
@@ -161,10 +171,14 @@ def ring_of_bases(k, cables=None):
     # the largest inputs the set budget (taut._validate.MAX_SET_NUMBERS) accepts run for
     # seconds: a 6-DoF fixed ring of 12 cables (16.6 million numbers: ~9 s of CPU, 0.43 GB)
     # and 10 cables on 4 moving bases (28 million: ~5 s of CPU beyond start-up, 0.5 GB)
-    pytest.param(ring_of_cables(12), ["wrench-set"], id="wrench-set"),
+    # Both in the slow target (CI runs them; ~3 s of CPU each): the fast suite keeps a cable
+    # robot command interrupted in its solver loop through
+    # test_cable_robot_commands_interrupted[cdpr workspace] and
+    # test_cable_robot_planners_interrupted[cdpr deploy].
+    pytest.param(ring_of_cables(12), ["wrench-set"], id="wrench-set", marks=pytest.mark.slow),
     pytest.param(ring_of_bases(4, [3, 3, 2, 2]),
                  ["twist-set", *(f"--moving=base{i}" for i in range(1, 5))], id="twist-set",
-                 marks=pytest.mark.slow),     # the slow target; wrench-set stays in the fast
+                 marks=pytest.mark.slow),
 ])
 def test_cable_robot_pose_commands_interrupted(tmp_path, model, args):
     """The one-pose analyses, on models whose size makes them take seconds."""
@@ -326,26 +340,44 @@ def test_an_interrupt_inside_llvmlite_is_raised_again_outside(monkeypatch):
     """Python drops an exception raised in a ctypes callback (llvmlite's object-cache
     notification, while numba compiles) and prints 'Exception ignored' with a traceback
     (seen in fresh-clone CI: Ctrl-C while `cdpr mission` compiled a kernel): there the
-    handler re-arms a 50 ms timer instead; anywhere else it raises at once."""
+    handler returns and its timer raises the interrupt 50 ms later, outside; anywhere else
+    it raises at once. Once raised, the timer raises it again only while the command
+    computes (a swallowed interrupt), never outside ``working``."""
     from taut import cli
+    from taut.cli import _progress
     armed = []
-    monkeypatch.setattr(signal, "setitimer", lambda which, seconds: armed.append(seconds))
+    monkeypatch.setattr(signal, "setitimer", lambda which, *times: armed.append(times))
     ns: dict = {}
-    exec(compile("def notify(handler):\n    import sys\n    handler(2, sys._getframe())\n",
+    exec(compile("def notify(handler, signum):\n    import sys\n"
+                 "    handler(signum, sys._getframe())\n",
                  "/site-packages/llvmlite/binding/executionengine.py", "exec"), ns)
     try:
         cli._interrupt.clear()
+        cli._raised.clear()
         try:
-            ns["notify"](cli._on_sigint)              # returns: nothing raised in there
+            ns["notify"](cli._on_sigint, signal.SIGINT)   # returns: nothing raised in there
+            ns["notify"](cli._on_sigint, signal.SIGALRM)  # the timer, still in there
         except KeyboardInterrupt:
             pytest.fail("KeyboardInterrupt raised inside the ctypes callback")
-        assert armed == [0.05] and cli._interrupt.is_set()
-        cli._interrupt.clear()
+        assert armed == [(0.05, cli.REPEAT_INTERRUPT_S)] and cli._interrupt.is_set()
+        with pytest.raises(KeyboardInterrupt):          # the timer, outside: raised
+            cli._on_sigint(signal.SIGALRM, sys._getframe())
+        cli._on_sigint(signal.SIGALRM, sys._getframe())  # raised once; not computing
+        monkeypatch.setattr(_progress, "_open", [1])     # inside `working`: again
         with pytest.raises(KeyboardInterrupt):
+            cli._on_sigint(signal.SIGALRM, sys._getframe())
+        try:
+            raise ValueError("cleanup on the way out")
+        except ValueError:                               # an exception being handled
+            cli._on_sigint(signal.SIGALRM, sys._getframe())
+        cli._interrupt.clear()
+        cli._raised.clear()
+        with pytest.raises(KeyboardInterrupt):           # a plain frame: at once
             cli._on_sigint(signal.SIGINT, sys._getframe())
-        assert armed == [0.05]
+        assert len(armed) == 2
     finally:
         cli._interrupt.clear()
+        cli._raised.clear()
 
 
 @pytest.mark.parametrize("route", ["typer-exit-130", "outside-typer", "swallowed"])
@@ -361,8 +393,8 @@ def test_an_interrupt_is_reported_in_one_line_whatever_catches_it(monkeypatch, c
     timers: list[float] = []
     real_setitimer = signal.setitimer
     monkeypatch.setattr(signal, "setitimer",
-                        lambda which, seconds: timers.append(seconds) or real_setitimer(
-                            which, seconds))
+                        lambda which, *times: timers.append(times[0]) or real_setitimer(
+                            which, *times))
 
     def command(argv):
         cli._interrupt.set()                     # what _on_sigint does first
@@ -384,3 +416,38 @@ def test_an_interrupt_is_reported_in_one_line_whatever_catches_it(monkeypatch, c
     assert cli.main(["fk", "x.yaml"]) == cli.EXIT_INTERRUPTED
     assert capsys.readouterr().err.splitlines() == ["taut: interrupted"]
     assert timers[-1:] == [0]                    # any deferred interrupt cancelled
+
+
+def test_an_interrupt_a_library_swallows_is_raised_again(tmp_path, monkeypatch):
+    """A library that catches the KeyboardInterrupt (pyarrow's lazy import of pandas does)
+    does not make the command run on: the interrupt is raised again within
+    ``REPEAT_INTERRUPT_S`` while the command computes, and the figure is not written."""
+    pa = pytest.importorskip("pyarrow", reason="needs the sweep extra")
+    import pyarrow.parquet as pq
+    import taut.cli.sweep as sweep_cli
+    from taut.cli import REPEAT_INTERRUPT_S, main
+
+    pq.write_table(pa.table({"point": np.arange(3), "scale": [0.5, 0.6, 0.7],
+                             "share": [0.1, 0.2, 0.3]}), tmp_path / "results.parquet")
+    seen = {}
+
+    def swallowing_plot(folder, x, y, value, target, meta):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except BaseException as exc:               # what a careless library does
+            seen["swallowed"] = type(exc).__name__
+        t0 = time.monotonic()
+        try:
+            while time.monotonic() - t0 < 10:      # computing on, for up to 10 s
+                sum(range(1000))
+        finally:
+            seen["computed_s"] = time.monotonic() - t0
+        target.write_text("a figure")
+
+    monkeypatch.setattr(sweep_cli, "_plot", swallowing_plot)
+    code = main(["sweep", "plot", str(tmp_path), "--x", "scale", "--value", "share"])
+    assert code == 130
+    assert seen["swallowed"] == "KeyboardInterrupt"
+    assert seen["computed_s"] < REPEAT_INTERRUPT_S + 0.5
+    assert not (tmp_path / "share.png").exists()

@@ -233,6 +233,24 @@ def test_progress_lines_when_not_a_terminal(capsys, monkeypatch):
     assert capsys.readouterr().err == ""                      # short runs stay silent
 
 
+@pytest.mark.parametrize("value", ["soon", "-1", "nan", "inf"])
+def test_a_bad_progress_delay_is_one_line(capsys, monkeypatch, value):
+    """TAUT_PROGRESS_AFTER_S is an input like any other: refused in one line, exit 2."""
+    monkeypatch.setenv("TAUT_PROGRESS_AFTER_S", value)
+    assert main(["fk", str(ROOT / "examples/sheet/example1.yaml")]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("taut: error: TAUT_PROGRESS_AFTER_S: ")
+
+
+def test_the_progress_delay_sets_the_first_line(capsys, monkeypatch):
+    import time
+    from taut.cli import _progress
+    monkeypatch.setenv("TAUT_PROGRESS_AFTER_S", "0")
+    with _progress.working("demo"):
+        time.sleep(0.2)
+    assert capsys.readouterr().err.startswith("taut: demo: working, 0 s")
+
+
 # --- 5. warnings never leak ----------------------------------------------------------------
 
 def test_numeric_warnings_do_not_leak_before_the_error(capsys, monkeypatch):

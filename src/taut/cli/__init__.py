@@ -34,6 +34,7 @@ from typer.exceptions import TyperException
 
 from .. import __version__
 from ..errors import EXTRAS, MissingExtraError, TautError
+from ._progress import computing
 
 #: The root command's settings.
 _APP_OPTIONS: dict[str, Any] = dict(
@@ -109,6 +110,15 @@ EXIT_INTERRUPTED = 130
 _interrupt = threading.Event()
 
 
+#: After a Ctrl-C, the interrupt is raised again this often (s) while the command computes
+#: (inside :func:`taut.cli._progress.working`) until it has stopped: a library may swallow
+#: a KeyboardInterrupt (pyarrow's lazy import of pandas does, so `taut sweep plot` drew and
+#: wrote its figure for 4 s after Ctrl-C).
+REPEAT_INTERRUPT_S = 0.25
+#: Set once the interrupt has been raised (it may have been swallowed since).
+_raised = threading.Event()
+
+
 def _on_sigint(signum: int, frame: Any) -> None:
     """First Ctrl-C: note it and raise KeyboardInterrupt at the next Python step (between
     kernel calls); a second one: leave at once.
@@ -116,19 +126,26 @@ def _on_sigint(signum: int, frame: Any) -> None:
     Python ignores (prints and drops) an exception raised inside a finalizer or a ctypes
     callback, which numba and llvmlite run while compiling (llvmlite's object-cache
     notification is a ctypes callback); there the interrupt is raised again 50 ms later
-    (SIGALRM), outside it."""
-    if signum == signal.SIGINT and _interrupt.is_set():
-        os.write(2, b"taut: interrupted\n")
-        os._exit(EXIT_INTERRUPTED)
-    _interrupt.set()
+    (SIGALRM), outside it. After that it is raised again every ``REPEAT_INTERRUPT_S`` while
+    the command computes, unless an exception is being handled (cleanup on the way out:
+    ``finally`` blocks, context managers) or the interrupt was reported."""
+    if signum == signal.SIGINT:
+        if _interrupt.is_set():
+            os.write(2, b"taut: interrupted\n")
+            os._exit(EXIT_INTERRUPTED)
+        _interrupt.set()
+        if hasattr(signal, "setitimer"):
+            signal.setitimer(signal.ITIMER_REAL, 0.05, REPEAT_INTERRUPT_S)
+    elif (_reported.is_set() or sys.exc_info()[0] is not None
+          or (_raised.is_set() and not computing())):
+        return
     depth = 0
     while frame is not None and depth < 64:
         code = frame.f_code
-        if ((code.co_name == "__del__" or "llvmlite" in code.co_filename)
-                and hasattr(signal, "setitimer")):
-            signal.setitimer(signal.ITIMER_REAL, 0.05)
-            return
+        if code.co_name == "__del__" or "llvmlite" in code.co_filename:
+            return                                   # the timer raises it again
         frame, depth = frame.f_back, depth + 1
+    _raised.set()
     raise KeyboardInterrupt
 
 
@@ -205,6 +222,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     _interrupt.clear()
     _reported.clear()
+    _raised.clear()
     from ._paths import set_command_line
     set_command_line(sys.argv[1:] if argv is None else list(argv))
     installed = threading.current_thread() is threading.main_thread()

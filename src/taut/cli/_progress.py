@@ -2,28 +2,61 @@
 
 On a terminal: a transient rich spinner with the elapsed time (or a bar when the analysis
 reports steps). Elsewhere (pipes, CI logs): one plain line when the work has taken 2 s and
-then one every 10 s, so a long run is never silent and a short one prints nothing.
+then one every 10 s, so a long run is never silent and a short one prints nothing. The
+environment variable ``TAUT_PROGRESS_AFTER_S`` sets when the first line comes (s; e.g. 0
+for a log that should show every run).
 """
 
 from __future__ import annotations
 
+import math
+import os
 import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["working", "FIRST_NOTICE_S", "NOTICE_EVERY_S"]
+__all__ = ["working", "computing", "FIRST_NOTICE_S", "NOTICE_EVERY_S", "first_notice_s"]
 
-#: A run shorter than this prints no progress at all, s.
+#: A run shorter than this prints no progress at all, s (default of
+#: ``TAUT_PROGRESS_AFTER_S``).
 FIRST_NOTICE_S = 2.0
 #: Interval between the plain progress lines when stderr is not a terminal, s.
 NOTICE_EVERY_S = 10.0
 
 
-def _plain(label: str, stop: threading.Event, state: dict[str, str]) -> None:
+#: How many :func:`working` blocks are open (the main thread's command computing).
+_open = [0]
+
+
+def computing() -> bool:
+    """Whether a command is inside :func:`working` (its computation, where a swallowed
+    Ctrl-C is raised again: :func:`taut.cli._on_sigint`)."""
+    return _open[0] > 0
+
+
+def first_notice_s() -> float:
+    """Seconds before the first plain progress line: ``TAUT_PROGRESS_AFTER_S`` from the
+    environment (a finite number >= 0) or :data:`FIRST_NOTICE_S`."""
+    from ..errors import InvalidInputError
+
+    raw = os.environ.get("TAUT_PROGRESS_AFTER_S", "").strip()
+    if not raw:
+        return FIRST_NOTICE_S
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise InvalidInputError("TAUT_PROGRESS_AFTER_S",
+                                f"must be a number of seconds >= 0, got {raw!r}")
+    return value
+
+
+def _plain(label: str, stop: threading.Event, state: dict[str, str], first: float) -> None:
     start = time.monotonic()
-    wait = FIRST_NOTICE_S
+    wait = first
     while not stop.wait(wait):
         detail = state.get("detail", "")
         print(f"taut: {label}: working, {time.monotonic() - start:.0f} s"
@@ -41,6 +74,17 @@ def working(label: str) -> Iterator[Callable[[int, int], None]]:
     >>> with working("demo") as update:
     ...     update(1, 2)
     """
+    _open[0] += 1
+    try:
+        with _shown(label) as update:
+            yield update
+    finally:
+        _open[0] -= 1
+
+
+@contextmanager
+def _shown(label: str) -> Iterator[Callable[[int, int], None]]:
+    """The spinner or the plain lines of :func:`working`."""
     state: dict[str, str] = {}
     if sys.stderr.isatty():
         from rich.progress import (BarColumn, Progress, SpinnerColumn, TextColumn,
@@ -54,12 +98,13 @@ def working(label: str) -> Iterator[Callable[[int, int], None]]:
 
             yield update
         return
+    first = first_notice_s()
     stop = threading.Event()
 
     def update_plain(done: int, total: int) -> None:
         state["detail"] = f"{done}/{total}"
 
-    thread = threading.Thread(target=_plain, args=(label, stop, state), daemon=True)
+    thread = threading.Thread(target=_plain, args=(label, stop, state, first), daemon=True)
     thread.start()
     try:
         yield update_plain
