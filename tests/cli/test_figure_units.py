@@ -6,6 +6,7 @@ extents, issue 29.5). The wrench-capacity chart says which direction it plots.""
 
 from __future__ import annotations
 
+import functools
 import re
 from pathlib import Path
 
@@ -103,16 +104,25 @@ def test_fk_figure():
     _check(plot_fk(r, units="mm"))
 
 
+@functools.cache
+def _paper_plan(method):
+    """The paper corridor and its plan by ``method``: planned once for this file's plan
+    figures (~0.8 s of CPU a plan), which only read them."""
+    from taut.io import load_plan_scenario
+    from taut.plan import plan
+    sc = load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml")
+    return sc, plan(sc, method=method)
+
+
 def test_plan_top_view_has_metres_on_both_axes(tmp_path):
-    from taut.plan import generate_scenario, plan
+    from taut.plan import generate_scenario
     from taut.viz.plan import plot_plan
     from taut.viz.plan import draw_world
-    sc = generate_scenario(0)
     fig, ax = plt.subplots()
-    draw_world(ax, sc)                  # the top view of plot_plan and animate_plan
+    draw_world(ax, generate_scenario(0))    # the top view of plot_plan and animate_plan
     assert ax.get_xlabel() == "x [m]" and ax.get_ylabel() == "y [m]"
     plt.close(fig)
-    r = plan(sc)                        # crosses both obstacles (the disc baseline fails)
+    sc, r = _paper_plan("se2")          # crosses both obstacles (test_se2.py: paper plan)
     assert r.success, r.message
     fig = _drawn(lambda: plot_plan(sc, r, tmp_path / "p.png"))
     top = fig.axes[0]
@@ -181,11 +191,8 @@ def test_sweep_figure(tmp_path):
 
 @pytest.mark.parametrize("method", ["se2", "algorithm2"])
 def test_plan_figure_shows_sides_only_for_algorithm2_crossings(tmp_path, method):
-    from taut.io import load_plan_scenario
-    from taut.plan import plan
     from taut.viz.plan import plot_plan
-    sc = load_plan_scenario(ROOT / "examples" / "plan" / "paper_corridor.yaml")
-    r = plan(sc, method=method)
+    sc, r = _paper_plan(method)
     assert r.success
     fig = _drawn(lambda: plot_plan(sc, r, tmp_path / "p.png"))
     third = fig.axes[2].get_title()

@@ -92,10 +92,18 @@ def test_result_does_not_depend_on_the_time_cap():
         assert np.array_equal(a.robots, b.robots) and np.array_equal(a.times, b.times)
 
 
-def test_exhausted_budget_names_the_samples():
+@pytest.fixture(scope="module")
+def narrow_passage():
+    """A tall cylinder leaving gaps of 0.55 m in the 2 m corridor, planned with 40 samples
+    a run: (scenario, result), shared by the two tests that read this failure (one plan,
+    ~1.6 s of CPU, instead of two)."""
     from taut.plan import Obstacle
     sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
-    r = plan(sc, iterations=40)
+    return sc, plan(sc, iterations=40)
+
+
+def test_exhausted_budget_names_the_samples(narrow_passage):
+    _, r = narrow_passage
     assert not r.success and r.status == "budget_exhausted"
     assert "40 samples per run" in r.message and "in all" in r.message
 
@@ -110,16 +118,14 @@ def test_iterations_must_be_positive():
     assert e.value.field == "time_budget"
 
 
-def test_budget_exhaustion_diagnoses_a_passage_too_narrow():
+def test_budget_exhaustion_diagnoses_a_passage_too_narrow(narrow_passage):
     # Gaps of 0.55 m beside a tall cylinder in a 2 m corridor (perpendicular line: (2 -
     # 0.9) / 2): a robot with its clearance (0.4 m) fits, so nothing is proved, but the
     # triangle team's narrowest formation (the squeezed one included) is wider than that
     # less the clearance, so the message says so, without claiming impossibility.
     import re
-    from taut.plan import Obstacle
     from taut.plan.formations.library import _library, _min_width, _with_squeezed
-    sc = corridor([Obstacle("wall-ish", 0.9, center=[3.0, 0.0], radius=0.45)])
-    r = plan(sc, iterations=40)
+    sc, r = narrow_passage
     assert r.status == "budget_exhausted" and r.certificate is None
     assert r.sheet_margin == 0.01                      # a failure carries the margin used
     m = re.search(r"obstacle 'wall-ish' .*? the widest passage is ([0-9.]+) m, less than "
