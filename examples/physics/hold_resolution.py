@@ -81,6 +81,14 @@ def row(team: SheetTeam, R: np.ndarray, name: str, want: tuple[int, ...], mesh: 
             f"| {outcome} | {read:.2e} | {force:.3f} | {later:.3f} | {wall:.1f} |")
 
 
+def picked(states: list[str], seed: int) -> tuple[list[tuple[int, tuple[int, ...]]], list]:
+    """``team:cables`` arguments as (0-based team, 0-based taut set) and the teams of the
+    sample up to the last one named."""
+    picks = [(int(t), tuple(sorted(int(i) - 1 for i in c.split(","))))
+             for t, c in (s.split(":") for s in states)]
+    return picks, sample(seed, max(t for t, _ in picks) + 1)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--meshes", default="10,14,20")
@@ -90,9 +98,7 @@ def main() -> None:
     ap.add_argument("--extra", type=float, default=2.0,
                     help="simulated seconds after the check's reading, s")
     a = ap.parse_args()
-    picks = [(int(t), tuple(sorted(int(i) - 1 for i in c.split(","))))
-             for t, c in (s.split(":") for s in a.states)]
-    teams = sample(a.seed, max(t for t, _ in picks) + 1)
+    picks, teams = picked(a.states, a.seed)
     print("| team | state | taut says | taut's pull / mg | mesh | spacing [mm] | tied run "
           f"| pull / mg (check) | force pull / mg | force pull (+{a.extra:g} s) | wall s |")
     print("|---|---|---|---|---|---|---|---|---|---|---|", flush=True)

@@ -43,7 +43,7 @@ from functools import partial
 import mujoco
 import numpy as np
 
-from hold_resolution import label, sample
+from hold_resolution import label, picked
 from taut._units import GRAVITY
 from taut.physics import _run, _tol
 from taut.physics import sheet as sheet_check
@@ -117,9 +117,7 @@ def main() -> None:
     ap.add_argument("--extra", type=float, default=1.0,
                     help="simulated seconds after the check's reading, s")
     a = ap.parse_args()
-    picks = [(int(t), tuple(sorted(int(i) - 1 for i in c.split(","))))
-             for t, c in (s.split(":") for s in a.states)]
-    teams = sample(a.seed, max(t for t, _ in picks) + 1)
+    picks, teams = picked(a.states, a.seed)
     saved = (sheet_check.build_sheet_sim, _tol.SOLREF, _tol.SOLIMP, _tol.NODE_MASS_PER_DT2)
     build, solref, solimp, per_dt2 = saved
     later = f"+{a.extra:g} s"
