@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..._jit import jit
-from .small import (INFEASIBLE, append_rows, borrowed, similar_fit, solve_carved, solve_into,
-    work_floats, work_views)
+from .small import (INFEASIBLE, append_rows, borrowed, shaped, similar_fit, solve_carved,
+    solve_into, work_floats, work_views)
 
 __all__ = ["solve_formations_ws", "solve_one", "pack", "out_rows", "decode", "snap_screen_batch",
            "HEADER", "FLAGS_SHIFT", "HAS_STABLE", "HAS_PENDING", "NEAR_COPY", "TORN"]
@@ -140,23 +140,23 @@ def solve_one(R, solver, out):
     for i in range(N):
         out[last, 2 * i] = R[i, 0]
         out[last, 2 * i + 1] = R[i, 1]
-    Rc = out[last, 0:2 * N].reshape(N, 2)
+    Rc = shaped(out[last, 0:2 * N], (N, 2))
     C = int(solver[1])
     g = HEADER
-    Vn = solver[g:g + 2 * N].reshape(N, 2)
-    A = solver[g + 2 * N:g + 4 * N].reshape(N, 2)
-    lim2 = solver[g + 4 * N:g + 4 * N + N * N].reshape(N, N)
+    Vn = shaped(solver[g:g + 2 * N], (N, 2))
+    A = shaped(solver[g + 2 * N:g + 4 * N], (N, 2))
+    lim2 = shaped(solver[g + 4 * N:g + 4 * N + N * N], (N, N))
     h = g + 4 * N + N * N
     ints = solver[h:h + 6 * C].view(np.int64)
-    table = ints[0:5 * C].reshape(C, 5)
+    table = shaped(ints[0:5 * C], (C, 5))
     sizes = ints[5 * C:6 * C]
-    flat = out.reshape(out.size)
+    flat = shaped(out, (out.size,))
     o = C * out.shape[1]
     fw = flat[o:o + work_floats(N, C)]
     o += work_floats(N, C)
     iw = flat[o:o + 2 * C].view(np.int64)
     o += 2 * C
-    taut = flat[o:o + (C * N + 7) // 8].view(np.bool_)[:C * N].reshape(C, N)
+    taut = shaped(flat[o:o + (C * N + 7) // 8].view(np.bool_)[:C * N], (C, N))
     k, stable, pending = solve_into(Rc, Vn, table, sizes, solver[2], solver[3], solver[4],
                                     solver[5], lim2, out, fw, iw, taut)
     if k < 0:
