@@ -1,6 +1,7 @@
 """The compiled projection test (``_kernels.linalg._in_hull``, the FK paper's test that the
 projected object lies in the taut robots' polygon) answers exactly as its ``atan2`` gaps
-do, now that ``_surely_outside`` answers the clear "outside" cases without ``atan2``:
+do, now that ``_surely_outside`` / ``_surely_inside`` answer the clear "outside" /
+"inside" cases without ``atan2``:
 against the ``atan2`` algorithm written out here, on random points and on points placed
 a hair (1e-15 .. 1e-3 of the size) either side of a half turn, where the sure answer must
 step aside."""
@@ -63,8 +64,10 @@ def test_projection_test_answers_as_its_atan2_gaps(seed, m, near, log_eps):
     Rn, taut, px, py = _case(seed, m, near, 10.0 ** log_eps)
     expected = _atan2_gaps(Rn, taut, px, py)
     assert la._in_hull(Rn, taut, 5, px, py, np.empty(5)) == expected
-    if la._surely_outside(Rn, taut, 5, px, py):    # the sure answer is never wrong
+    if la._surely_outside(Rn, taut, 5, px, py):    # the sure answers are never wrong
         assert not expected
+    if la._surely_inside(Rn, taut, 5, px, py):
+        assert expected
 
 
 def test_the_sure_answer_takes_the_clear_cases():
@@ -80,3 +83,22 @@ def test_the_sure_answer_takes_the_clear_cases():
     hair = np.array([True, True, False, False, True])        # pi + 1e-12: atan2 decides
     assert not la._surely_outside(Rn, hair, 5, 0.0, 0.0)
     assert la._in_hull(Rn, hair, 5, 0.0, 0.0, np.empty(5)) == _atan2_gaps(Rn, hair, 0.0, 0.0)
+
+
+def test_the_sure_inside_answer_takes_the_clear_cases():
+    """Inside a triangle of taut robots by more than the margin: answered without
+    ``atan2``; on an edge, a hair inside it, or with fewer than three taut robots: left to
+    ``atan2``."""
+    Rn = np.array([[1.0, 0.0], [-1.0, 1.0], [-1.0, -1.0], [5.0, 5.0], [0.0, 3.0]])
+    three = np.array([True, True, True, False, False])
+    for taut in (three, np.array([False, True, True, False, True])):
+        assert la._surely_inside(Rn, taut, 5, -0.2, 0.1) == bool(taut[0])
+    assert la._in_hull(Rn, three, 5, -0.2, 0.1, np.empty(5))
+    two = np.array([True, True, False, False, False])
+    assert not la._surely_inside(Rn, two, 5, 0.0, 0.0)
+    # The edge (1, 0)-(-1, 1) passes (0, 0.5); the triangle lies below it.
+    for eps, sure in ((0.0, False), (1e-15, False), (-1e-15, False), (1e-3, False),
+                      (-1e-3, True)):
+        px, py = 0.0, 0.5 + eps
+        assert la._surely_inside(Rn, three, 5, px, py) == sure
+        assert la._in_hull(Rn, three, 5, px, py, np.empty(5)) == _atan2_gaps(Rn, three, px, py)

@@ -22,7 +22,7 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     """As ``_small_kernel.solve_formations``: rows (M, width) of every formation of
     ``Rb`` (B, N, 2), their formation index (M,), and the first infeasible formation's
     index (or -1). One workspace for the whole batch; the formations are solved by
-    :func:`_solve_formations`, which returns here only to grow the output."""
+    :func:`_solve_formations`, which returns here only to size or grow the output."""
     B, N = Rb.shape[0], Rb.shape[1]
     C = table.shape[0]
     W = 12 + 3 * N
@@ -30,9 +30,9 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
     fw = np.empty(work_floats(N, C))
     iw = np.empty(2 * C, dtype=np.int64)
     taut = np.empty((C, N), dtype=np.bool_)
-    cap = max(16, 2 * B)
-    rows = np.empty((cap, W))
-    form = np.empty(cap, dtype=np.int64)
+    # No room until the first formation with rows: it sizes the output (below).
+    rows = np.empty((0, W))
+    form = np.empty(0, dtype=np.int64)
     M = 0
     b = 0
     while True:
@@ -40,7 +40,16 @@ def solve_formations_ws(Rb, Vn, table, sizes, scale, vcx, vcy, hold, lim2):
                                     fw, iw, taut, rows, form, M)
         if k <= 0:                                 # done, or formation b infeasible
             return rows[:M], form[:M], (b if k < 0 else -1)
-        rows, form = append_rows(rows, form, M, buf, k, b)    # full: grow
+        if M == 0:
+            # Room for the rest at this formation's k rows each, plus 1/8 (a batch of
+            # similar formations has similar counts; a team with several rest states
+            # per formation then fills its output without regrowing), at least 2 per
+            # formation; a later overflow doubles (append_rows).
+            left = B - b
+            cap = max(16, 2 * left, k * left + left // 8 + 16)
+            rows = np.empty((cap, W))
+            form = np.empty(cap, dtype=np.int64)
+        rows, form = append_rows(rows, form, M, buf, k, b)    # grows when full
         M += k
         b += 1
 

@@ -288,7 +288,8 @@ def _in_hull(Rn, taut, N, px, py, ang):
     """The paper's projection test (``_kernel.in_hull_2d``) for the robots in ``taut``:
     True when the projected object ``(px, py)`` sits on a taut robot, else when no angular
     gap between the taut robots seen from it exceeds pi (``ANGLE_TOL``). The gaps come
-    from ``atan2``, unless :func:`_surely_outside` already answers False."""
+    from ``atan2``, unless :func:`_surely_outside` already answers False or
+    :func:`_surely_inside` True."""
     m = 0
     scale2 = 1.0
     for j in range(N):
@@ -306,6 +307,8 @@ def _in_hull(Rn, taut, N, px, py, ang):
                 return True
     if _surely_outside(Rn, taut, N, px, py):
         return False
+    if _surely_inside(Rn, taut, N, px, py):
+        return True
     for j in range(N):                             # none at the point (above)
         if taut[j]:
             ang[m] = math.atan2(Rn[j, 1] - py, Rn[j, 0] - px)
@@ -353,6 +356,44 @@ def _surely_outside(Rn, taut, N, px, py):
                 break
         if arc:
             return True
+    return False
+
+
+@jit
+def _surely_inside(Rn, taut, N, px, py):
+    """True when ``(px, py)`` (no taut robot at it) lies inside a triangle of three robots
+    in ``taut``, each seen from it turning the same way to the next by a sine above
+    ``_CCW_SIN`` (cross products, no ``atan2``). The three directions then leave no gap
+    above pi - 1e-12 (rounding ~1e-15), and neither do all of them: :func:`_in_hull`'s
+    ``atan2`` gaps would answer True as well (within pi + ``ANGLE_TOL``). False when
+    unsure (then ``atan2`` decides)."""
+    s2 = _CCW_SIN * _CCW_SIN
+    for j in range(N):
+        if not taut[j]:
+            continue
+        ax = Rn[j, 0] - px
+        ay = Rn[j, 1] - py
+        a2 = ax * ax + ay * ay
+        for k in range(j + 1, N):
+            if not taut[k]:
+                continue
+            bx = Rn[k, 0] - px
+            by = Rn[k, 1] - py
+            b2 = bx * bx + by * by
+            ab = ax * by - ay * bx
+            if not ab * ab > s2 * (a2 * b2):
+                continue
+            for m in range(k + 1, N):
+                if not taut[m]:
+                    continue
+                cx = Rn[m, 0] - px
+                cy = Rn[m, 1] - py
+                c2 = cx * cx + cy * cy
+                bc = bx * cy - by * cx
+                ca = cx * ay - cy * ax
+                if ((ab > 0.0) == (bc > 0.0) and (ab > 0.0) == (ca > 0.0)
+                        and bc * bc > s2 * (b2 * c2) and ca * ca > s2 * (c2 * a2)):
+                    return True
     return False
 
 
