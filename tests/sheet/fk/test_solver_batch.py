@@ -115,3 +115,72 @@ def test_batch_kernel_grows_its_output_and_stops_at_a_torn_formation():
     np.testing.assert_array_equal(a[1], b[1])
     whole = bk.solve_formations_ws(np.ascontiguousarray(forms[:30]), *solver._args)
     assert whole[2] == -1 and np.array_equal(whole[0], b[0])
+
+
+
+_FIELDS = ("count", "valid", "taut", "object", "contact", "weights", "tensions", "kind")
+
+
+def _late_team(seed, mass):
+    """A team of 4 and 40 formations jittered by 3 % of the sheet size: 1 to 3 states
+    each (seed 6: all feasible, a stable state in each; seed 4: some torn, some without a
+    stable state)."""
+    rng = np.random.default_rng(seed)
+    sheet, R = random_team(4, rng)
+    hold = 1.5 * sheet.size
+    solver = FKSolver(SheetTeam(sheet, hold, mass=mass) if mass else SheetTeam(sheet, hold))
+    return solver, R + rng.normal(scale=0.03 * sheet.size, size=(40, 4, 2))
+
+
+def _same_late(solver, forms, want):
+    """A fresh batch result built lazily gives ``want``'s fields (read first there) when
+    read after ``success``, and so does its pickled copy."""
+    import pickle
+
+    late = solver.solve_batch(forms)
+    assert callable(late._enum)                    # nothing but the kinds copied yet
+    success = late.success.copy()
+    assert callable(late._enum)
+    for r in (pickle.loads(pickle.dumps(late)), late):
+        for f in _FIELDS + ("success", "status", "message"):
+            if want[f] is None:
+                assert getattr(r, f) is None
+            else:
+                np.testing.assert_array_equal(getattr(r, f), want[f])
+        np.testing.assert_array_equal(r.success, success)
+
+
+@pytest.mark.parametrize("mass", [None, 2.0])
+def test_batch_arrays_read_late_or_pickled_are_the_kernel_rows(mass):
+    """``batch_from_rows`` copies only the kinds out of the kernel rows at once, the other
+    padded arrays when a field first needs them: read first, after ``success`` or after a
+    pickle, they are the rows of each formation in order (padding NaN / False / -1)."""
+    solver, forms = _late_team(6, mass)
+    rows, form = solver._fix_batch(forms, *solver._kernel_batch(forms)[:2])
+    first = solver.solve_batch(forms)
+    want = {f: getattr(first, f) for f in _FIELDS + ("success", "status", "message")}
+    K = want["kind"].shape[1]
+    assert K == 3 and len(set(want["count"].tolist())) == 3 and want["success"].all()
+    for b in range(len(forms)):
+        mine = rows[form == b]
+        c = len(mine)
+        assert want["count"][b] == c
+        np.testing.assert_array_equal(want["kind"][b], np.r_[mine[:, 0], [-1] * (K - c)])
+        np.testing.assert_array_equal(want["valid"][b], np.arange(K) < c)
+        np.testing.assert_array_equal(want["object"][b, :c], mine[:, 2:5])
+        np.testing.assert_array_equal(want["contact"][b, :c], mine[:, 5:7])
+        np.testing.assert_array_equal(want["taut"][b, :c], mine[:, 8:12] > 0.5)
+        np.testing.assert_array_equal(want["weights"][b, :c], mine[:, 12:16])
+        assert np.isnan(want["object"][b, c:]).all() and not want["taut"][b, c:].any()
+    assert (want["tensions"] is None) == (mass is None)
+    _same_late(solver, forms, want)
+
+
+def test_batch_arrays_read_late_with_torn_and_unheld_formations():
+    """As above on a batch with torn formations and formations without a stable state
+    (the direct minimisation's candidates)."""
+    solver, forms = _late_team(4, 2.0)
+    first = solver.solve_batch(forms)
+    want = {f: getattr(first, f) for f in _FIELDS + ("success", "status", "message")}
+    assert not want["success"].all() and not first.feasible.all()
+    _same_late(solver, forms, want)

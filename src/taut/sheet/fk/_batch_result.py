@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Callable
 
 import numpy as np
@@ -10,7 +11,8 @@ from ..._units import GRAVITY
 from .._lifted import KIND_NOT_EQUILIBRIUM, KIND_STABLE
 from .._tol import MERGE_RTOL
 from ..model import Sheet
-from .results import BatchFKResult, _has_kind, _merge_equilibria, _row_states, _write_row
+from .results import (BatchFKResult, _has_kind, _merge_equilibria, _Padded, _row_states,
+                      _write_row)
 
 __all__ = ["padded_batch", "batch_from_rows"]
 
@@ -38,32 +40,45 @@ def padded_batch(sheet: Sheet, formations: np.ndarray, hold_height: float,
     kind : ndarray of int, shape (M,)
         ``KIND_*`` codes.
     """
-    B, N = formations.shape[:2]
-    count = np.bincount(form, minlength=B) if len(form) else np.zeros(B, dtype=np.intp)
-    K = int(count.max()) if B else 0
-    pad = _padder(form, count, B, K)
+    count, pad = _padder(form, formations.shape[0])
+    arrays = (count, pad(np.ones(len(form), dtype=bool), False, bool), pad(taut, False, bool),
+              pad(obj, np.nan), pad(contact, np.nan), pad(weights, 0.0),
+              None if tensions is None else pad(tensions, 0.0), pad(kind, -1, np.int8))
+    return _batch(sheet, formations, hold_height, mass, method, feasible, arrays[3],
+                  arrays[7], arrays)
 
-    valid = pad(np.ones(len(form), dtype=bool), False, bool)
-    kinds = pad(kind, -1, np.int8)
-    ten = None if tensions is None else pad(tensions, 0.0)
-    arrays = (count, valid, pad(taut, False, bool), pad(obj, np.nan), pad(contact, np.nan),
-              pad(weights, 0.0), ten, kinds)
-    if K > 1:
-        _merge_batch(sheet, formations, hold_height, mass, arrays)
+
+def _batch(sheet: Sheet, formations: np.ndarray, hold_height: float, mass: float | None,
+           method: str, feasible: np.ndarray, obj: np.ndarray, kinds: np.ndarray,
+           padded: _Padded | Callable[[], _Padded]) -> BatchFKResult:
+    """The :class:`BatchFKResult` of the padded arrays ``padded`` (:data:`_Padded`), or of
+    a function building them (``batch_from_rows``: built when a field first needs them),
+    whose object points and kinds are ``obj`` (B, K, 3) and ``kinds`` (B, K): coinciding
+    states merged (the arrays built at once for that, as rarely needed), and the direct
+    minimisation's candidates found."""
+    if obj.shape[1] > 1:
+        close = _close_states(obj, MERGE_RTOL * sheet.size)
+        if len(close):
+            if callable(padded):
+                padded = padded()
+            _merge_batch(sheet, formations, hold_height, mass, padded, close)
     # The direct minimisation of the lowest state runs on these when a field needs it.
     missing = np.flatnonzero(feasible & ~_has_kind(kinds, KIND_STABLE))
-    return BatchFKResult(arrays, missing, feasible, sheet, formations, hold_height, mass,
-                         method)
+    return BatchFKResult(padded, kinds, missing, feasible, sheet, formations, hold_height,
+                         mass, method)
 
 
-def _padder(form: np.ndarray, count: np.ndarray, B: int, K: int
-            ) -> Callable[..., np.ndarray]:
-    """``pad(values, fill, dtype=float64)``: the flat per-solution ``values`` (M, ...)
-    placed in fresh padded (B, K, ...) arrays, slot ``j`` of row ``b`` holding formation
+def _padder(form: np.ndarray, B: int
+            ) -> tuple[np.ndarray, Callable[..., np.ndarray]]:
+    """``count`` (B,), the solutions of each of ``B`` formations, and ``pad(values, fill,
+    dtype=float64)``: the flat per-solution ``values`` (M, ...) placed in fresh padded
+    (B, K, ...) arrays (K = ``count.max()``), slot ``j`` of row ``b`` holding formation
     ``b``'s ``j``-th solution. When every formation has ``K`` solutions (``form`` is then
     ``0,..,0, 1,..``: the common case of a batch of similar formations) this is a
     reshaped copy; else one flat index, computed once, places them (a fraction of the cost
     of indexing by (formation, slot) pairs for every array)."""
+    count = np.bincount(form, minlength=B) if len(form) else np.zeros(B, dtype=np.intp)
+    K = int(count.max()) if B else 0
     full = len(form) == B * K
 
     if not full:
@@ -78,16 +93,15 @@ def _padder(form: np.ndarray, count: np.ndarray, B: int, K: int
         out: np.ndarray = np.full((B * K,) + values.shape[1:], fill, dtype=dtype)
         out[flat] = values
         return out.reshape(shape)
-    return pad
+    return count, pad
 
 
 def _merge_batch(sheet: Sheet, formations: np.ndarray, hold_height: float,
-                 mass: float | None, arrays: tuple) -> None:
+                 mass: float | None, arrays: _Padded, close: np.ndarray) -> None:
     """Report coinciding states of each formation once, in place (as
-    :class:`FKResult` does, :mod:`taut.sheet.fk._merge`): one vectorised screen over all
-    formations (:func:`_close_states`), the merge itself only on the (rare) formations
-    that pass it."""
-    for b in _close_states(arrays[3], MERGE_RTOL * sheet.size):
+    :class:`FKResult` does, :mod:`taut.sheet.fk._merge`): the merge itself only on the
+    (rare) formations ``close`` that pass the vectorised screen (:func:`_close_states`)."""
+    for b in close:
         eqs = _row_states(sheet, arrays, int(b))
         merged = _merge_equilibria(eqs, sheet, formations[b], hold_height, mass)
         if len(merged) < len(eqs):
@@ -114,8 +128,28 @@ def batch_from_rows(sheet: Sheet, formations: np.ndarray, hold_height: float,
                     mass: float | None, method: str, feasible: np.ndarray,
                     rows: np.ndarray, form: np.ndarray) -> BatchFKResult:
     """:func:`padded_batch` of compiled-kernel rows (layout of ``_kernels.small``: kind,
-    taut-set size, object, contact, depth, taut mask, weights, lengths, ...)."""
-    N = formations.shape[1]
+    taut-set size, object, contact, depth, taut mask, weights, lengths, ...). Only the
+    kinds are copied out at once (``success`` needs no more) and the object points read
+    by the merge screen (in place when every formation has ``K`` rows); the padded
+    arrays (most of the cost of copying out the rows) when a field first needs them, at
+    once only when some states coincide."""
+    B = formations.shape[0]
+    count, pad = _padder(form, B)
+    kinds = pad(rows[:, 0], -1, np.int8)
+    K = kinds.shape[1]
+    obj = (rows.reshape(B, K, rows.shape[1])[:, :, 2:5] if len(form) == B * K
+           else pad(rows[:, 2:5], np.nan))
+    build = partial(_row_arrays, sheet, mass, rows, form, count, kinds)
+    return _batch(sheet, formations, hold_height, mass, method, feasible, obj, kinds, build)
+
+
+def _row_arrays(sheet: Sheet, mass: float | None, rows: np.ndarray, form: np.ndarray,
+                count: np.ndarray, kinds: np.ndarray) -> _Padded:
+    """The padded arrays (:data:`_Padded`) of kernel ``rows`` of formations ``form``,
+    with their ``count`` and padded ``kinds`` already made (:func:`batch_from_rows`; a
+    module function, so that a result pickles)."""
+    N = sheet.n
+    pad = _padder(form, len(count))[1]
     taut = rows[:, 8:8 + N] > 0.5
     weights = rows[:, 8 + N:8 + 2 * N]
     tensions = None
@@ -124,7 +158,7 @@ def batch_from_rows(sheet: Sheet, formations: np.ndarray, hold_height: float,
         t = weights * (mass * GRAVITY) * lengths_n / rows[:, 7:8]
         # Only equilibria have tensions: elsewhere the "tension" would be a push.
         held = taut & (rows[:, :1] != KIND_NOT_EQUILIBRIUM)
-        tensions = np.where(held, t, np.where(taut, np.nan, 0.0))
-    return padded_batch(sheet, formations, hold_height, mass, method, feasible, form, taut,
-                        rows[:, 2:5], rows[:, 5:7], weights, tensions,
-                        rows[:, 0].astype(np.int8))
+        tensions = pad(np.where(held, t, np.where(taut, np.nan, 0.0)), 0.0)
+    return (count, pad(np.ones(len(form), dtype=bool), False, bool), pad(taut, False, bool),
+            pad(rows[:, 2:5], np.nan), pad(rows[:, 5:7], np.nan), pad(weights, 0.0), tensions,
+            kinds)

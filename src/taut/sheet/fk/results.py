@@ -645,7 +645,8 @@ class BatchFKResult(CompactRepr):
                    "kind", "feasible", "success", "status", "message", "sheet",
                    "formations", "hold_height", "mass", "method")
 
-    _enum: _Padded
+    _enum: _Padded | Callable[[], _Padded]
+    _kind: np.ndarray
     _padded: _Padded | None
     _missing: np.ndarray
     _found: dict[int, tuple[tuple[Equilibrium, ...], bool, str | None]]
@@ -659,13 +660,16 @@ class BatchFKResult(CompactRepr):
     mass: float | None
     method: str
 
-    def __init__(self, padded: _Padded, missing: np.ndarray, feasible: np.ndarray,
-                 sheet: Sheet, formations: np.ndarray, hold_height: float,
-                 mass: float | None, method: str) -> None:
+    def __init__(self, padded: _Padded | Callable[[], _Padded], kind: np.ndarray,
+                 missing: np.ndarray, feasible: np.ndarray, sheet: Sheet,
+                 formations: np.ndarray, hold_height: float, mass: float | None,
+                 method: str) -> None:
         """``padded``: the enumeration's states (:data:`_Padded`, coinciding ones already
-        merged); ``missing``: the feasible formations among them without a stable state
-        (the direct minimisation's candidates)."""
-        self.__dict__.update(_enum=padded, _padded=padded if not len(missing) else None,
+        merged), or a function building them on first need; ``kind``: their kinds (B, K);
+        ``missing``: the feasible formations among them without a stable state (the
+        direct minimisation's candidates)."""
+        ready = not callable(padded) and not len(missing)
+        self.__dict__.update(_enum=padded, _kind=kind, _padded=padded if ready else None,
                              _missing=missing, _found={}, _success=None, _status=None,
                              _message=None, feasible=feasible, sheet=sheet,
                              formations=formations, hold_height=hold_height, mass=mass,
@@ -687,11 +691,20 @@ class BatchFKResult(CompactRepr):
     tensions = _padded_field(6)
     kind = _padded_field(7)
 
+    def _states(self) -> _Padded:
+        """The enumeration's padded states (``_enum``), built on first call when given as
+        a function, published at once."""
+        enum = self._enum
+        if callable(enum):
+            enum = enum()
+            self.__dict__["_enum"] = enum
+        return enum
+
     def _lowest_of(self, b: int) -> tuple[tuple[Equilibrium, ...], bool, str | None]:
         """:func:`_with_lowest` of formation ``b`` (one of ``_missing``), worked out once."""
         found = self._found.get(b)
         if found is None:
-            found = _with_lowest(_row_states(self.sheet, self._enum, b), self.sheet,
+            found = _with_lowest(_row_states(self.sheet, self._states(), b), self.sheet,
                                  self.formations[b], self.hold_height, self.mass)
             self._found[b] = found
         return found
@@ -703,12 +716,16 @@ class BatchFKResult(CompactRepr):
         padded = self._padded
         if padded is not None:
             return padded
+        if not len(self._missing):
+            padded = self._states()
+            self.__dict__["_padded"] = padded
+            return padded
         supplied = {}
         for b in self._missing.tolist():
             eqs, direct, _ = self._lowest_of(b)
             if direct:
                 supplied[b] = eqs
-        enum = self._enum
+        enum = self._states()
         K = max([enum[1].shape[1]] + [len(e) for e in supplied.values()])
         padded = (enum[0].copy(),) + tuple(
             None if a is None else _widen(a, K, fill)
@@ -723,7 +740,7 @@ class BatchFKResult(CompactRepr):
     def success(self) -> np.ndarray:
         s = self._success
         if s is None:
-            s = self.feasible & _has_kind(self._enum[7], KIND_STABLE)
+            s = self.feasible & _has_kind(self._kind, KIND_STABLE)
             missing = self._missing
             if len(missing):
                 # Only next to a similar copy can the descent supply a stable state
@@ -781,7 +798,7 @@ class BatchFKResult(CompactRepr):
         if found is not None:
             return FKResult._settled(found, self.method, self.sheet, formation,
                                      self.hold_height, self.mass)
-        return FKResult(_row_states(self.sheet, self._enum, b), None, self.method,
+        return FKResult(_row_states(self.sheet, self._states(), b), None, self.method,
                         self.sheet, formation, self.hold_height, self.mass)
 
 
