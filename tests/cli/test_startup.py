@@ -43,9 +43,12 @@ def _heavy(modules: list[str]) -> list[str]:
 
 def test_fk_loads_only_what_fk_needs(tmp_path):
     env = dict(os.environ, TAUT_NUMBA="auto", NUMBA_CACHE_DIR=str(tmp_path))
-    # a fresh lock: the cold process starts no background warmup
+    # A fresh lock: the cold process starts no background warmup (one would compile every
+    # kernel into tmp_path, ~65 s of CPU outliving the test). The stamp's path does not
+    # depend on TAUT_NUMBA; asked with "never", the asking process starts none either.
     stamp = subprocess.run([sys.executable, "-c", "import taut._jit as j; print(j.stamp_path())"],
-                           env=env, capture_output=True, text=True, check=True).stdout
+                           env=dict(env, TAUT_NUMBA="never"), capture_output=True, text=True,
+                           check=True).stdout
     Path(stamp.strip() + ".lock").write_text("0")
     assert _heavy(_loaded(["fk", EXAMPLE1], env)) == []
     assert _heavy(_loaded(["fk", EXAMPLE1])) == []            # the suite's: TAUT_NUMBA=always
