@@ -233,7 +233,7 @@ def test_progress_lines_when_not_a_terminal(capsys, monkeypatch):
     assert capsys.readouterr().err == ""                      # short runs stay silent
 
 
-@pytest.mark.parametrize("value", ["soon", "-1", "nan", "inf"])
+@pytest.mark.parametrize("value", ["soon", "-1", "nan", "inf", "1e308"])
 def test_a_bad_progress_delay_is_one_line(capsys, monkeypatch, value):
     """TAUT_PROGRESS_AFTER_S is an input like any other: refused in one line, exit 2."""
     monkeypatch.setenv("TAUT_PROGRESS_AFTER_S", value)

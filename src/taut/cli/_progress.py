@@ -22,6 +22,8 @@ __all__ = ["working", "computing", "FIRST_NOTICE_S", "NOTICE_EVERY_S", "first_no
 #: A run shorter than this prints no progress at all, s (default of
 #: ``TAUT_PROGRESS_AFTER_S``).
 FIRST_NOTICE_S = 2.0
+#: Largest ``TAUT_PROGRESS_AFTER_S``, s (a day; a longer wait overflows the thread's timer).
+MAX_FIRST_NOTICE_S = 86_400.0
 #: Interval between the plain progress lines when stderr is not a terminal, s.
 NOTICE_EVERY_S = 10.0
 
@@ -48,9 +50,9 @@ def first_notice_s() -> float:
         value = float(raw)
     except ValueError:
         value = math.nan
-    if not (math.isfinite(value) and value >= 0):
-        raise InvalidInputError("TAUT_PROGRESS_AFTER_S",
-                                f"must be a number of seconds >= 0, got {raw!r}")
+    if not (math.isfinite(value) and 0 <= value <= MAX_FIRST_NOTICE_S):
+        raise InvalidInputError("TAUT_PROGRESS_AFTER_S", f"must be a number of seconds in "
+                                f"0..{MAX_FIRST_NOTICE_S:g}, got {raw!r}")
     return value
 
 
