@@ -3,7 +3,8 @@
 A user never waits for the compiler (docs/compiled_kernels.md). Every kernel is written
 once, as plain Python that numba can compile; :func:`jit` returns either
 ``numba.njit(cache=True, nogil=True, error_model="numpy")`` of it (float division by zero
-gives inf/NaN as in numpy) or the function itself. The choice is made once per process,
+gives inf/NaN as in numpy) or the function itself (:func:`jit_inline`: the same, inlined
+into its compiled callers). The choice is made once per process,
 here, from the environment variable ``TAUT_NUMBA``:
 
 ``auto`` (default)
@@ -42,13 +43,13 @@ import tempfile
 import time
 from functools import lru_cache
 from importlib.util import find_spec
-from typing import Any, Callable
+from typing import Any, Callable, Literal
 
 from . import __version__
 from .errors import InvalidInputError, TautError
 
-__all__ = ["MODES", "MODE", "HAVE_NUMBA", "KERNEL_SOURCES", "jit", "not_compiled_reason",
-           "cache_dir", "stamp_path", "is_warm", "warm_in_background", "compile_kernels",
+__all__ = ["MODES", "MODE", "HAVE_NUMBA", "KERNEL_SOURCES", "jit", "jit_inline",
+           "not_compiled_reason", "cache_dir", "stamp_path", "is_warm", "warm_in_background", "compile_kernels",
            "LOAD_COST_S", "prefer_compiled", "charge_numpy"]
 
 #: Values of the environment variable ``TAUT_NUMBA`` (module docstring).
@@ -255,6 +256,27 @@ def not_compiled_reason() -> str:
 
 def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
     """``numba.njit(cache=True)`` of ``fn`` when :data:`HAVE_NUMBA`, else ``fn`` itself."""
+    return _njit(fn, "never")
+
+
+def jit_inline(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """:func:`jit`, with ``fn`` inlined into every compiled caller (numba's
+    ``inline="always"``, at numba's IR level) instead of called.
+
+    For the small helpers a kernel calls per candidate or per row. A compiled call passes
+    each array argument as ~7-9 machine words and LLVM does not inline these helpers on
+    its own: on the 4-robot FK batch (bench/bench_fk.py's team, 3 rest states a formation)
+    the calls were ~20 % of the kernel's time. The price is compile time (every caller
+    compiles its own copy: ``taut compile`` ~67 s -> ~84 s of CPU), paid at install, not on
+    a user's path. The results are the same floating-point operations (bit-identical
+    rows, tests/sheet/fk). A caller's cache entry is not invalidated when an inlined
+    helper in another file changes (as for any cross-file call; module docstring)."""
+    return _njit(fn, "always")
+
+
+def _njit(fn: Callable[..., Any], inline: Literal["never", "always"]) -> Callable[..., Any]:
+    """``numba.njit`` of ``fn`` with the project's options when :data:`HAVE_NUMBA`, else
+    ``fn`` itself."""
     if not HAVE_NUMBA:
         return fn
     import numba
@@ -262,4 +284,4 @@ def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
     directory, override = cache_dir()
     if override:
         numba.config.CACHE_DIR = directory  # type: ignore[attr-defined]
-    return numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
+    return numba.njit(cache=True, nogil=True, error_model="numpy", inline=inline)(fn)

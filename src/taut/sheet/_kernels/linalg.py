@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..._jit import jit
+from ..._jit import jit, jit_inline
 from .._tol import ANGLE_TOL, COINCIDE_RTOL2, JACOBI_TOL
 
 #: Columns of the 3 x 3 minors giving the null vector of a 3 x 4 matrix (signs +-+-).
@@ -55,7 +55,7 @@ def _lu_solve(K, rhs, n):
     return det, True
 
 
-@jit
+@jit_inline
 def _lu_solve4(r0, r1, r2, r3):
     """:func:`_lu_solve` for ``n = 4`` on the rows ``(K[i, 0], ..., K[i, 3], rhs[i])`` as
     tuples (kept in registers, no loop): the same pivots, operations and order, hence
@@ -132,7 +132,7 @@ def _eliminate5(ri, rk, f):
             ri[4] - f * rk[4])
 
 
-@jit
+@jit_inline
 def _lu_solve5(r0, r1, r2, r3, r4):
     """:func:`_lu_solve4` for ``n = 5`` (rows ``(K[i, 0], ..., K[i, 4], rhs[i])``):
     bit-identical to :func:`_lu_solve`. Returns ``(det, ok_solved, y0, ..., y4)``.
@@ -283,7 +283,7 @@ def _singular_extremes(W, n):
 _CCW_SIN, _ARC_SIN = 1e-12, 2e-6
 
 
-@jit
+@jit_inline
 def _in_hull(Rn, taut, N, px, py, ang):
     """The paper's projection test (``_kernel.in_hull_2d``) for the robots in ``taut``:
     True when the projected object ``(px, py)`` sits on a taut robot, else when no angular
@@ -359,7 +359,7 @@ def _surely_outside(Rn, taut, N, px, py):
     return False
 
 
-@jit
+@jit_inline
 def _surely_inside(Rn, taut, N, px, py):
     """True when ``(px, py)`` (no taut robot at it) lies inside a triangle of three robots
     in ``taut``, each seen from it turning the same way to the next by a sine above
@@ -409,7 +409,7 @@ def _reduced_min_eig(P, members, s):
     return _reduced_min_eig_ws(P, members, s, np.empty((EIG_WORK_ROWS, 4)))
 
 
-@jit
+@jit_inline
 def _reduced_min_eig_ws(P, members, s, work):
     """:func:`_reduced_min_eig` on a caller's work array ``work`` (``EIG_WORK_ROWS``, 4):
     no allocation (the per-call path of the small-team kernel)."""
@@ -439,7 +439,7 @@ def _reduced_min_eig_ws(P, members, s, work):
     return num / den
 
 
-@jit
+@jit_inline
 def _min_eig_three(P, i, j, k):
     """The 3-member case of :func:`_reduced_min_eig_ws`: the face's tangent space is the
     orthogonal complement of the plane spanned by ``d1 = P_j - P_i`` and ``d2 = P_k - P_i``

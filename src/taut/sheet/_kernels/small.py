@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ..._jit import HAVE_NUMBA, jit
+from ..._jit import HAVE_NUMBA, jit, jit_inline
 from .linalg import (EIG_WORK_ROWS, _in_hull, _lu_solve, _lu_solve4, _lu_solve5,
     _reduced_min_eig_ws, _singular_extremes)
 from .._tol import CURVATURE_TOL, INSIDE_WEIGHT, MAX_CONDITION, SINGULAR_RTOL, TAUT_TOL, WEIGHT_TOL
@@ -182,7 +182,7 @@ def _lagrange(G, bvec, members, s, K, rhs, work):
     return _clear(det, solved, norms) or _conditioned(G, members, s, work, solved)
 
 
-@jit
+@jit_inline
 def _clear(det, solved, norms):
     """The bordered system is solved and clearly regular (relative determinant)."""
     return solved and abs(det) > SINGULAR_RTOL * norms
@@ -216,7 +216,7 @@ def _fill_bordered(G, members, s, K):
     K[s, s] = 0.0
 
 
-@jit
+@jit_inline
 def _bordered3(G, bvec, i, j, k, rhs):
     """:func:`_lagrange`'s system for the members ``i, j, k``: rows as tuples, the
     product of the row norms in :func:`_lagrange`'s order, :func:`_lu_solve4`; the
@@ -239,7 +239,7 @@ def _bordered3(G, bvec, i, j, k, rhs):
     return det, solved, norms
 
 
-@jit
+@jit_inline
 def _bordered4(G, bvec, i, j, k, m, rhs):
     """:func:`_bordered3` for the four members ``i, j, k, m`` (:func:`_lu_solve5`)."""
     r0 = (G[i, i], G[i, j], G[i, k], G[i, m], 1.0, bvec[i])
@@ -268,7 +268,7 @@ def _bordered4(G, bvec, i, j, k, m, rhs):
     return det, solved, norms
 
 
-@jit
+@jit_inline
 def centroid(R):
     """Mean ``(x, y)`` of the points ``R`` (N, 2)."""
     N = R.shape[0]
@@ -280,7 +280,7 @@ def centroid(R):
     return cx / N, cy / N
 
 
-@jit
+@jit_inline
 def _frame(R, Vn, scale, Rn, P, G, bvec):
     """Normalised robots ``Rn``, lifted points ``P`` (N, 5), Gram matrix ``G`` and ``b``
     (``_kernel.Frame.build``); returns the formation centre (cx, cy)."""
@@ -303,7 +303,7 @@ def _frame(R, Vn, scale, Rn, P, G, bvec):
     return cx, cy
 
 
-@jit
+@jit_inline
 def feasible(R, lim2):
     """Finite coordinates and no robot pair farther apart than its (tolerant) sheet
     distance (``model.check_formations``); ``lim2`` (N, N) squared limits."""
@@ -383,7 +383,7 @@ def _candidates(Rn, P, G, bvec, table, sizes, z2, sol, taut, key, lin):
     return found
 
 
-@jit
+@jit_inline
 def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang, eig):
     """Step 4 for candidate ``c`` whose exact taut set is ``taut_c``: -1 when the paper's
     projection test fails, else the status (``PENDING`` for weight families). ``ang``
@@ -408,7 +408,7 @@ def _classify_row(Rn, P, table, sizes, c, sol, taut_c, tsize, ang, eig):
     return SADDLE
 
 
-@jit
+@jit_inline
 def _write_row(out, k, status, c, sol, taut_c, tsize, table, sizes, Vn, scale, cx, cy,
                vcx, vcy, hold):
     """Row ``k`` of ``out`` in the caller's units (layout in the module docstring)."""
