@@ -8,20 +8,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("rerun")
-
-import rerun.chunk as rc  # noqa: E402
-
-from taut.cli import main  # noqa: E402
-from taut.io import load_sheet_scenario, write_rerun  # noqa: E402
-from taut.io.trajectory import load_trajectory  # noqa: E402
-from taut.sheet import simulate  # noqa: E402
+from taut.cli import main
+from taut.io import load_sheet_scenario, write_rerun
+from taut.io.trajectory import load_trajectory
+from taut.sheet import simulate
 
 SHEET = Path(__file__).resolve().parents[2] / "examples" / "sheet"
 
 
+@pytest.fixture(scope="module", autouse=True)
+def rc():
+    """rerun's chunk reader; every test here skips without rerun. Imported when the tests
+    run, not at collection (~0.5 s of CPU in each pytest-xdist worker)."""
+    return pytest.importorskip("rerun.chunk")
+
+
 def columns(path: Path) -> dict[str, dict[str, list]]:
     """entity path -> column name -> values (rows of every chunk, in time order)."""
+    import rerun.chunk as rc
     out: dict[str, dict[str, list]] = {}
     for chunk in rc.RrdReader(path).stream():
         batch = chunk.to_record_batch()
@@ -38,7 +42,7 @@ def simulation():
     return sc, traj, simulate(sc.team, traj.formations)
 
 
-def test_simulation_recording_loads_with_a_blueprint(tmp_path, simulation):
+def test_simulation_recording_loads_with_a_blueprint(tmp_path, simulation, rc):
     sc, traj, sim = simulation
     out = write_rerun(sim, tmp_path / "sim.rrd", length_unit=sc.units, times=traj.time)
     reader = rc.RrdReader(out)

@@ -16,6 +16,20 @@ def _sampled_distance(p0, p1, q0, q1, n=401):
     return np.sqrt(d2.min())
 
 
+def _sampled_distance_rows(p0, p1, q0, q1, n=401):
+    """The minimum of ``_sampled_distance``'s n x n grid in O(n): for each sample on the
+    first segment the squared distance is convex in the second's parameter, so the grid
+    minimum of that row is at one of the two samples around its unconstrained minimiser."""
+    s = np.linspace(0, 1, n)
+    a = p0 + s[:, None] * (p1 - p0)
+    v = q1 - q0
+    vv = v @ v
+    t_star = np.clip(((a - q0) @ v) / vv if vv > 0 else np.zeros(n), 0.0, 1.0)
+    k = np.clip(np.floor(t_star * (n - 1)).astype(int)[:, None] + [0, 1], 0, n - 1)
+    b = q0 + s[k][..., None] * v                    # (n, 2, 3): the two candidate samples
+    return np.sqrt(((a[:, None, :] - b) ** 2).sum(-1).min())
+
+
 coord = st.floats(-2.0, 2.0, allow_nan=False)
 point = st.tuples(coord, coord, coord).map(np.array)
 
@@ -111,8 +125,9 @@ def test_shared_attachment_pairs_of_ipanema_match_sampling():
         for i, j in pairs:
             a_i = att[b, i] + ell * st_.unit[b, i]
             a_j = att[b, j] + ell * st_.unit[b, j]
-            sampled = _sampled_distance(a_i, robot.exits_world[i], a_j,
-                                        robot.exits_world[j], n=2001)
+            # the 2001 x 2001 grid's minimum, row by row (the full grid was 2 s of CPU)
+            sampled = _sampled_distance_rows(a_i, robot.exits_world[i], a_j,
+                                             robot.exits_world[j], n=2001)
             assert res.distance[b, i, j] <= sampled + 1e-12
             assert sampled <= res.distance[b, i, j] + 0.01
             assert res.distance[b, i, j] > 0    # not interfering: they only meet at the ring

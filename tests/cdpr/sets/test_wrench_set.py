@@ -139,7 +139,8 @@ def test_stabilisers_never_reduce_capacities(fastkit):
 
 
 def test_capacity_margin_sign_matches_feasibility(fastkit):
-    poses = random_poses(fastkit, 120, seed=31, angle=0.05)
+    # 60 poses: 14 feasible and 46 not, with and without tipping (120: 0.6 s more CPU)
+    poses = random_poses(fastkit, 60, seed=31, angle=0.05)
     D = external_wrench_box(fastkit, [3, 3, 3, 0.3, 0.3, 0.3])
     assert D.shape == (64, 6)
     for tip in (False, True):

@@ -10,7 +10,8 @@ from taut.errors import InvalidInputError
 
 from cdpr_helpers import A, H, MASS, point_mass_robot, random_poses
 
-N_POSES = 600          # per preset; LP and SLSQP loops make this the costly fixture
+N_POSES = 400          # per preset; LP and SLSQP loops make this the costly fixture
+                       # (148 LP-feasible FASTKIT poses at seed 1, over the > 100 asked below)
 G = 9.81
 
 
@@ -73,9 +74,12 @@ def test_optimality_of_each_method(solved, name):
 
 
 def test_qp_enumeration_matches_scipy(fastkit):
-    P = random_poses(fastkit, 400, seed=5)
+    # the first 25 LP-feasible of these 400 poses are among the first 120 (the 25th is pose
+    # 99): the LP runs on those only (0.3 s of CPU less), the poses compared are the same
+    P = random_poses(fastkit, 400, seed=5)[:120]
     f = distribute_tensions(fastkit, P, "lp_min_sum").success
     P = P[f][:25]
+    assert len(P) == 25
     for tip in (False, True):
         a = distribute_tensions(fastkit, P, "qp_min_norm", tipping=tip)
         b = distribute_tensions(fastkit, P, "qp_min_norm", tipping=tip, qp_solver="scipy")
@@ -84,7 +88,9 @@ def test_qp_enumeration_matches_scipy(fastkit):
 
 
 def test_tipping_constrained_methods_agree(fastkit):
-    P = random_poses(fastkit, 800, seed=7)
+    # 250 poses: 12 tip-only infeasible at seed 7 (5-13 at seeds 1-5; ~4 % of poses), so
+    # the "...and here it does" assertion bites; 800 poses cost 2 s more CPU.
+    P = random_poses(fastkit, 250, seed=7)
     lp = distribute_tensions(fastkit, P, "lp_min_sum", tipping=True)
     qp = distribute_tensions(fastkit, P, "qp_min_norm", tipping=True)
     free = distribute_tensions(fastkit, P, "lp_min_sum", tipping=False)
@@ -103,7 +109,7 @@ def test_unequal_limits_closed_form(fastkit):
     cables = tuple(replace(c, t_min=1.0 + i, t_max=30.0 + 5 * i)
                    for i, c in enumerate(fastkit.cables))
     robot = replace(fastkit, cables=cables)
-    P = random_poses(robot, 600, seed=11)
+    P = random_poses(robot, 300, seed=11)      # 105 closed-form feasible (600: 0.35 s more)
     cf = distribute_tensions(robot, P, "closed_form", tipping=False)
     lp = distribute_tensions(robot, P, "lp_min_sum", tipping=False)
     assert cf.success.sum() > 50
