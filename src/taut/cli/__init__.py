@@ -26,6 +26,7 @@ import sys
 import threading
 import warnings
 from collections.abc import Iterable
+from functools import lru_cache
 from importlib import import_module
 from typing import Any
 
@@ -65,6 +66,16 @@ def build_app(commands: Iterable[str] = tuple(COMMANDS)) -> typer.Typer:
     for name in dict.fromkeys(COMMANDS[c] for c in commands):
         import_module(f"{__name__}.{name}").register(app)
     return app
+
+
+@lru_cache(maxsize=None)
+def _command(commands: tuple[str, ...]) -> Any:
+    """The click command of ``build_app(commands)``, built once per process for each set
+    of commands. Typer converts its whole app into click objects on every call of the app
+    (1-20 ms by the command); a process calling :func:`main` many times (the test suite,
+    a script looping over command lines) paid that per call. click makes a fresh context
+    for every invocation, so nothing carries over from one call to the next."""
+    return typer.main.get_command(build_app(commands))
 
 
 def __getattr__(name: str) -> Any:
@@ -249,7 +260,8 @@ def main(argv: list[str] | None = None) -> int:
 def _run(argv: list[str] | None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
     try:
-        result = build_app(_needed(args))(args=args, prog_name="taut", standalone_mode=False)
+        result = _command(_needed(args)).main(args=args, prog_name="taut",
+                                              standalone_mode=False)
     except TautError as exc:
         return _fail(str(exc))
     except KeyboardInterrupt:
