@@ -276,3 +276,42 @@ def test_chunk_size_is_bounded_in_the_file(examples_dir):
                             "chunk_size": MAX_CHUNK + 1, "parameters": {"scale": [0.8]}},
                            examples_dir.parent)
     assert err.value.field == "chunk_size"
+
+
+@pytest.mark.parametrize("at", ["table", "rename", "hash", "checksum"])
+def test_ctrl_c_inside_a_chunk_write_keeps_the_chunk_and_its_checksum(fk_spec, tmp_path,
+                                                                     monkeypatch, at):
+    """A Ctrl-C anywhere in a chunk's write (while Parquet writes it, at its rename, while
+    it is hashed, while the checksum is written) still interrupts (KeyboardInterrupt, once
+    the pair is written), and the chunk is there whole with its checksum: the resumed run
+    takes it as finished. (Fresh-clone CI once kept a chunk without its checksum.)"""
+    import hashlib
+    import signal
+
+    from taut.sweep import store as store_module
+
+    def interrupted(fn, when=lambda *args: True):
+        def wrapped(*args, **kw):
+            if when(*args):
+                signal.raise_signal(signal.SIGINT)      # Python's handler: KeyboardInterrupt
+            return fn(*args, **kw)
+        return wrapped
+
+    target, when = {                # (the manifest's rewrite comes first: not that one)
+        "table": ((store_module, "to_table"), lambda *a: True),
+        "rename": ((store_module.os, "replace"), lambda src, dst: dst.name.endswith("quet")),
+        "hash": ((store_module, "_sha256"), lambda *a: True),
+        "checksum": ((Path, "write_text"), lambda path, *a: ".sha256" in path.name)}[at]
+    spec = fk_spec(scale=[0.8, 0.9])
+    with Store(tmp_path / "run", spec.digest, resume=False) as store:
+        monkeypatch.setattr(*target, interrupted(getattr(*target), when))
+        with pytest.raises(KeyboardInterrupt):
+            store.write_chunk(0, {"x": np.arange(5.0)})
+        monkeypatch.undo()
+        if at == "table":                    # before the write began: nothing is written
+            assert store.state(0) == "not computed"
+            return
+        assert store.state(0) == "finished"
+        chunk = store.chunk_path(0)
+        digest = Path(f"{chunk}.sha256").read_text().split()[0]
+        assert hashlib.sha256(chunk.read_bytes()).hexdigest() == digest

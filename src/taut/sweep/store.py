@@ -20,10 +20,13 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import signal
 import socket
+import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -69,6 +72,33 @@ def _atomic_write(path: Path, write: Any) -> None:
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+#: Signals whose Python handlers :func:`_uninterrupted` holds back: Ctrl-C, and the alarm
+#: by which the CLI raises a swallowed interrupt again (:mod:`taut.cli`).
+_DEFERRED = tuple(getattr(signal, name) for name in ("SIGINT", "SIGALRM")
+                  if hasattr(signal, name))
+
+
+@contextmanager
+def _uninterrupted() -> Iterator[None]:
+    """Run the block whole: a Ctrl-C (or the CLI's repeat alarm) arriving inside it is
+    held and sent again when the block ends, to the disposition that was in place (in the
+    CLI a ``KeyboardInterrupt`` then). Only the main thread receives signals; elsewhere,
+    and for a signal whose handler was not installed from Python, the block runs as is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous = {s: signal.signal(s, lambda signum, frame: held.append(signum))
+                for s in _DEFERRED if signal.getsignal(s) is not None}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        for s in held:
+            signal.raise_signal(s)
 
 
 def _sha256(path: Path) -> str:
@@ -264,10 +294,13 @@ class Store:
         self._ensure()
         self._check_manifest()
         path = self.chunk_path(index)
-        _atomic_write(path, lambda p: pq.write_table(table, p))
-        digest = _sha256(path)
-        _atomic_write(path.with_name(path.name + ".sha256"),
-                      lambda p: p.write_text(digest + "\n", encoding="ascii"))
+        # A Ctrl-C between the two files would leave a whole chunk without its checksum
+        # (seen in CI: a resumed run then computes it again); the pair is written whole.
+        with _uninterrupted():
+            _atomic_write(path, lambda p: pq.write_table(table, p))
+            digest = _sha256(path)
+            _atomic_write(path.with_name(path.name + ".sha256"),
+                          lambda p: p.write_text(digest + "\n", encoding="ascii"))
 
     def assemble(self, chunks: int, rows: int, metadata: dict[str, str]) -> Path:
         """Write chunks ``0..chunks-1`` in order, first ``rows`` rows, to ``results.parquet``
