@@ -303,15 +303,22 @@ def test_ctrl_c_inside_a_chunk_write_keeps_the_chunk_and_its_checksum(fk_spec, t
         "hash": ((store_module, "_sha256"), lambda *a: True),
         "checksum": ((Path, "write_text"), lambda path, *a: ".sha256" in path.name)}[at]
     spec = fk_spec(scale=[0.8, 0.9])
-    with Store(tmp_path / "run", spec.digest, resume=False) as store:
-        monkeypatch.setattr(*target, interrupted(getattr(*target), when))
-        with pytest.raises(KeyboardInterrupt):
-            store.write_chunk(0, {"x": np.arange(5.0)})
-        monkeypatch.undo()
-        if at == "table":                    # before the write began: nothing is written
-            assert store.state(0) == "not computed"
-            return
-        assert store.state(0) == "finished"
-        chunk = store.chunk_path(0)
-        digest = Path(f"{chunk}.sha256").read_text().split()[0]
-        assert hashlib.sha256(chunk.read_bytes()).hexdigest() == digest
+    # Python's own Ctrl-C handler: a shell starts a background job with SIGINT ignored,
+    # and Python then installs none (so ran CI; raise_signal would do nothing).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with Store(tmp_path / "run", spec.digest, resume=False) as store:
+            monkeypatch.setattr(*target, interrupted(getattr(*target), when))
+            with pytest.raises(KeyboardInterrupt):
+                store.write_chunk(0, {"x": np.arange(5.0)})
+            monkeypatch.undo()
+            stored = store.state(0)
+            chunk = store.chunk_path(0)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if at == "table":                        # before the write began: nothing is written
+        assert stored == "not computed"
+        return
+    assert stored == "finished"
+    digest = Path(f"{chunk}.sha256").read_text().split()[0]
+    assert hashlib.sha256(chunk.read_bytes()).hexdigest() == digest
