@@ -53,15 +53,17 @@ VVCM_RS = ("import numpy as np, vvcm_rs\n"
 
 
 def run(args: list[str], env: dict[str, str], cwd: Path = ROOT) -> tuple[float, float]:
-    """Wall and CPU seconds of one process run in ``cwd`` (fails loudly on a non-zero
-    exit but 1 for a valid "no" answer)."""
+    """Wall and CPU seconds of one process run in ``cwd`` (fails loudly on a traceback or
+    a non-zero exit but 1, a valid "no" answer)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     out = subprocess.run([sys.executable, *args], env=env, cwd=cwd, capture_output=True,
                          text=True)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if out.returncode not in (0, 1):
+    # Python's own crash exits 1 too: a traceback is a failure whatever the code (a broken
+    # "before" revision, f552908, once passed for a 0.9 s "first plan" this way).
+    if out.returncode not in (0, 1) or "Traceback (most recent call last)" in out.stderr:
         raise SystemExit(f"{args} failed ({out.returncode}): {out.stderr.strip()[-400:]}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return wall, cpu

@@ -227,3 +227,21 @@ def _assert_close(a, b, path="plan"):
         assert abs(a - b) <= 1e-9 * max(1.0, abs(a)), (path, a, b)
     else:
         assert a == b, (path, a, b)
+
+
+def test_warmup_byte_compiles_every_module(tmp_path):
+    """`taut compile` (the warmup) also writes the package's bytecode, as pip does for a
+    wheel, so the first command after it compiles no module: every module of a copy
+    without ``__pycache__`` gets the file import reads (``cache_from_source``)."""
+    import importlib.util
+
+    from taut import _warmup
+
+    pkg = tmp_path / "taut"
+    shutil.copytree(SRC, pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    sources = sorted(pkg.rglob("*.py"))
+    assert len(sources) > 100 and not list(pkg.rglob("*.pyc"))
+    assert _warmup.bytecode(str(pkg))
+    missing = [p for p in sources if not Path(importlib.util.cache_from_source(str(p))).is_file()]
+    assert not missing, missing[:5]
+    assert _warmup.warm.__code__.co_names.count("bytecode") == 1     # the warmup calls it
