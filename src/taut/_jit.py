@@ -49,8 +49,8 @@ from . import __version__
 from .errors import InvalidInputError, TautError
 
 __all__ = ["MODES", "MODE", "HAVE_NUMBA", "KERNEL_SOURCES", "jit", "jit_inline",
-           "not_compiled_reason", "cache_dir", "stamp_path", "is_warm", "warm_in_background", "compile_kernels",
-           "LOAD_COST_S", "prefer_compiled", "charge_numpy"]
+           "not_compiled_reason", "cache_dir", "stamp_path", "is_warm", "warm_in_background",
+           "compile_kernels", "LOAD_COST_S", "prefer_compiled", "charge_numpy"]
 
 #: Values of the environment variable ``TAUT_NUMBA`` (module docstring).
 MODES = ("auto", "always", "never")

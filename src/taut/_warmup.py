@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _jit
 
-__all__ = ["warm"]
+__all__ = ["warm", "bytecode"]
 
 #: The planning paper's corridor (examples/plan/paper_corridor.yaml): a plan that runs
 #: the lattice search, the clearance proofs and formation changes.

@@ -290,7 +290,7 @@ def test_ctrl_c_inside_a_chunk_write_keeps_the_chunk_and_its_checksum(fk_spec, t
 
     from taut.sweep import store as store_module
 
-    def interrupted(fn, when=lambda *args: True):
+    def interrupted(fn, when):
         def wrapped(*args, **kw):
             if when(*args):
                 signal.raise_signal(signal.SIGINT)      # Python's handler: KeyboardInterrupt
